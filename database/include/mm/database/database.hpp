@@ -1,0 +1,85 @@
+#pragma once
+// The motion database: every clip resampled to one rate, expressed relative to a simulation
+// root (joint 0), with velocities, foot contacts, clip ranges and tags, and the normalized
+// feature matrix the search runs over. Built by the builder (builder.hpp), saved and loaded as
+// one versioned binary file (database_file.hpp).
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mm/database/features.hpp"
+#include "mm/runtime/skeleton.hpp"
+
+namespace mm {
+
+// One source take inside the database. Frames [start, end) belong to it; nothing is ever
+// matched or blended across a clip boundary.
+struct ClipRange {
+  std::string name;     // source file stem; mirrored copies end in "_mirror"
+  int start = 0;        // first database frame of the clip
+  int end = 0;          // one past the last frame
+  uint64_t tags = 0;    // bit i set when the clip carries Database::tag_names[i]
+  bool mirrored = false;
+  int frame_count() const { return end - start; }
+};
+
+// Joint indices of the roles the features and the controller need (-1 when absent).
+struct JointRoleIndices {
+  int hips = -1;
+  int left_foot = -1;
+  int right_foot = -1;
+  int left_toe = -1;
+  int right_toe = -1;
+  int head = -1;
+};
+
+struct Database {
+  // Joint 0 is the simulation root (hips projected on the ground, smoothed facing); the source
+  // skeleton's joints follow it, depth-first. Rest transforms are the first clip's.
+  Skeleton skeleton;
+  JointRoleIndices roles;
+  float frame_time = 1.0f / 30.0f;  // seconds
+  int frame_count = 0;
+
+  // Per-frame, per-joint arrays, frame-major: [frame * joint_count + joint]. Local to the
+  // parent; joint 0's values are relative to the world (its clip's origin).
+  std::vector<glm::vec3> local_positions;           // metres
+  std::vector<glm::quat> local_rotations;           // unit
+  std::vector<glm::vec3> local_velocities;          // metres / second, in the parent's frame
+  std::vector<glm::vec3> local_angular_velocities;  // radians / second, in the parent's frame
+  // Per-frame foot contacts: [frame * 2 + 0] left, [frame * 2 + 1] right; 1 = in contact.
+  std::vector<uint8_t> contacts;
+
+  std::vector<ClipRange> clips;
+  std::vector<std::string> tag_names;  // at most 64
+
+  // The feature matrix: frame_count rows of schema.dims() floats, row-major, normalized:
+  // features[f * dims + c] = (raw - feature_offset[c]) / feature_scale[c]. The plain squared
+  // Euclidean distance between rows is the weighted distance the search minimizes.
+  FeatureSchema schema;
+  std::vector<float> features;
+  std::vector<float> feature_offset;  // dims: per-column mean
+  std::vector<float> feature_scale;   // dims: group standard deviation / weight (never 0)
+  // 1 when the frame may be matched: every feature time of the frame lies inside its clip.
+  std::vector<uint8_t> searchable;
+  // Clip index of every frame (derived from clips on build and load).
+  std::vector<int> frame_clip;
+
+  int joint_count() const { return skeleton.joint_count(); }
+  int feature_dims() const { return schema.dims(); }
+  std::span<const float> feature_row(int frame) const {
+    const size_t d = static_cast<size_t>(feature_dims());
+    return {features.data() + frame * d, d};
+  }
+  // Bit mask of the named tags (unknown names give no bits), for search filters.
+  uint64_t tag_mask(std::span<const std::string> names) const;
+  // Consistency of sizes and indices between all the arrays above.
+  Status validate() const;
+};
+
+}  // namespace mm

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the project needs (only those missing), then configures and
+# builds one configuration. Usage: scripts/setup.sh [release|asan|fuzz]   (default: release)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libglm-dev libtinygltf-dev libflann-dev nlohmann-json3-dev libstb-dev
+  libglfw3-dev libgl-dev libegl-dev libosmesa6-dev libgl1-mesa-dri xvfb xauth
+  libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev xz-utils
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing missing Debian packages: ${missing[*]}"
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+config=${1:-release}
+jobs=$(nproc)
+case "$config" in
+  release)
+    cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DMM_WERROR=ON >/dev/null ;;
+  asan)
+    cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON -DMM_WERROR=ON \
+      -DMM_BUILD_BENCH=OFF >/dev/null ;;
+  fuzz)
+    CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_BUILD_FUZZ=ON \
+      -DMM_BUILD_TESTS=OFF -DMM_BUILD_BENCH=OFF >/dev/null ;;
+  *) echo "setup: unknown configuration '$config' (release, asan or fuzz)" >&2; exit 2 ;;
+esac
+echo "setup: building build/$config with $jobs jobs"
+cmake --build "build/$config" -j "$jobs"

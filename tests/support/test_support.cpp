@@ -1,0 +1,30 @@
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+namespace mm::test {
+
+std::filesystem::path mocap_dir() { return std::filesystem::path(MM_SHARED_DIR) / "mocap"; }
+
+std::filesystem::path data_dir() {
+  if (const char* env = std::getenv("MM_DATA"); env && *env) return env;
+  return mocap_dir() / "bandai-normal";
+}
+
+std::filesystem::path scratch_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "scratch";
+  for (char& c : name) {
+    if (c == '/') c = '_';
+  }
+  auto dir = std::filesystem::path(MM_BINARY_DIR) / "test-scratch" / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::filesystem::path clip_path(const std::string& stem) { return data_dir() / (stem + ".bvh"); }
+
+}  // namespace mm::test
