@@ -1,0 +1,235 @@
+#include "mm/runtime/interpolation.hpp"
+
+#include <cassert>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+
+namespace mm {
+
+namespace {
+
+// sin(x) / x, with its Taylor series where the division would lose precision.
+float sinc(float x) {
+  if (std::abs(x) < 1e-3f) return 1.0f - x * x * (1.0f / 6.0f);
+  return std::sin(x) / x;
+}
+
+glm::quat negated_if_far(const glm::quat& from, const glm::quat& q) {
+  return glm::dot(from, q) < 0.0f ? -q : q;
+}
+
+}  // namespace
+
+glm::quat quat_abs(const glm::quat& q) { return q.w < 0.0f ? -q : q; }
+
+glm::vec3 quat_log(const glm::quat& q) {
+  const glm::vec3 v(q.x, q.y, q.z);
+  const float s = glm::length(v);
+  // Only an exactly (or denormally) zero vector part is special; atan2(s, w) / s is accurate
+  // for every other s, tiny ones included, because atan2 keeps relative precision near 0.
+  if (s < 1e-30f) return q.w >= 0.0f ? v : glm::vec3(glm::pi<float>(), 0.0f, 0.0f);
+  return v * (std::atan2(s, q.w) / s);
+}
+
+glm::quat quat_exp(const glm::vec3& half_angle_axis) {
+  const float a = glm::length(half_angle_axis);
+  const glm::vec3 v = half_angle_axis * sinc(a);
+  return glm::quat(std::cos(a), v.x, v.y, v.z);
+}
+
+glm::vec3 quat_to_scaled_angle_axis(const glm::quat& q) { return 2.0f * quat_log(quat_abs(q)); }
+
+glm::quat quat_from_scaled_angle_axis(const glm::vec3& scaled_angle_axis) {
+  return quat_exp(0.5f * scaled_angle_axis);
+}
+
+float quat_angle_between(const glm::quat& a, const glm::quat& b) {
+  return glm::length(quat_to_scaled_angle_axis(glm::conjugate(a) * b));
+}
+
+glm::quat quat_nlerp(const glm::quat& a, const glm::quat& b, float t) {
+  const glm::quat bs = negated_if_far(a, b);
+  const glm::quat m = (1.0f - t) * a + t * bs;
+  const float len = glm::length(m);
+  // After the sign flip a and bs are less than 90 degrees apart in 4D, so m vanishes only for
+  // non-unit input; fall back to a rather than divide by zero.
+  return len > 1e-20f ? m / len : a;
+}
+
+glm::quat quat_slerp(const glm::quat& a, const glm::quat& b, float t) {
+  const glm::quat bs = negated_if_far(a, b);
+  const glm::quat relative = glm::conjugate(a) * bs;  // w >= 0: the short way round
+  return glm::normalize(a * quat_exp(t * quat_log(relative)));
+}
+
+DualQuat dual_quat_from_transform(const Transform& t) {
+  DualQuat q;
+  q.real = t.rotation;
+  q.dual = 0.5f * (glm::quat(0.0f, t.translation.x, t.translation.y, t.translation.z) * t.rotation);
+  return q;
+}
+
+Transform dual_quat_to_transform(const DualQuat& q) {
+  Transform t;
+  t.rotation = q.real;
+  t.translation = dual_quat_translation(q);
+  return t;
+}
+
+DualQuat operator*(const DualQuat& a, const DualQuat& b) {
+  DualQuat q;
+  q.real = a.real * b.real;
+  q.dual = a.real * b.dual + a.dual * b.real;
+  return q;
+}
+
+DualQuat operator+(const DualQuat& a, const DualQuat& b) {
+  DualQuat q;
+  q.real = a.real + b.real;
+  q.dual = a.dual + b.dual;
+  return q;
+}
+
+DualQuat operator*(float s, const DualQuat& q) {
+  DualQuat r;
+  r.real = s * q.real;
+  r.dual = s * q.dual;
+  return r;
+}
+
+DualQuat dual_quat_conjugate(const DualQuat& q) {
+  DualQuat r;
+  r.real = glm::conjugate(q.real);
+  r.dual = glm::conjugate(q.dual);
+  return r;
+}
+
+DualQuat dual_quat_normalize(const DualQuat& q) {
+  const float len = glm::length(q.real);
+  if (!(len > 1e-20f)) return DualQuat{};
+  DualQuat r;
+  r.real = q.real / len;
+  r.dual = q.dual / len;
+  // A unit dual quaternion has dot(real, dual) == 0; blending breaks that slightly.
+  r.dual = r.dual - glm::dot(r.real, r.dual) * r.real;
+  return r;
+}
+
+glm::vec3 dual_quat_translation(const DualQuat& q) {
+  const glm::quat t = 2.0f * (q.dual * glm::conjugate(q.real));
+  return {t.x, t.y, t.z};
+}
+
+glm::vec3 dual_quat_transform_point(const DualQuat& q, const glm::vec3& p) {
+  return q.real * p + dual_quat_translation(q);
+}
+
+DualQuat dual_quat_pow(const DualQuat& q_in, float t) {
+  // The motion x -> R x + p as a screw: R turns by angle 2*alpha about the unit axis l, and p
+  // splits into a slide `pitch` along l and a part p_perp across it. Raising to the power t
+  // turns by 2*t*alpha about the same axis line and slides t*pitch along it, which gives
+  //   p(t) = t*pitch*l + (sin(t*alpha) / sin(alpha)) * rotate(l, (t - 1)*alpha, p_perp).
+  // (Derived from p(t) = (I - R(t)) c + t*pitch*l with c the axis point solving
+  // (I - R) c = p_perp.) As alpha -> 0 the ratio tends to t, so p(t) -> t*p.
+  const DualQuat q = q_in.real.w < 0.0f ? -1.0f * q_in : q_in;
+  const glm::vec3 p = dual_quat_translation(q);
+  const glm::vec3 half_angle_axis = quat_log(q.real);
+  const float alpha = glm::length(half_angle_axis);  // in [0, pi/2] since w >= 0
+
+  Transform out;
+  out.rotation = glm::normalize(quat_exp(t * half_angle_axis));
+  if (alpha < 1e-6f) {
+    out.translation = t * p;
+  } else {
+    const glm::vec3 axis = half_angle_axis / alpha;
+    const float pitch = glm::dot(p, axis);
+    const glm::vec3 p_perp = p - pitch * axis;
+    const float ratio = std::sin(t * alpha) / std::sin(alpha);
+    const glm::vec3 turned = glm::angleAxis((t - 1.0f) * alpha, axis) * p_perp;
+    out.translation = t * pitch * axis + ratio * turned;
+  }
+  return dual_quat_from_transform(out);
+}
+
+DualQuat dual_quat_sclerp(const DualQuat& a, const DualQuat& b, float t) {
+  return a * dual_quat_pow(dual_quat_conjugate(a) * b, t);
+}
+
+Transform transform_nlerp(const Transform& a, const Transform& b, float t) {
+  Transform out;
+  out.rotation = quat_nlerp(a.rotation, b.rotation, t);
+  out.translation = glm::mix(a.translation, b.translation, t);
+  out.scale = glm::mix(a.scale, b.scale, t);
+  return out;
+}
+
+Transform transform_slerp(const Transform& a, const Transform& b, float t) {
+  Transform out;
+  out.rotation = quat_slerp(a.rotation, b.rotation, t);
+  out.translation = glm::mix(a.translation, b.translation, t);
+  out.scale = glm::mix(a.scale, b.scale, t);
+  return out;
+}
+
+Transform transform_sclerp(const Transform& a, const Transform& b, float t) {
+  const DualQuat q =
+      dual_quat_sclerp(dual_quat_from_transform(a), dual_quat_from_transform(b), t);
+  Transform out = dual_quat_to_transform(q);
+  out.rotation = glm::normalize(out.rotation);
+  out.scale = glm::mix(a.scale, b.scale, t);
+  return out;
+}
+
+Transform interpolate(const Transform& a, const Transform& b, float t,
+                      InterpolationMethod method) {
+  switch (method) {
+    case InterpolationMethod::Nlerp:
+      return transform_nlerp(a, b, t);
+    case InterpolationMethod::Slerp:
+      return transform_slerp(a, b, t);
+    case InterpolationMethod::Sclerp:
+      return transform_sclerp(a, b, t);
+  }
+  return transform_nlerp(a, b, t);
+}
+
+void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time,
+                 float time, InterpolationMethod method, WrapMode wrap, std::span<Transform> out) {
+  assert(joint_count > 0 && frame_time > 0.0f);
+  assert(!frames.empty() && frames.size() % static_cast<size_t>(joint_count) == 0);
+  assert(out.size() == static_cast<size_t>(joint_count));
+  const size_t joints = static_cast<size_t>(joint_count);
+  const long frame_count = static_cast<long>(frames.size() / joints);
+
+  // Frame positions are computed in double so long clips keep sub-frame precision.
+  double position = std::isfinite(time) ? static_cast<double>(time) / frame_time : 0.0;
+  long i0 = 0;
+  long i1 = 0;
+  if (wrap == WrapMode::Loop) {
+    position = std::fmod(position, static_cast<double>(frame_count));
+    if (position < 0.0) position += static_cast<double>(frame_count);
+    i0 = static_cast<long>(std::floor(position));
+    if (i0 >= frame_count) {  // fmod + frame_count can round up to exactly frame_count
+      i0 = 0;
+      position = 0.0;
+    }
+    i1 = (i0 + 1) % frame_count;
+  } else {
+    const double last = static_cast<double>(frame_count - 1);
+    position = position < 0.0 ? 0.0 : (position > last ? last : position);
+    i0 = static_cast<long>(std::floor(position));
+    i1 = i0 + 1 < frame_count ? i0 + 1 : i0;
+  }
+  const float alpha = static_cast<float>(position - static_cast<double>(i0));
+
+  const Transform* a = frames.data() + static_cast<size_t>(i0) * joints;
+  const Transform* b = frames.data() + static_cast<size_t>(i1) * joints;
+  if (alpha == 0.0f || i0 == i1) {
+    for (size_t j = 0; j < joints; ++j) out[j] = a[j];
+    return;
+  }
+  for (size_t j = 0; j < joints; ++j) out[j] = interpolate(a[j], b[j], alpha, method);
+}
+
+}  // namespace mm
