@@ -1,0 +1,96 @@
+#pragma once
+// Critically damped springs in exact closed form, parametrized by a halflife in seconds.
+//
+// The spring obeys x'' = -2*w*x' - w*w*(x - goal), the critically damped case (zeta = 1) of
+// x'' = -c*x' - k*(x - goal) with damping c = 2*w and stiffness k = w*w. With j0 = x0 - goal
+// and j1 = v0 + w*j0 its exact solution is
+//   x(t) = goal + exp(-w*t) * (j0 + j1*t),   v(t) = exp(-w*t) * (v0 - w*j1*t),
+// so one update of any length dt is exact: no integration error and no instability.
+//
+// Halflife (our definition): the time a spring starting AT REST takes to close exactly half of
+// its distance to the goal, i.e. (1 + w*h) * exp(-w*h) = 1/2, which gives
+// w = kHalflifeFrequencyFactor / h with kHalflifeFrequencyFactor = 1.67834699. (Some code uses
+// w = 2*ln(2)/h instead, whose "halflife" leaves about 60 % of the distance; ours means what
+// it says.) A spring that is already moving may close more or less than half in one halflife.
+//
+// Robustness, shared by every function here:
+// - dt <= 0 leaves the state unchanged (springs never run backwards);
+// - a non-finite goal, halflife or dt is ignored: the call leaves the state unchanged, so one
+//   NaN from input cannot poison the state;
+// - halflife is clamped below at kMinSpringHalflife (so 0 means "arrive at once");
+// - a very long dt converges exactly to the goal with zero velocity;
+// - predictions at a negative or non-finite time give the current state, and predictions
+//   with a non-finite goal or halflife give the current state at every time.
+// Nothing here allocates.
+
+#include <span>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+namespace mm {
+
+// w * halflife for a critically damped spring: the root of (1 + u) * exp(-u) = 1/2.
+inline constexpr float kHalflifeFrequencyFactor = 1.6783469900166608f;
+
+// The shortest halflife used (seconds); shorter ones, including 0, are clamped to it.
+inline constexpr float kMinSpringHalflife = 1e-5f;
+
+// The natural angular frequency w (1/s) of a critically damped spring with this halflife (s).
+float halflife_to_angular_frequency(float halflife);
+
+// The halflife (s) of a critically damped spring with natural angular frequency w (1/s).
+float angular_frequency_to_halflife(float angular_frequency);
+
+// The damping coefficient c = 2*w of x'' = -c*x' - k*(x - goal) for this halflife.
+float halflife_to_damping(float halflife);
+
+// The halflife whose critically damped spring has damping coefficient c = 2*w.
+float damping_to_halflife(float damping);
+
+// The stiffness k = w*w of x'' = -c*x' - k*(x - goal) for this halflife (critical damping).
+float halflife_to_stiffness(float halflife);
+
+// Advances a scalar spring (position x, velocity v) toward goal by dt seconds, exactly.
+void critical_spring_update(float& x, float& v, float goal, float halflife, float dt);
+
+// Advances a 3D spring toward goal by dt seconds, exactly (each axis is independent).
+void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
+                            float dt);
+
+// Advances a rotation spring toward goal by dt seconds along the shortest path. The state is
+// the rotation error e = angle*axis of rotation * inverse(goal) (world frame, |e| <= pi) and
+// angular_velocity = de/dt (rad/s, axis times rate), which is the true angular velocity
+// whenever the rotation stays about one axis (a facing about +Y, for instance).
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity,
+                            const glm::quat& goal, float halflife, float dt);
+
+// Predicts a 3D spring at future times (seconds from now, each >= 0) without changing it:
+// positions[i] and velocities[i] are the state after times[i]. Either output may be empty;
+// a non-empty output must have times.size() entries.
+void critical_spring_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                             const glm::vec3& x, const glm::vec3& v, const glm::vec3& goal,
+                             float halflife, std::span<const float> times);
+
+// Predicts a rotation spring at future times (seconds from now), like critical_spring_update.
+// Either output may be empty; a non-empty output must have times.size() entries.
+void critical_spring_predict(std::span<glm::quat> rotations,
+                             std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
+                             const glm::vec3& angular_velocity, const glm::quat& goal,
+                             float halflife, std::span<const float> times);
+
+// The "spring character": the velocity is a critically damped spring toward desired_velocity
+// and the position is its exact integral, so position, velocity and acceleration all stay
+// continuous when the desired velocity jumps. Advances the state by dt seconds.
+void spring_character_update(glm::vec3& position, glm::vec3& velocity, glm::vec3& acceleration,
+                             const glm::vec3& desired_velocity, float halflife, float dt);
+
+// Predicts the spring character at future times (seconds from now) for a fixed desired
+// velocity. Outputs may be empty; a non-empty output must have times.size() entries.
+void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> accelerations, const glm::vec3& position,
+                              const glm::vec3& velocity, const glm::vec3& acceleration,
+                              const glm::vec3& desired_velocity, float halflife,
+                              std::span<const float> times);
+
+}  // namespace mm

@@ -1,0 +1,212 @@
+#include "mm/runtime/spring.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "mm/runtime/interpolation.hpp"
+
+namespace mm {
+
+namespace {
+
+// Beyond this many time constants exp(-w*t) is below 1e-43: the spring has arrived.
+constexpr double kArrivedExponent = 100.0;
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool finite(const glm::quat& q) {
+  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
+}
+
+double angular_frequency(float halflife) {
+  return static_cast<double>(kHalflifeFrequencyFactor) /
+         static_cast<double>(std::max(halflife, kMinSpringHalflife));
+}
+
+// The critically damped spring after t seconds is linear in the initial offset j0 = x0 - goal
+// and velocity v0: x - goal = xx*j0 + xv*v0, v = vx*j0 + vv*v0. Computed in double.
+struct SpringCoefficients {
+  double xx = 1.0, xv = 0.0, vx = 0.0, vv = 1.0;
+};
+
+SpringCoefficients spring_coefficients(double w, double t) {
+  SpringCoefficients c;
+  const double u = w * t;
+  if (u > kArrivedExponent) return {0.0, 0.0, 0.0, 0.0};
+  const double e = std::exp(-u);
+  c.xx = e * (1.0 + u);
+  c.xv = e * t;
+  c.vx = -e * w * w * t;
+  c.vv = e * (1.0 - u);
+  return c;
+}
+
+// The spring character after t seconds, with j0 = v0 - desired and j1 = a0 + w*j0:
+//   x = x0 + desired*t + j0*t*f1(u) + j1*t*t*f2(u),  v = desired + e*(j0 + j1*t),
+//   a = e*(a0 - w*j1*t),
+// where f1(u) = (1 - e^-u)/u and f2(u) = (1 - e^-u (1 + u))/u^2 (series near u = 0, where
+// the differences cancel).
+struct CharacterCoefficients {
+  double x_j0 = 0.0, x_j1 = 0.0, e = 1.0, t = 0.0, w = 0.0;
+};
+
+CharacterCoefficients character_coefficients(double w, double t) {
+  CharacterCoefficients c;
+  const double u = w * t;
+  c.t = t;
+  c.w = w;
+  c.e = u > kArrivedExponent ? 0.0 : std::exp(-u);
+  double f1 = 0.0;
+  double f2 = 0.0;
+  if (u < 1e-3) {
+    f1 = 1.0 - u / 2.0 + u * u / 6.0 - u * u * u / 24.0;
+    f2 = 0.5 - u / 3.0 + u * u / 8.0 - u * u * u / 30.0;
+  } else {
+    f1 = (1.0 - c.e) / u;
+    f2 = (1.0 - c.e * (1.0 + u)) / (u * u);
+  }
+  c.x_j0 = t * f1;
+  c.x_j1 = t * t * f2;
+  return c;
+}
+
+glm::vec3 scaled(double s, const glm::vec3& v) { return static_cast<float>(s) * v; }
+
+void apply_spring(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, const SpringCoefficients& c) {
+  const glm::vec3 j0 = x - goal;
+  const glm::vec3 v0 = v;
+  x = goal + scaled(c.xx, j0) + scaled(c.xv, v0);
+  v = scaled(c.vx, j0) + scaled(c.vv, v0);
+}
+
+void apply_character(glm::vec3& x, glm::vec3& v, glm::vec3& a, const glm::vec3& desired,
+                     const CharacterCoefficients& c) {
+  const glm::vec3 j0 = v - desired;
+  const glm::vec3 j1 = a + scaled(c.w, j0);
+  x = x + scaled(c.t, desired) + scaled(c.x_j0, j0) + scaled(c.x_j1, j1);
+  v = desired + scaled(c.e, j0) + scaled(c.e * c.t, j1);
+  a = scaled(c.e, a) - scaled(c.e * c.w * c.t, j1);
+}
+
+bool usable(float halflife, float dt) { return std::isfinite(halflife) && std::isfinite(dt); }
+
+// A prediction time that is negative or non-finite predicts "now".
+double prediction_time(float t) { return std::isfinite(t) && t > 0.0f ? t : 0.0; }
+
+}  // namespace
+
+float halflife_to_angular_frequency(float halflife) {
+  return static_cast<float>(angular_frequency(halflife));
+}
+
+float angular_frequency_to_halflife(float angular_frequency) {
+  return kHalflifeFrequencyFactor / angular_frequency;
+}
+
+float halflife_to_damping(float halflife) { return 2.0f * halflife_to_angular_frequency(halflife); }
+
+float damping_to_halflife(float damping) { return angular_frequency_to_halflife(0.5f * damping); }
+
+float halflife_to_stiffness(float halflife) {
+  const float w = halflife_to_angular_frequency(halflife);
+  return w * w;
+}
+
+void critical_spring_update(float& x, float& v, float goal, float halflife, float dt) {
+  if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
+  const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
+  const double j0 = static_cast<double>(x) - goal;
+  const double v0 = v;
+  x = static_cast<float>(goal + c.xx * j0 + c.xv * v0);
+  v = static_cast<float>(c.vx * j0 + c.vv * v0);
+}
+
+void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
+                            float dt) {
+  if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(goal)) return;
+  apply_spring(x, v, goal, spring_coefficients(angular_frequency(halflife), dt));
+}
+
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity,
+                            const glm::quat& goal, float halflife, float dt) {
+  if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(goal)) return;
+  glm::vec3 error = quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
+  critical_spring_update(error, angular_velocity, glm::vec3(0.0f), halflife, dt);
+  rotation = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+}
+
+void critical_spring_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                             const glm::vec3& x, const glm::vec3& v, const glm::vec3& goal,
+                             float halflife, std::span<const float> times) {
+  assert(positions.empty() || positions.size() == times.size());
+  assert(velocities.empty() || velocities.size() == times.size());
+  const bool frozen = !std::isfinite(halflife) || !finite(goal);
+  const double w = angular_frequency(halflife);
+  for (size_t i = 0; i < times.size(); ++i) {
+    glm::vec3 xi = x;
+    glm::vec3 vi = v;
+    if (!frozen) apply_spring(xi, vi, goal, spring_coefficients(w, prediction_time(times[i])));
+    if (!positions.empty()) positions[i] = xi;
+    if (!velocities.empty()) velocities[i] = vi;
+  }
+}
+
+void critical_spring_predict(std::span<glm::quat> rotations,
+                             std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
+                             const glm::vec3& angular_velocity, const glm::quat& goal,
+                             float halflife, std::span<const float> times) {
+  assert(rotations.empty() || rotations.size() == times.size());
+  assert(angular_velocities.empty() || angular_velocities.size() == times.size());
+  const bool frozen = !std::isfinite(halflife) || !finite(goal);
+  const double w = angular_frequency(halflife);
+  const glm::vec3 error0 = frozen ? glm::vec3(0.0f)
+                                  : quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
+  for (size_t i = 0; i < times.size(); ++i) {
+    if (frozen) {
+      if (!rotations.empty()) rotations[i] = rotation;
+      if (!angular_velocities.empty()) angular_velocities[i] = angular_velocity;
+      continue;
+    }
+    glm::vec3 error = error0;
+    glm::vec3 rate = angular_velocity;
+    apply_spring(error, rate, glm::vec3(0.0f), spring_coefficients(w, prediction_time(times[i])));
+    if (!rotations.empty()) rotations[i] = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+    if (!angular_velocities.empty()) angular_velocities[i] = rate;
+  }
+}
+
+void spring_character_update(glm::vec3& position, glm::vec3& velocity, glm::vec3& acceleration,
+                             const glm::vec3& desired_velocity, float halflife, float dt) {
+  if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(desired_velocity)) return;
+  apply_character(position, velocity, acceleration, desired_velocity,
+                  character_coefficients(angular_frequency(halflife), dt));
+}
+
+void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> accelerations, const glm::vec3& position,
+                              const glm::vec3& velocity, const glm::vec3& acceleration,
+                              const glm::vec3& desired_velocity, float halflife,
+                              std::span<const float> times) {
+  assert(positions.empty() || positions.size() == times.size());
+  assert(velocities.empty() || velocities.size() == times.size());
+  assert(accelerations.empty() || accelerations.size() == times.size());
+  const bool frozen = !std::isfinite(halflife) || !finite(desired_velocity);
+  const double w = angular_frequency(halflife);
+  for (size_t i = 0; i < times.size(); ++i) {
+    glm::vec3 x = position;
+    glm::vec3 v = velocity;
+    glm::vec3 a = acceleration;
+    if (!frozen) {
+      apply_character(x, v, a, desired_velocity,
+                      character_coefficients(w, prediction_time(times[i])));
+    }
+    if (!positions.empty()) positions[i] = x;
+    if (!velocities.empty()) velocities[i] = v;
+    if (!accelerations.empty()) accelerations[i] = a;
+  }
+}
+
+}  // namespace mm

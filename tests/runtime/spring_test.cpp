@@ -1,0 +1,373 @@
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <glm/gtc/constants.hpp>
+
+#include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/spring.hpp"
+#include "test_math.hpp"
+
+namespace mm {
+namespace {
+
+using test::near_vec3;
+using test::same_rotation;
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+const glm::vec3 kUp{0.0f, 1.0f, 0.0f};
+
+// ---- independent reference: fine-step RK4 of the ODE --------------------------------------------
+
+// x'' = -c*x' - k*(x - goal), integrated with classical RK4 in double with a tiny step.
+struct Rk4Spring {
+  double c, k;  // damping and stiffness
+
+  void advance(double& x, double& v, double goal, double duration, double h = 1e-4) const {
+    auto acc = [&](double px, double pv) { return -c * pv - k * (px - goal); };
+    const int steps = static_cast<int>(std::ceil(duration / h));
+    h = duration / steps;
+    for (int i = 0; i < steps; ++i) {
+      const double k1x = v, k1v = acc(x, v);
+      const double k2x = v + 0.5 * h * k1v, k2v = acc(x + 0.5 * h * k1x, v + 0.5 * h * k1v);
+      const double k3x = v + 0.5 * h * k2v, k3v = acc(x + 0.5 * h * k2x, v + 0.5 * h * k2v);
+      const double k4x = v + h * k3v, k4v = acc(x + h * k3x, v + h * k3v);
+      x += h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x);
+      v += h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    }
+  }
+};
+
+Rk4Spring reference_for(float halflife) {
+  return {halflife_to_damping(halflife), halflife_to_stiffness(halflife)};
+}
+
+// The spring character as an ODE in (x, v, a): x' = v, v' = a, a' = -c*a - k*(v - desired).
+struct Rk4Character {
+  double c, k;
+
+  void advance(std::array<double, 3>& s, double desired, double duration, double h = 1e-4) const {
+    auto f = [&](const std::array<double, 3>& y) {
+      return std::array<double, 3>{y[1], y[2], -c * y[2] - k * (y[1] - desired)};
+    };
+    auto add = [](const std::array<double, 3>& y, const std::array<double, 3>& d, double scale) {
+      return std::array<double, 3>{y[0] + scale * d[0], y[1] + scale * d[1], y[2] + scale * d[2]};
+    };
+    const int steps = static_cast<int>(std::ceil(duration / h));
+    h = duration / steps;
+    for (int i = 0; i < steps; ++i) {
+      const auto k1 = f(s);
+      const auto k2 = f(add(s, k1, 0.5 * h));
+      const auto k3 = f(add(s, k2, 0.5 * h));
+      const auto k4 = f(add(s, k3, h));
+      for (int j = 0; j < 3; ++j) s[j] += h / 6.0 * (k1[j] + 2 * k2[j] + 2 * k3[j] + k4[j]);
+    }
+  }
+};
+
+// ---- conversions ----------------------------------------------------------------------------------
+
+TEST(SpringConversions, CriticalDampingAndRoundTrips) {
+  for (float h : {0.05f, 0.2f, 1.0f, 3.0f}) {
+    const float w = halflife_to_angular_frequency(h);
+    EXPECT_NEAR(w * h, 1.6783469900166608f, 1e-5f);
+    EXPECT_NEAR(halflife_to_damping(h), 2.0f * w, 1e-4f * w);
+    EXPECT_NEAR(halflife_to_stiffness(h), w * w, 1e-4f * w * w);
+    // Critical damping: c^2 == 4k, i.e. zeta = c / (2 sqrt(k)) == 1.
+    const float zeta = halflife_to_damping(h) / (2.0f * std::sqrt(halflife_to_stiffness(h)));
+    EXPECT_NEAR(zeta, 1.0f, 1e-6f);
+    EXPECT_NEAR(damping_to_halflife(halflife_to_damping(h)), h, 1e-6f * h);
+    EXPECT_NEAR(angular_frequency_to_halflife(w), h, 1e-6f * h);
+  }
+  // The factor solves (1 + u) e^-u = 1/2.
+  const double u = kHalflifeFrequencyFactor;
+  EXPECT_NEAR((1.0 + u) * std::exp(-u), 0.5, 1e-7);
+}
+
+// ---- scalar and vec3 springs ----------------------------------------------------------------------
+
+TEST(CriticalSpring, ScalarMatchesRk4OfTheOde) {
+  struct Case {
+    float x, v, goal, halflife;
+  };
+  for (const Case c : {Case{0.0f, 0.0f, 1.0f, 0.2f}, Case{2.0f, -5.0f, -1.0f, 0.1f},
+                       Case{-3.0f, 10.0f, 0.5f, 0.5f}, Case{1.0f, 0.0f, 1.0f, 1.0f}}) {
+    const Rk4Spring ref = reference_for(c.halflife);
+    float x = c.x, v = c.v;
+    double rx = c.x, rv = c.v;
+    const float dt = 1.0f / 60.0f;
+    for (int frame = 0; frame < 90; ++frame) {
+      critical_spring_update(x, v, c.goal, c.halflife, dt);
+      ref.advance(rx, rv, c.goal, dt);
+      ASSERT_NEAR(x, rx, 1e-5) << frame;
+      ASSERT_NEAR(v, rv, 1e-4 * (1.0 + std::abs(rv))) << frame;
+    }
+  }
+}
+
+TEST(CriticalSpring, Vec3MatchesRk4PerAxis) {
+  const float h = 0.15f;
+  const Rk4Spring ref = reference_for(h);
+  glm::vec3 x(1.0f, -2.0f, 0.5f), v(0.0f, 3.0f, -4.0f);
+  const glm::vec3 goal(0.2f, 0.4f, -0.6f);
+  std::array<double, 3> rx{1.0, -2.0, 0.5}, rv{0.0, 3.0, -4.0};
+  for (int frame = 0; frame < 60; ++frame) {
+    const float dt = 0.01f + 0.005f * (frame % 3);  // uneven frame times
+    critical_spring_update(x, v, goal, h, dt);
+    for (int i = 0; i < 3; ++i) {
+      ref.advance(rx[i], rv[i], goal[i], dt);
+      ASSERT_NEAR(x[i], rx[i], 1e-5) << frame;
+      ASSERT_NEAR(v[i], rv[i], 1e-4 * (1.0 + std::abs(rv[i]))) << frame;
+    }
+  }
+}
+
+TEST(CriticalSpring, HalflifeHalvesTheDistanceFromRest) {
+  for (float h : {0.05f, 0.3f, 2.0f}) {
+    // Closed form in one step, and in many small steps.
+    float x = 10.0f, v = 0.0f;
+    critical_spring_update(x, v, 4.0f, h, h);
+    EXPECT_NEAR(x - 4.0f, 3.0f, 1e-5f) << h;
+    float xs = 10.0f, vs = 0.0f;
+    for (int i = 0; i < 100; ++i) critical_spring_update(xs, vs, 4.0f, h, h / 100.0f);
+    EXPECT_NEAR(xs - 4.0f, 3.0f, 1e-4f) << h;
+    // The ODE itself agrees, so the halflife meaning does not rest on the closed form.
+    double rx = 10.0, rv = 0.0;
+    reference_for(h).advance(rx, rv, 4.0, h);
+    EXPECT_NEAR(rx - 4.0, 3.0, 1e-6) << h;
+    // Two halflives from rest leave less than a quarter: critical damping never overshoots.
+    critical_spring_update(x, v, 4.0f, h, h);
+    EXPECT_GT(x - 4.0f, 0.0f);
+    EXPECT_LT(x - 4.0f, 6.0f / 4.0f);
+  }
+}
+
+TEST(CriticalSpring, ZeroAndNegativeDtLeaveStateUnchanged) {
+  float x = 1.5f, v = -2.0f;
+  critical_spring_update(x, v, 10.0f, 0.2f, 0.0f);
+  EXPECT_EQ(x, 1.5f);
+  EXPECT_EQ(v, -2.0f);
+  critical_spring_update(x, v, 10.0f, 0.2f, -0.1f);
+  EXPECT_EQ(x, 1.5f);
+  EXPECT_EQ(v, -2.0f);
+  glm::vec3 p(1, 2, 3), pv(4, 5, 6);
+  critical_spring_update(p, pv, glm::vec3(0.0f), 0.2f, 0.0f);
+  EXPECT_EQ(p, glm::vec3(1, 2, 3));
+  EXPECT_EQ(pv, glm::vec3(4, 5, 6));
+}
+
+TEST(CriticalSpring, HugeDtConvergesExactly) {
+  for (float dt : {100.0f, 1e6f, 1e30f, 3e38f}) {
+    float x = 1.5f, v = 40.0f;
+    critical_spring_update(x, v, -7.0f, 0.2f, dt);
+    EXPECT_EQ(x, -7.0f) << dt;
+    EXPECT_EQ(v, 0.0f) << dt;
+    glm::vec3 p(1, 2, 3), pv(4, 5, 6);
+    critical_spring_update(p, pv, glm::vec3(9.0f), 0.2f, dt);
+    EXPECT_EQ(p, glm::vec3(9.0f));
+    EXPECT_EQ(pv, glm::vec3(0.0f));
+  }
+}
+
+TEST(CriticalSpring, NonFiniteInputIsIgnored) {
+  float x = 1.0f, v = 2.0f;
+  critical_spring_update(x, v, kNaN, 0.2f, 0.1f);
+  critical_spring_update(x, v, kInf, 0.2f, 0.1f);
+  critical_spring_update(x, v, 0.0f, kNaN, 0.1f);
+  critical_spring_update(x, v, 0.0f, 0.2f, kNaN);
+  critical_spring_update(x, v, 0.0f, 0.2f, kInf);
+  EXPECT_EQ(x, 1.0f);
+  EXPECT_EQ(v, 2.0f);
+  glm::vec3 p(1.0f), pv(0.0f);
+  critical_spring_update(p, pv, glm::vec3(0.0f, kNaN, 0.0f), 0.2f, 0.1f);
+  EXPECT_EQ(p, glm::vec3(1.0f));
+  EXPECT_EQ(pv, glm::vec3(0.0f));
+  // The spring still works afterwards.
+  critical_spring_update(x, v, 0.0f, 0.2f, 10.0f);
+  EXPECT_NEAR(x, 0.0f, 1e-6f);
+}
+
+TEST(CriticalSpring, ZeroHalflifeArrivesAtOnce) {
+  float x = 1.0f, v = 3.0f;
+  critical_spring_update(x, v, 5.0f, 0.0f, 1.0f / 60.0f);
+  EXPECT_EQ(x, 5.0f);
+  EXPECT_EQ(v, 0.0f);
+  float y = 1.0f, w = 3.0f;
+  critical_spring_update(y, w, 5.0f, -1.0f, 1.0f / 60.0f);
+  EXPECT_EQ(y, 5.0f);
+}
+
+// ---- rotation spring ---------------------------------------------------------------------------
+
+TEST(RotationSpring, SingleAxisEqualsScalarSpringOnTheShortestAngle) {
+  // Facing 0 toward a goal of 300 degrees about +Y: the short way is -60 degrees.
+  const float h = 0.25f;
+  const Rk4Spring ref = reference_for(h);
+  glm::quat q(1.0f, 0.0f, 0.0f, 0.0f);
+  glm::vec3 w(0.0f, 0.5f, 0.0f);
+  const glm::quat goal = glm::angleAxis(glm::radians(300.0f), kUp);
+  double angle = 0.0, rate = 0.5;
+  const double goal_angle = glm::radians(-60.0);
+  for (int frame = 0; frame < 60; ++frame) {
+    critical_spring_update(q, w, goal, h, 1.0f / 60.0f);
+    ref.advance(angle, rate, goal_angle, 1.0 / 60.0);
+    ASSERT_TRUE(same_rotation(q, glm::angleAxis(static_cast<float>(angle), kUp), 1e-5f)) << frame;
+    ASSERT_TRUE(near_vec3(w, glm::vec3(0.0f, static_cast<float>(rate), 0.0f), 1e-4f)) << frame;
+  }
+  // It went the short way: the angle was always between -60 and +small, never near +300.
+  EXPECT_LT(angle, 0.0);
+}
+
+TEST(RotationSpring, HalflifeHalvesTheAngleAndConverges) {
+  for (int i = 0; i < 20; ++i) {
+    const glm::quat start = test::random_rotation();
+    const glm::quat goal = test::random_rotation();
+    const double angle0 = test::rotation_angle_between(start, goal);
+    glm::quat q = start;
+    glm::vec3 w(0.0f);
+    critical_spring_update(q, w, goal, 0.3f, 0.3f);
+    EXPECT_NEAR(test::rotation_angle_between(q, goal), 0.5 * angle0, 1e-5);
+    critical_spring_update(q, w, goal, 0.3f, 100.0f);
+    EXPECT_TRUE(same_rotation(q, goal, 1e-6f));
+    EXPECT_NEAR(glm::length(q), 1.0f, 1e-6f);
+  }
+}
+
+TEST(RotationSpring, NonFiniteGoalAndZeroDtAreIgnored) {
+  const glm::quat start = glm::angleAxis(0.4f, kUp);
+  glm::quat q = start;
+  glm::vec3 w(0.1f, 0.2f, 0.3f);
+  critical_spring_update(q, w, glm::quat(kNaN, 0.0f, 0.0f, 0.0f), 0.2f, 0.1f);
+  critical_spring_update(q, w, glm::quat(1.0f, 0.0f, 0.0f, 0.0f), 0.2f, 0.0f);
+  EXPECT_EQ(q, start);
+  EXPECT_EQ(w, glm::vec3(0.1f, 0.2f, 0.3f));
+}
+
+// ---- predictions ---------------------------------------------------------------------------------
+
+TEST(SpringPredict, MatchesRk4AndRepeatedUpdates) {
+  const float h = 0.2f;
+  const glm::vec3 x(1.0f, 0.0f, -1.0f), v(2.0f, 0.0f, 1.0f), goal(0.0f, 0.0f, 3.0f);
+  const std::array<float, 4> times{0.0f, 0.33f, 0.67f, 1.0f};
+  std::array<glm::vec3, 4> positions, velocities;
+  critical_spring_predict(positions, velocities, x, v, goal, h, times);
+  const Rk4Spring ref = reference_for(h);
+  for (size_t i = 0; i < times.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      double rx = x[axis], rv = v[axis];
+      if (times[i] > 0.0f) ref.advance(rx, rv, goal[axis], times[i]);
+      EXPECT_NEAR(positions[i][axis], rx, 1e-5) << i;
+      EXPECT_NEAR(velocities[i][axis], rv, 1e-4) << i;
+    }
+  }
+  // Predicting 1 s ahead equals stepping 60 frames of 1/60 s.
+  glm::vec3 sx = x, sv = v;
+  for (int f = 0; f < 60; ++f) critical_spring_update(sx, sv, goal, h, 1.0f / 60.0f);
+  EXPECT_TRUE(near_vec3(positions[3], sx, 1e-5f));
+  EXPECT_TRUE(near_vec3(velocities[3], sv, 1e-4f));
+  // Empty outputs are allowed; a negative time predicts "now".
+  const std::array<float, 1> past{-1.0f};
+  std::array<glm::vec3, 1> now;
+  critical_spring_predict(now, {}, x, v, goal, h, past);
+  EXPECT_EQ(now[0], x);
+}
+
+TEST(SpringPredict, RotationsMatchRepeatedUpdates) {
+  const glm::quat q = test::random_rotation();
+  const glm::quat goal = test::random_rotation();
+  const glm::vec3 w(0.3f, -0.2f, 0.1f);
+  const std::array<float, 3> times{0.25f, 0.5f, 1.0f};
+  std::array<glm::quat, 3> rotations;
+  std::array<glm::vec3, 3> rates;
+  critical_spring_predict(rotations, rates, q, w, goal, 0.2f, times);
+  glm::quat sq = q;
+  glm::vec3 sw = w;
+  for (int f = 1; f <= 60; ++f) {
+    critical_spring_update(sq, sw, goal, 0.2f, 1.0f / 60.0f);
+    if (f == 15 || f == 30 || f == 60) {
+      const int i = f == 15 ? 0 : (f == 30 ? 1 : 2);
+      EXPECT_TRUE(same_rotation(rotations[i], sq, 1e-5f)) << f;
+      EXPECT_TRUE(near_vec3(rates[i], sw, 1e-4f)) << f;
+    }
+  }
+}
+
+// ---- spring character ----------------------------------------------------------------------------
+
+TEST(SpringCharacter, MatchesRk4AcrossDesiredVelocityChanges) {
+  const float h = 0.3f;
+  const Rk4Character ref{halflife_to_damping(h), halflife_to_stiffness(h)};
+  glm::vec3 x(0.0f), v(0.0f), a(0.0f);
+  std::array<std::array<double, 3>, 3> rs{};  // per axis: x, v, a
+  const float dt = 1.0f / 60.0f;
+  for (int frame = 0; frame < 180; ++frame) {
+    // Walk forward, then strafe, then stop.
+    const glm::vec3 desired = frame < 60 ? glm::vec3(0, 0, 1.5f)
+                              : frame < 120 ? glm::vec3(2.0f, 0, 0.5f)
+                                            : glm::vec3(0.0f);
+    spring_character_update(x, v, a, desired, h, dt);
+    for (int i = 0; i < 3; ++i) {
+      ref.advance(rs[i], desired[i], dt);
+      ASSERT_NEAR(x[i], rs[i][0], 1e-5) << frame;
+      ASSERT_NEAR(v[i], rs[i][1], 1e-5) << frame;
+      ASSERT_NEAR(a[i], rs[i][2], 1e-4) << frame;
+    }
+  }
+}
+
+TEST(SpringCharacter, AccelerationIsContinuousWhenTheGoalJumps) {
+  glm::vec3 x(0.0f), v(1.0f, 0.0f, 0.0f), a(0.5f, 0.0f, 0.0f);
+  const glm::vec3 a_before = a;
+  // A sudden 5 m/s change of desired velocity; a 10 microsecond step barely moves a.
+  spring_character_update(x, v, a, glm::vec3(-4.0f, 0.0f, 0.0f), 0.2f, 1e-5f);
+  // Jerk at the jump is bounded by w^2 * 5 m/s + 2 w |a|, about 370 m/s^3 here.
+  EXPECT_LT(glm::length(a - a_before), 0.01f);
+  EXPECT_LT(glm::length(v - glm::vec3(1.0f, 0.0f, 0.0f)), 1e-4f);
+}
+
+TEST(SpringCharacter, VelocityHalflifeAndConvergence) {
+  glm::vec3 x(0.0f), v(0.0f), a(0.0f);
+  spring_character_update(x, v, a, glm::vec3(0, 0, 4.0f), 0.25f, 0.25f);
+  EXPECT_NEAR(v.z, 2.0f, 1e-5f);
+  spring_character_update(x, v, a, glm::vec3(0, 0, 4.0f), 0.25f, 1e9f);
+  EXPECT_TRUE(test::finite_vec3(x));
+  EXPECT_EQ(v, glm::vec3(0, 0, 4.0f));
+  EXPECT_EQ(a, glm::vec3(0.0f));
+  // dt = 0 and a NaN desired velocity change nothing.
+  const glm::vec3 x0 = x;
+  spring_character_update(x, v, a, glm::vec3(0, 0, 1.0f), 0.25f, 0.0f);
+  spring_character_update(x, v, a, glm::vec3(kNaN), 0.25f, 0.1f);
+  EXPECT_EQ(x, x0);
+  EXPECT_EQ(v, glm::vec3(0, 0, 4.0f));
+}
+
+TEST(SpringCharacter, PredictMatchesRk4AndRepeatedUpdates) {
+  const float h = 0.27f;
+  const glm::vec3 x(1.0f, 0.0f, 2.0f), v(0.5f, 0.0f, -1.0f), a(2.0f, 0.0f, 0.0f);
+  const glm::vec3 desired(-1.0f, 0.0f, 3.0f);
+  const std::array<float, 4> times{1e-6f, 0.33f, 0.67f, 1.0f};
+  std::array<glm::vec3, 4> px, pv, pa;
+  spring_character_predict(px, pv, pa, x, v, a, desired, h, times);
+  const Rk4Character ref{halflife_to_damping(h), halflife_to_stiffness(h)};
+  for (size_t i = 0; i < times.size(); ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      std::array<double, 3> s{x[axis], v[axis], a[axis]};
+      ref.advance(s, desired[axis], times[i], 1e-4);
+      EXPECT_NEAR(px[i][axis], s[0], 1e-5) << i;
+      EXPECT_NEAR(pv[i][axis], s[1], 1e-5) << i;
+      EXPECT_NEAR(pa[i][axis], s[2], 1e-4) << i;
+    }
+  }
+  glm::vec3 sx = x, sv = v, sa = a;
+  for (int f = 0; f < 60; ++f) spring_character_update(sx, sv, sa, desired, h, 1.0f / 60.0f);
+  EXPECT_TRUE(near_vec3(px[3], sx, 1e-5f));
+  EXPECT_TRUE(near_vec3(pv[3], sv, 1e-5f));
+  EXPECT_TRUE(near_vec3(pa[3], sa, 1e-4f));
+}
+
+}  // namespace
+}  // namespace mm
