@@ -1,0 +1,150 @@
+#pragma once
+// The database file: one relocatable binary blob written and read by one call each. Loading
+// trusts nothing: the magic, version, endianness, sizes, every section's place, every count and
+// string length, a 64-bit checksum over the whole file and finally Database::validate() are all
+// checked, and any failure comes back as a message naming the file, the section and the index.
+//
+// Layout of format version 1 (all integers and floats in the writer's native byte order, which
+// the endianness marker pins down; offsets in bytes from the start of the file):
+//
+//   0    magic            8 bytes  8A 'M' 'M' 'D' '\r' '\n' 1A '\n' (catches text-mode and
+//                                  7-bit transfers, which rewrite or strip these bytes)
+//   8    format_version   uint32   kDatabaseFormatVersion
+//   12   endian_marker    uint32   0x01020304
+//   16   file_size        uint64   the total size of the file, checksum included
+//   24   header_size      uint32   kDatabaseHeaderSize (where the first section may start)
+//   28   section_count    uint32   kDatabaseSectionCount
+//   32   joint_count, frame_count, clip_count, tag_count, feature_dims, channel_count: uint32 each
+//   56   frame_time       float32  seconds
+//   60   roles            int32 x 6: hips, left_foot, right_foot, left_toe, right_toe, head
+//   84   reserved         uint32   0
+//   88   section table    kDatabaseSectionCount x {uint64 offset, uint64 length}, in
+//                                  DatabaseSection order
+//   ...  sections         each at a 16-byte aligned offset, in table order, zero padding between
+//   file_size - 8         checksum uint64   database_checksum() of every byte before it
+//
+// Fixed-size sections are plain arrays: quaternions as x, y, z, w; vec3 as x, y, z; a rest
+// transform as rotation (x, y, z, w), translation (x, y, z), scale (x, y, z). Variable sections
+// are records packed back to back with no padding:
+//   string list (skeleton names, tag names): uint32 length, then the bytes (no terminator);
+//   schema channel: uint8 kind, 3 zero bytes, string name, string bone, uint32 time count, that
+//     many float32 times, float32 axis x, y, z, float32 weight;
+//   clip: int32 start, int32 end, uint64 tags, uint8 mirrored (0 or 1), 3 zero bytes, string name.
+// frame_clip is not stored: it is derived from the clips on load.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mm/database/database.hpp"
+#include "mm/runtime/result.hpp"
+
+namespace mm {
+
+// The format version this program writes and the only one it reads.
+inline constexpr uint32_t kDatabaseFormatVersion = 1;
+// The value written in the endianness field; read back byte-swapped on a machine of the other
+// byte order.
+inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
+// The 8 magic bytes at the start of every database file.
+inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M', 'M', 'D',
+                                                                '\r', '\n', 0x1A, '\n'};
+
+// The sections of a version-1 file, in the order they appear in the table and in the file.
+enum class DatabaseSection : uint32_t {
+  Schema = 0,              // feature channels (variable records)
+  SkeletonNames,           // joint names (string list)
+  SkeletonParents,         // int32 per joint
+  SkeletonRest,            // rest transform per joint (10 floats)
+  LocalPositions,          // vec3 per frame and joint
+  LocalRotations,          // quat per frame and joint
+  LocalVelocities,         // vec3 per frame and joint
+  LocalAngularVelocities,  // vec3 per frame and joint
+  Contacts,                // uint8 x 2 per frame
+  Features,                // float32 x feature_dims per frame
+  FeatureOffset,           // float32 x feature_dims
+  FeatureScale,            // float32 x feature_dims
+  Searchable,              // uint8 per frame
+  Clips,                   // clip records
+  TagNames,                // string list
+  Count,                   // not a section: the number of sections
+};
+// Number of sections in a version-1 file.
+inline constexpr size_t kDatabaseSectionCount = static_cast<size_t>(DatabaseSection::Count);
+// Size of the fixed header including the section table, rounded up to 16 bytes.
+inline constexpr uint32_t kDatabaseHeaderSize = 336;
+
+// Largest counts a file may declare; anything larger is refused as corrupt before allocating.
+inline constexpr uint32_t kMaxDatabaseJoints = 4096;
+inline constexpr uint32_t kMaxDatabaseFrames = 1u << 27;
+inline constexpr uint32_t kMaxDatabaseFeatureDims = 4096;
+inline constexpr uint32_t kMaxDatabaseChannels = 1024;
+
+// Human-readable name of a section for messages, e.g. "local_rotations".
+const char* database_section_name(DatabaseSection section);
+
+// Where one section lies in the file.
+struct DatabaseFileSection {
+  uint64_t offset = 0;  // bytes from the start of the file, a multiple of 16
+  uint64_t length = 0;  // bytes
+};
+
+// What the header of a database file says, after its magic, version, endianness, sizes and
+// section table were checked against the file size (the checksum and contents are not).
+struct DatabaseFileInfo {
+  uint32_t format_version = 0;  // always kDatabaseFormatVersion once parsed
+  uint64_t file_size = 0;       // bytes, checksum included
+  uint32_t joint_count = 0;     // skeleton joints (the simulation root included)
+  uint32_t frame_count = 0;     // database frames
+  uint32_t clip_count = 0;      // clip ranges
+  uint32_t tag_count = 0;       // tag names
+  uint32_t feature_dims = 0;    // columns of the feature matrix
+  uint32_t channel_count = 0;   // feature schema channels
+  float frame_time = 0.0f;      // seconds between frames
+  JointRoleIndices roles;       // as stored (range-checked by the full load only)
+  std::array<DatabaseFileSection, kDatabaseSectionCount> sections{};  // in DatabaseSection order
+  uint64_t stored_checksum = 0;  // the last 8 bytes of the file (0 when not read)
+
+  const DatabaseFileSection& section(DatabaseSection s) const {
+    return sections[static_cast<size_t>(s)];
+  }
+};
+
+// The file's 64-bit checksum of a byte range: four independent multiply-rotate lanes over
+// 32-byte blocks (several GB/s), a word and byte tail, and an avalanche finalizer. Every lane
+// step is a bijection of both the state and the input word, so any change confined to one
+// 8-byte word is always detected.
+uint64_t database_checksum(std::span<const std::byte> bytes);
+
+// The exact bytes of the file save_database() writes. Writes whatever the arrays hold (an
+// inconsistent database gives a file that load refuses); does not validate.
+std::vector<std::byte> serialize_database(const Database& db);
+
+// Parses and checks the header of a file image (magic, endianness, version, header and total
+// sizes, section table against the counts). `name_for_messages` prefixes every message. Does not
+// verify the checksum; `stored_checksum` is filled when the image is complete.
+Result<DatabaseFileInfo> parse_database_header(std::span<const std::byte> bytes,
+                                               std::string_view name_for_messages);
+
+// Rebuilds a database from a file image, validating everything (see the top of this file), and
+// derives frame_clip. Never trusts a count or offset before checking it against the bytes.
+Result<Database> deserialize_database(std::span<const std::byte> bytes,
+                                      std::string_view name_for_messages);
+
+// Validates the database, then writes it to `path` through a temporary file in the same folder
+// renamed into place, so a failed write never leaves a half-written database behind.
+Status save_database(const Database& db, const std::filesystem::path& path);
+
+// Reads the whole file (memory-mapped when possible) and deserializes it. Messages name the path.
+Result<Database> load_database(const std::filesystem::path& path);
+
+// Reads and checks only the header of a database file (cheap, for `mm info`): the full load
+// still has to verify the checksum and contents.
+Result<DatabaseFileInfo> read_database_header(const std::filesystem::path& path);
+
+}  // namespace mm

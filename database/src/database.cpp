@@ -1,0 +1,354 @@
+#include "mm/database/database.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string_view>
+#include <thread>
+
+#include <glm/gtc/type_ptr.hpp>
+
+namespace mm {
+
+namespace {
+
+constexpr size_t kNotFound = static_cast<size_t>(-1);
+// Arrays are checked in blocks: a branch-free pass over a block vectorizes, and only a block
+// that holds a bad value is scanned again to find which one.
+constexpr size_t kBlock = 2048;
+// Below this many values a second thread costs more than it saves.
+constexpr size_t kParallelThreshold = size_t{1} << 20;
+
+// Squared quaternion norms within this band count as unit (|length - 1| <= 1e-3, the
+// importers' tolerance).
+constexpr float kMinUnitNormSquared = (1.0f - 1e-3f) * (1.0f - 1e-3f);
+constexpr float kMaxUnitNormSquared = (1.0f + 1e-3f) * (1.0f + 1e-3f);
+
+bool is_finite_bits(float v) {
+  return (std::bit_cast<uint32_t>(v) & 0x7f800000u) != 0x7f800000u;
+}
+
+size_t first_non_finite_serial(const float* values, size_t begin, size_t end) {
+  for (size_t block = begin; block < end; block += kBlock) {
+    const size_t block_end = std::min(end, block + kBlock);
+    uint32_t bad = 0;
+    for (size_t i = block; i < block_end; ++i) bad |= static_cast<uint32_t>(!is_finite_bits(values[i]));
+    if (bad != 0) {
+      for (size_t i = block; i < block_end; ++i) {
+        if (!std::isfinite(values[i])) return i;
+      }
+    }
+  }
+  return kNotFound;
+}
+
+bool is_unit(const float* q) {
+  const float n = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  // Written so that NaN (and an infinite component, whose square is infinite) fails.
+  return n >= kMinUnitNormSquared && n <= kMaxUnitNormSquared;
+}
+
+size_t first_non_unit_serial(const float* quats, size_t begin, size_t end) {
+  for (size_t block = begin; block < end; block += kBlock) {
+    const size_t block_end = std::min(end, block + kBlock);
+    uint32_t bad = 0;
+    for (size_t i = block; i < block_end; ++i) bad |= static_cast<uint32_t>(!is_unit(quats + 4 * i));
+    if (bad != 0) {
+      for (size_t i = block; i < block_end; ++i) {
+        if (!is_unit(quats + 4 * i)) return i;
+      }
+    }
+  }
+  return kNotFound;
+}
+
+// Runs scan(begin, end) over [0, count) on two threads when count is large, and returns the
+// smallest index found (kNotFound when none), so the message names the first bad value exactly
+// as a serial scan would.
+template <class Scan>
+size_t first_bad(size_t count, const Scan& scan) {
+  if (count < kParallelThreshold) return scan(size_t{0}, count);
+  const size_t half = count / 2;
+  size_t second = kNotFound;
+  bool threaded = true;
+  std::thread worker;
+  try {
+    worker = std::thread([&] { second = scan(half, count); });
+  } catch (...) {
+    threaded = false;  // no thread available: fall back to scanning both halves here
+  }
+  const size_t first = scan(size_t{0}, half);
+  if (threaded) {
+    worker.join();
+  } else {
+    second = scan(half, count);
+  }
+  return first != kNotFound ? first : second;
+}
+
+size_t first_non_finite(std::span<const float> values) {
+  return first_bad(values.size(), [&](size_t b, size_t e) {
+    return first_non_finite_serial(values.data(), b, e);
+  });
+}
+
+size_t first_non_unit(std::span<const glm::quat> quats) {
+  const float* data = quats.empty() ? nullptr : glm::value_ptr(quats[0]);
+  return first_bad(quats.size(), [&](size_t b, size_t e) {
+    return first_non_unit_serial(data, b, e);
+  });
+}
+
+// First byte that is neither 0 nor 1.
+size_t first_non_boolean(std::span<const uint8_t> values) {
+  for (size_t block = 0; block < values.size(); block += kBlock) {
+    const size_t block_end = std::min(values.size(), block + kBlock);
+    uint8_t bad = 0;
+    for (size_t i = block; i < block_end; ++i) bad |= static_cast<uint8_t>(values[i] > 1);
+    if (bad != 0) {
+      for (size_t i = block; i < block_end; ++i) {
+        if (values[i] > 1) return i;
+      }
+    }
+  }
+  return kNotFound;
+}
+
+std::span<const float> floats_of(const std::vector<glm::vec3>& v) {
+  return {v.empty() ? nullptr : glm::value_ptr(v[0]), v.size() * 3};
+}
+
+bool finite3(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// The joint a role name refers to in this database, or -2 when the name is not a role.
+int role_joint(const JointRoleIndices& roles, std::string_view name) {
+  if (name == "hips") return roles.hips;
+  if (name == "left_foot") return roles.left_foot;
+  if (name == "right_foot") return roles.right_foot;
+  if (name == "left_toe") return roles.left_toe;
+  if (name == "right_toe") return roles.right_toe;
+  if (name == "head") return roles.head;
+  return -2;
+}
+
+bool is_bone_kind(FeatureKind kind) {
+  return kind == FeatureKind::BonePosition || kind == FeatureKind::BoneVelocity ||
+         kind == FeatureKind::BoneDirection;
+}
+
+std::string frame_joint(const Database& db, size_t index) {
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const int joint = static_cast<int>(index % joints);
+  return "[frame " + std::to_string(index / joints) + ", joint " + std::to_string(joint) + " '" +
+         db.skeleton.name(joint) + "']";
+}
+
+Status check_size(std::string_view what, size_t actual, size_t expected, std::string_view how) {
+  if (actual == expected) return Status::success();
+  return Error{"database: " + std::string(what) + " has " + std::to_string(actual) +
+               " values, expected " + std::to_string(expected) + " (" + std::string(how) + ")"};
+}
+
+}  // namespace
+
+uint64_t Database::tag_mask(std::span<const std::string> names) const {
+  uint64_t mask = 0;
+  const size_t usable = std::min<size_t>(tag_names.size(), 64);
+  for (const std::string& name : names) {
+    for (size_t i = 0; i < usable; ++i) {
+      if (tag_names[i] == name) mask |= uint64_t{1} << i;
+    }
+  }
+  return mask;
+}
+
+Status Database::validate() const {
+  if (!(frame_time > 0.0f) || !std::isfinite(frame_time)) {
+    return Error{"database: frame_time " + std::to_string(frame_time) +
+                 " s; expected a positive finite number of seconds"};
+  }
+
+  // Skeleton: structure, then rest transforms.
+  const int joints = joint_count();
+  if (joints <= 0) return Error{"database: the skeleton has no joints"};
+  if (Status s = Skeleton::validate(skeleton.names(), skeleton.parents(), skeleton.rest().size());
+      !s) {
+    return Error{"database: " + s.message()};
+  }
+  for (int j = 0; j < joints; ++j) {
+    const Transform& t = skeleton.rest(j);
+    const glm::quat& q = t.rotation;
+    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    if (!finite3(t.translation) || !finite3(t.scale) ||
+        !(n2 >= kMinUnitNormSquared && n2 <= kMaxUnitNormSquared)) {
+      return Error{"database: skeleton rest transform of joint " + std::to_string(j) + " '" +
+                   skeleton.name(j) + "' is not finite or its rotation is not unit length"};
+    }
+  }
+
+  // Roles name existing joints or nothing.
+  const std::pair<const char*, int> role_list[] = {
+      {"hips", roles.hips},           {"left_foot", roles.left_foot},
+      {"right_foot", roles.right_foot}, {"left_toe", roles.left_toe},
+      {"right_toe", roles.right_toe}, {"head", roles.head}};
+  for (const auto& [role, joint] : role_list) {
+    if (joint < -1 || joint >= joints) {
+      return Error{"database: role " + std::string(role) + " is joint " + std::to_string(joint) +
+                   ", out of range [-1, " + std::to_string(joints) + ")"};
+    }
+  }
+
+  if (frame_count <= 0) return Error{"database: has no frames (frame_count " +
+                                     std::to_string(frame_count) + ")"};
+  const size_t frames = static_cast<size_t>(frame_count);
+  const size_t samples = frames * static_cast<size_t>(joints);
+  const std::string per_joint =
+      std::to_string(frame_count) + " frames x " + std::to_string(joints) + " joints";
+  if (Status s = check_size("local_positions", local_positions.size(), samples, per_joint); !s) return s;
+  if (Status s = check_size("local_rotations", local_rotations.size(), samples, per_joint); !s) return s;
+  if (Status s = check_size("local_velocities", local_velocities.size(), samples, per_joint); !s) return s;
+  if (Status s = check_size("local_angular_velocities", local_angular_velocities.size(), samples,
+                            per_joint);
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("contacts", contacts.size(), frames * 2,
+                            std::to_string(frame_count) + " frames x 2 feet");
+      !s) {
+    return s;
+  }
+
+  // Schema and feature matrix.
+  if (Status s = schema.validate(); !s) return Error{"database: schema: " + s.message()};
+  for (size_t c = 0; c < schema.channels.size(); ++c) {
+    const FeatureChannel& channel = schema.channels[c];
+    if (!is_bone_kind(channel.kind)) continue;
+    const int role = role_joint(roles, channel.bone);
+    if (role == -1) {
+      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
+                   "' uses role '" + channel.bone + "', which this database's skeleton lacks"};
+    }
+    if (role == -2 && skeleton.find(channel.bone) < 0) {
+      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
+                   "' names bone '" + channel.bone + "', which is neither a role nor a joint"};
+    }
+  }
+  const int dims_int = feature_dims();
+  if (dims_int <= 0) return Error{"database: the feature schema has no columns"};
+  const size_t dims = static_cast<size_t>(dims_int);
+  if (Status s = check_size("features", features.size(), frames * dims,
+                            std::to_string(frame_count) + " frames x " + std::to_string(dims) +
+                                " feature columns");
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("feature_offset", feature_offset.size(), dims, "one per feature column");
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("feature_scale", feature_scale.size(), dims, "one per feature column");
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("searchable", searchable.size(), frames, "one per frame"); !s) return s;
+
+  // Tags.
+  if (tag_names.size() > 64) {
+    return Error{"database: " + std::to_string(tag_names.size()) +
+                 " tag names; at most 64 fit the 64-bit clip tag masks"};
+  }
+  for (size_t i = 0; i < tag_names.size(); ++i) {
+    if (tag_names[i].empty()) return Error{"database: tag name " + std::to_string(i) + " is empty"};
+    for (size_t k = 0; k < i; ++k) {
+      if (tag_names[k] == tag_names[i]) {
+        return Error{"database: duplicate tag name '" + tag_names[i] + "' (tags " +
+                     std::to_string(k) + " and " + std::to_string(i) + ")"};
+      }
+    }
+  }
+  const uint64_t known_tags =
+      tag_names.size() >= 64 ? ~uint64_t{0} : (uint64_t{1} << tag_names.size()) - 1;
+
+  // Clips tile [0, frame_count) in order.
+  if (clips.empty()) return Error{"database: has frames but no clips"};
+  int expected_start = 0;
+  for (size_t c = 0; c < clips.size(); ++c) {
+    const ClipRange& clip = clips[c];
+    const std::string where = "database: clip " + std::to_string(c) + " '" + clip.name + "'";
+    if (clip.name.empty()) return Error{"database: clip " + std::to_string(c) + " has an empty name"};
+    if (clip.start != expected_start) {
+      return Error{where + " starts at frame " + std::to_string(clip.start) + ", expected " +
+                   std::to_string(expected_start) +
+                   " (clips must be sorted, non-overlapping and cover every frame)"};
+    }
+    if (clip.end <= clip.start || clip.end > frame_count) {
+      return Error{where + " has range [" + std::to_string(clip.start) + ", " +
+                   std::to_string(clip.end) + "); expected a non-empty range within [0, " +
+                   std::to_string(frame_count) + ")"};
+    }
+    if ((clip.tags & ~known_tags) != 0) {
+      return Error{where + " has tag bit " + std::to_string(std::countr_zero(clip.tags & ~known_tags)) +
+                   " set, but only " + std::to_string(tag_names.size()) + " tags exist"};
+    }
+    expected_start = clip.end;
+  }
+  if (expected_start != frame_count) {
+    return Error{"database: the clips end at frame " + std::to_string(expected_start) +
+                 " but there are " + std::to_string(frame_count) + " frames"};
+  }
+  if (Status s = check_size("frame_clip", frame_clip.size(), frames, "one per frame"); !s) return s;
+  for (size_t c = 0; c < clips.size(); ++c) {
+    for (int f = clips[c].start; f < clips[c].end; ++f) {
+      if (frame_clip[static_cast<size_t>(f)] != static_cast<int>(c)) {
+        return Error{"database: frame_clip[" + std::to_string(f) + "] is " +
+                     std::to_string(frame_clip[static_cast<size_t>(f)]) + ", but the frame is in clip " +
+                     std::to_string(c) + " '" + clips[c].name + "'"};
+      }
+    }
+  }
+
+  // Values: the large arrays last, with the vectorized scans.
+  if (size_t i = first_non_unit(local_rotations); i != kNotFound) {
+    const glm::quat& q = local_rotations[i];
+    return Error{"database: local_rotations" + frame_joint(*this, i) +
+                 " is not a finite unit quaternion (squared length " +
+                 std::to_string(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) + ")"};
+  }
+  const std::pair<const char*, const std::vector<glm::vec3>*> vector_arrays[] = {
+      {"local_positions", &local_positions},
+      {"local_velocities", &local_velocities},
+      {"local_angular_velocities", &local_angular_velocities}};
+  for (const auto& [name, array] : vector_arrays) {
+    if (size_t i = first_non_finite(floats_of(*array)); i != kNotFound) {
+      return Error{"database: " + std::string(name) + frame_joint(*this, i / 3) +
+                   " is not finite"};
+    }
+  }
+  if (size_t i = first_non_boolean(contacts); i != kNotFound) {
+    return Error{"database: contacts[frame " + std::to_string(i / 2) + ", " +
+                 (i % 2 == 0 ? "left" : "right") + "] is " + std::to_string(contacts[i]) +
+                 "; expected 0 or 1"};
+  }
+  if (size_t i = first_non_finite(features); i != kNotFound) {
+    return Error{"database: features[frame " + std::to_string(i / dims) + ", column " +
+                 std::to_string(i % dims) + "] is not finite"};
+  }
+  for (size_t c = 0; c < dims; ++c) {
+    if (!std::isfinite(feature_offset[c])) {
+      return Error{"database: feature_offset[" + std::to_string(c) + "] is not finite"};
+    }
+    if (!std::isfinite(feature_scale[c]) || feature_scale[c] == 0.0f) {
+      return Error{"database: feature_scale[" + std::to_string(c) + "] is " +
+                   std::to_string(feature_scale[c]) + "; expected a finite non-zero scale"};
+    }
+  }
+  if (size_t i = first_non_boolean(searchable); i != kNotFound) {
+    return Error{"database: searchable[" + std::to_string(i) + "] is " +
+                 std::to_string(searchable[i]) + "; expected 0 or 1"};
+  }
+  return Status::success();
+}
+
+}  // namespace mm
