@@ -1,0 +1,534 @@
+// Search: the rules on hand-made databases, the kernels against scalar loops, and every method
+// against the `brute` reference on synthetic curve-like data under every combination of
+// constraints. (search_real_test.cpp does the same on real motion capture.)
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mm/database/search.hpp"
+#include "mm/database/search_kernels.hpp"
+#include "mm/database/search_synthetic.hpp"
+
+namespace mm {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Same cost within 1e-5 relative (the definition of an exact match).
+bool same_cost(float a, float b) {
+  if (a == b) return true;
+  return std::fabs(a - b) <= 1e-5f * std::max(std::fabs(a), std::fabs(b));
+}
+
+std::unique_ptr<Searcher> make(std::string_view method, const SearchInput& input,
+                               const SearchOptions& options = {}) {
+  auto searcher = make_searcher(method, input, options);
+  EXPECT_TRUE(searcher.ok()) << method << ": " << (searcher.ok() ? "" : searcher.message());
+  return searcher.ok() ? std::move(searcher.value()) : nullptr;
+}
+
+// A tiny database written out by hand: 1-d features, so every distance is easy to verify.
+//   clip 0 "walk" (tag bit 0): frames 0..5, values 0,1,2,3,4,5; frame 5 not searchable
+//   clip 1 "run"  (tag bit 1): frames 6..11, values 10,11,12,13,14,15; frame 11 not searchable
+//   clip 2 "idle" (tags 0 and 2): frames 12..14, values 2.5, 2.5, 2.5 (exact duplicates)
+struct TinyDatabase {
+  std::vector<float> features{0, 1, 2, 3, 4, 5, 10, 11, 12, 13, 14, 15, 2.5f, 2.5f, 2.5f};
+  std::vector<uint8_t> searchable{1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1};
+  std::vector<int> frame_clip{0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 2};
+  std::vector<ClipRange> clips{{"walk", 0, 6, 0b001, false},
+                               {"run", 6, 12, 0b010, false},
+                               {"idle", 12, 15, 0b101, false}};
+
+  SearchInput input() const {
+    SearchInput view;
+    view.features = features;
+    view.dims = 1;
+    view.searchable = searchable;
+    view.frame_clip = frame_clip;
+    view.clips = clips;
+    return view;
+  }
+};
+
+class TinyRules : public ::testing::TestWithParam<std::string_view> {
+ protected:
+  void SetUp() override {
+    SearchOptions options;
+    options.kdtree_leaf_size = 2;
+    options.approx_checks = 1000;  // more checks than rows: exhaustive on this size
+    searcher_ = make(GetParam(), db_.input(), options);
+    ASSERT_NE(searcher_, nullptr);
+  }
+  SearchResult find(float query, const SearchConstraints& constraints) const {
+    return searcher_->search(std::span<const float>(&query, 1), constraints);
+  }
+  TinyDatabase db_;
+  std::unique_ptr<Searcher> searcher_;
+};
+
+TEST_P(TinyRules, NothingPlayingPicksTheNearestSearchableFramePlusTransitionCost) {
+  SearchConstraints c;
+  c.transition_cost = 0.5f;
+  SearchResult r = find(4.75f, c);  // frame 5 (value 5) is not searchable: frame 4 wins
+  EXPECT_EQ(r.frame, 4);
+  EXPECT_NEAR(r.cost, 0.5625f + 0.5f, 1e-6f);
+  EXPECT_FALSE(r.continuation);
+  r = find(16.0f, c);  // frame 11 (15) is excluded, frame 10 (14) costs 4 + 0.5
+  EXPECT_EQ(r.frame, 10);
+  EXPECT_NEAR(r.cost, 4.5f, 1e-6f);
+}
+
+TEST_P(TinyRules, WindowSkipsNeighboursButNotTheContinuation) {
+  SearchConstraints c;
+  c.current_frame = 2;
+  c.window_frames = 1;  // frames 1..3 skipped, except the continuation 3
+  c.transition_cost = 0.0f;
+  // Query 2.0: frame 2 (d 0) and 1 (d 1) are in the window; continuation 3 costs 1; idle
+  // frames 12..14 cost 0.25 and win.
+  SearchResult r = find(2.0f, c);
+  EXPECT_GE(r.frame, 12);
+  EXPECT_LE(r.frame, 14);
+  EXPECT_NEAR(r.cost, 0.25f, 1e-6f);
+  // A transition cost of 1 makes the continuation (cost 1, no extra) beat idle (0.25 + 1) and
+  // frame 0 (4 + 1).
+  c.transition_cost = 1.0f;
+  r = find(2.0f, c);
+  EXPECT_EQ(r.frame, 3);
+  EXPECT_TRUE(r.continuation);
+  EXPECT_NEAR(r.cost, 1.0f, 1e-6f);
+}
+
+TEST_P(TinyRules, ContinuationWinsAnExactTie) {
+  SearchConstraints c;
+  c.current_frame = 0;
+  c.window_frames = 0;
+  c.transition_cost = 0.0f;
+  // Query 1.5: the continuation (frame 1) and frame 2 are both at 0.25; the continuation wins.
+  const SearchResult r = find(1.5f, c);
+  EXPECT_EQ(r.frame, 1);
+  EXPECT_TRUE(r.continuation);
+  EXPECT_NEAR(r.cost, 0.25f, 1e-6f);
+}
+
+TEST_P(TinyRules, ContinuationMustBeSearchableAndInTheSameClip) {
+  SearchConstraints c;
+  c.window_frames = 0;
+  c.transition_cost = 100.0f;
+  c.current_frame = 4;  // next frame 5 is not searchable: no continuation
+  SearchResult r = find(5.0f, c);
+  EXPECT_FALSE(r.continuation);
+  EXPECT_EQ(r.frame, 3);  // frame 4 is the window; frame 3 costs 4 + 100
+  EXPECT_NEAR(r.cost, 104.0f, 1e-4f);
+  c.current_frame = 5;  // next frame 6 is in another clip: no continuation either
+  r = find(10.0f, c);
+  EXPECT_FALSE(r.continuation);
+  EXPECT_EQ(r.frame, 6);
+  EXPECT_NEAR(r.cost, 100.0f, 1e-4f);
+}
+
+TEST_P(TinyRules, TagFiltersApplyToEveryCandidateIncludingTheContinuation) {
+  SearchConstraints c;
+  c.transition_cost = 0.0f;
+  c.include_tags = 0b001;  // walk and idle
+  SearchResult r = find(11.0f, c);
+  EXPECT_EQ(r.frame, 4);  // the run frames are filtered out
+  EXPECT_NEAR(r.cost, 49.0f, 1e-4f);
+  c.include_tags = 0b101;  // idle only (must carry both tags)
+  r = find(0.0f, c);
+  EXPECT_GE(r.frame, 12);
+  EXPECT_NEAR(r.cost, 6.25f, 1e-5f);
+  c.include_tags = 0;
+  c.exclude_tags = 0b100;  // no idle
+  r = find(2.5f, c);
+  EXPECT_TRUE(r.frame == 2 || r.frame == 3);
+  EXPECT_NEAR(r.cost, 0.25f, 1e-6f);
+  // The continuation of a run frame is filtered out by include walk: frame 7 is not chosen.
+  c.exclude_tags = 0;
+  c.include_tags = 0b001;
+  c.current_frame = 6;
+  c.transition_cost = 1000.0f;
+  r = find(11.0f, c);
+  EXPECT_FALSE(r.continuation);
+  EXPECT_EQ(r.frame, 4);
+  EXPECT_NEAR(r.cost, 1049.0f, 1e-2f);
+}
+
+TEST_P(TinyRules, NoCandidateGivesFrameMinusOne) {
+  SearchConstraints c;
+  c.include_tags = 0b110;  // no clip carries both run and idle
+  const SearchResult r = find(1.0f, c);
+  EXPECT_EQ(r.frame, -1);
+  EXPECT_EQ(r.cost, kInf);
+}
+
+// Test names from method names ("brute-simd" -> "brute_simd").
+std::string method_test_name(const ::testing::TestParamInfo<std::string_view>& param_info) {
+  std::string name(param_info.param);
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+}
+
+INSTANTIATE_TEST_SUITE_P(AllMethods, TinyRules, ::testing::ValuesIn(search_method_names()),
+                         method_test_name);
+
+TEST(SearchInputValidation, RejectsEveryInconsistency) {
+  TinyDatabase db;
+  EXPECT_TRUE(db.input().validate().ok());
+  {
+    SearchInput in = db.input();
+    in.dims = 0;
+    EXPECT_FALSE(in.validate().ok());
+    in.dims = kMaxSearchDims + 1;
+    EXPECT_FALSE(in.validate().ok());
+  }
+  {
+    SearchInput in = db.input();
+    in.features = in.features.first(14);
+    const Status s = in.validate();
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("14"), std::string::npos) << s.message();
+  }
+  {
+    SearchInput in = db.input();
+    in.frame_clip = in.frame_clip.first(3);
+    EXPECT_FALSE(in.validate().ok());
+  }
+  {
+    TinyDatabase bad;
+    bad.frame_clip[4] = 7;  // no such clip
+    EXPECT_FALSE(bad.input().validate().ok());
+    EXPECT_FALSE(make_searcher("brute", bad.input()).ok());
+  }
+  {
+    TinyDatabase bad;
+    bad.frame_clip[4] = 1;  // clip 1 is frames 6..11
+    const Status s = bad.input().validate();
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("run"), std::string::npos) << s.message();
+  }
+  {
+    TinyDatabase bad;
+    bad.features[3] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FALSE(bad.input().validate().ok());
+  }
+}
+
+TEST(SearchFactory, RejectsUnknownMethodsAndBadOptions) {
+  TinyDatabase db;
+  auto unknown = make_searcher("octree", db.input());
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.message().find("brute-simd"), std::string::npos) << unknown.message();
+  SearchOptions options;
+  options.kdtree_leaf_size = 0;
+  EXPECT_FALSE(make_searcher("kdtree", db.input(), options).ok());
+  options = {};
+  options.approx_checks = 0;
+  EXPECT_FALSE(make_searcher("approx", db.input(), options).ok());
+  for (std::string_view name : search_method_names()) {
+    auto s = make_searcher(name, db.input());
+    ASSERT_TRUE(s.ok()) << name;
+    EXPECT_EQ(s.value()->method(), name);
+    EXPECT_EQ(s.value()->dims(), 1);
+    EXPECT_GT(s.value()->memory_bytes(), 0u);
+    EXPECT_EQ(s.value()->exact(), name != "approx");
+  }
+}
+
+TEST(SearchFactory, EmptyCandidateSetFindsNothing) {
+  TinyDatabase db;
+  std::fill(db.searchable.begin(), db.searchable.end(), uint8_t{0});
+  for (std::string_view name : search_method_names()) {
+    auto s = make(name, db.input());
+    ASSERT_NE(s, nullptr);
+    const float q = 1.0f;
+    EXPECT_EQ(s->search(std::span<const float>(&q, 1), {}).frame, -1) << name;
+  }
+}
+
+// --- kernels --------------------------------------------------------------------------------
+
+TEST(SearchKernels, DistancesMatchHandComputation) {
+  const float a[3] = {1, 2, 3};
+  const float b[3] = {2, 0, 3};
+  EXPECT_FLOAT_EQ(search_kernels::squared_distance(a, b, 3), 5.0f);
+  // Stops at the first partial sum >= bound: 1 after one column, 5 after two.
+  EXPECT_FLOAT_EQ(search_kernels::squared_distance_bounded(a, b, 3, 0.5f), 1.0f);
+  EXPECT_FLOAT_EQ(search_kernels::squared_distance_bounded(a, b, 3, 100.0f), 5.0f);
+  const float lo[3] = {0, 3, -1};
+  const float hi[3] = {2, 4, 1};
+  // Inside on x, 1 below on y, 2 above on z: 0 + 1 + 4.
+  EXPECT_FLOAT_EQ(search_kernels::box_squared_distance_bounded(a, lo, hi, 3, kInf), 5.0f);
+}
+
+TEST(SearchKernels, PackBlocksIsColumnMajorPerBlockWithFarPadding) {
+  const int rows = 10;
+  const int dims = 3;
+  std::vector<float> data(rows * dims);
+  for (int i = 0; i < rows * dims; ++i) data[i] = static_cast<float>(i);
+  std::vector<float> packed(search_kernels::blocked_float_count(rows, dims));
+  ASSERT_EQ(packed.size(), 2u * dims * 8);
+  search_kernels::pack_blocks(data.data(), rows, dims, packed.data());
+  // Row 9 (block 1, lane 1), column 2 holds 9 * 3 + 2.
+  EXPECT_EQ(packed[(1 * dims + 2) * 8 + 1], 29.0f);
+  EXPECT_EQ(packed[(0 * dims + 1) * 8 + 5], 16.0f);
+  EXPECT_GT(packed[(1 * dims + 0) * 8 + 7], 1e20f);  // padding row 15
+}
+
+// Scans against a scalar loop on random rows with random tags and windows.
+void check_scan(search_kernels::ScanBlocksFn scan) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> gauss;
+  for (int dims : {1, 2, 7, 27, 33}) {
+    const int rows = 203;  // not a multiple of 8 or 32: exercises the tails
+    std::vector<float> data(static_cast<size_t>(rows) * dims);
+    for (float& v : data) v = gauss(rng);
+    std::vector<uint64_t> tags(rows);
+    std::vector<int> frames(rows);
+    for (int r = 0; r < rows; ++r) {
+      tags[r] = rng() & 7u;
+      frames[r] = 2 * r;
+    }
+    std::vector<float> packed(search_kernels::blocked_float_count(rows, dims));
+    search_kernels::pack_blocks(data.data(), rows, dims, packed.data());
+    const int blocks = (rows + 7) / 8;
+    std::vector<uint64_t> block_or(blocks, 0), block_and(blocks, ~uint64_t{0});
+    for (int r = 0; r < rows; ++r) {
+      block_or[r / 8] |= tags[r];
+      block_and[r / 8] &= tags[r];
+    }
+    for (int trial = 0; trial < 40; ++trial) {
+      std::vector<float> q(dims);
+      for (float& v : q) v = gauss(rng);
+      search_kernels::RowFilter filter;
+      filter.row_tags = tags.data();
+      filter.row_frame = frames.data();
+      filter.row_count = rows;
+      filter.include_tags = trial % 3 == 0 ? 1 : 0;
+      filter.exclude_tags = trial % 4 == 0 ? 2 : 0;
+      filter.window_first = trial * 9;
+      filter.window_last = trial * 9 + trial % 5 * 20;
+      if (trial % 2) {
+        filter.block_tags_or = block_or.data();
+        filter.block_tags_and = block_and.data();
+      }
+      const float bound = trial % 7 == 0 ? 0.5f * dims : kInf;
+      int expected_row = -1;
+      float expected = bound;
+      for (int r = 0; r < rows; ++r) {
+        if (!filter.passes(r)) continue;
+        const float d = search_kernels::squared_distance(q.data(), &data[static_cast<size_t>(r) * dims], dims);
+        if (d < expected) {
+          expected = d;
+          expected_row = r;
+        }
+      }
+      search_kernels::ScanBest best;
+      best.distance = bound;
+      scan(packed.data(), 0, blocks, dims, q.data(), filter, best);
+      ASSERT_EQ(best.row >= 0, expected_row >= 0) << "dims " << dims << " trial " << trial;
+      if (expected_row >= 0) {
+        EXPECT_TRUE(same_cost(best.distance, expected)) << best.distance << " vs " << expected;
+        const float d = search_kernels::squared_distance(q.data(), &data[static_cast<size_t>(best.row) * dims], dims);
+        EXPECT_TRUE(same_cost(d, expected));
+        EXPECT_TRUE(filter.passes(best.row));
+      }
+    }
+  }
+}
+
+TEST(SearchKernels, PortableScanMatchesScalarLoop) { check_scan(&search_kernels::scan_blocks_portable); }
+
+TEST(SearchKernels, Avx2ScanMatchesScalarLoop) {
+  // This machine and the CI machine support AVX2; the check keeps the test honest elsewhere.
+  if (!search_kernels::avx2_supported()) {
+    EXPECT_EQ(search_kernels::scan_blocks(), &search_kernels::scan_blocks_portable);
+    return;
+  }
+  EXPECT_STREQ(search_kernels::scan_blocks_isa(), "avx2");
+  check_scan(&search_kernels::scan_blocks_avx2);
+}
+
+// --- every method against brute on synthetic data --------------------------------------------
+
+SyntheticSearchData small_synthetic() {
+  SyntheticSearchSpec spec;
+  spec.clip_count = 50;
+  spec.min_clip_frames = 60;
+  spec.max_clip_frames = 180;
+  spec.seed = 3;
+  return make_synthetic_search_data(spec);
+}
+
+// Query i: a searchable frame's features plus Gaussian noise, playing that frame or another.
+struct Query {
+  std::vector<float> features;
+  SearchConstraints constraints;
+};
+
+std::vector<Query> constrained_queries(const SyntheticSearchData& data, int per_combination,
+                                       uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> gauss;
+  std::vector<int> frames;
+  for (int f = 0; f < data.frame_count(); ++f) {
+    if (data.searchable[f]) frames.push_back(f);
+  }
+  std::vector<Query> queries;
+  const float noises[] = {0.0f, 0.1f, 0.5f};
+  const float costs[] = {0.0f, 0.3f, 5.0f};
+  for (int playing = 0; playing < 2; ++playing) {
+    for (int window : {0, 10}) {
+      for (float cost : costs) {
+        for (uint64_t include : {uint64_t{0}, uint64_t{2}}) {
+          for (uint64_t exclude : {uint64_t{0}, uint64_t{1}, uint64_t{4}}) {
+            for (int i = 0; i < per_combination; ++i) {
+              const int source = frames[rng() % frames.size()];
+              Query q;
+              const float noise = noises[i % 3];
+              for (int d = 0; d < data.dims; ++d) {
+                q.features.push_back(data.features[static_cast<size_t>(source) * data.dims + d] +
+                                     noise * gauss(rng));
+              }
+              q.constraints.current_frame = playing ? (i % 2 ? source : frames[rng() % frames.size()]) : -1;
+              q.constraints.window_frames = window;
+              q.constraints.transition_cost = cost;
+              q.constraints.include_tags = include;
+              q.constraints.exclude_tags = exclude;
+              queries.push_back(std::move(q));
+            }
+          }
+        }
+      }
+    }
+  }
+  return queries;
+}
+
+// Checks that `r` obeys the rules for query `q`, with its cost recomputed independently.
+void expect_valid(const SyntheticSearchData& data, const Query& q, const SearchResult& r) {
+  if (r.frame < 0) return;
+  const SearchConstraints& c = q.constraints;
+  ASSERT_LT(r.frame, data.frame_count());
+  EXPECT_TRUE(data.searchable[r.frame]);
+  const uint64_t tags = data.clips[data.frame_clip[r.frame]].tags;
+  EXPECT_EQ(tags & c.include_tags, c.include_tags);
+  EXPECT_EQ(tags & c.exclude_tags, 0u);
+  const bool is_next = c.current_frame >= 0 && r.frame == c.current_frame + 1 &&
+                       data.frame_clip[r.frame] == data.frame_clip[c.current_frame];
+  EXPECT_EQ(r.continuation, is_next);
+  if (!is_next && c.current_frame >= 0) {
+    EXPECT_TRUE(r.frame < c.current_frame - c.window_frames ||
+                r.frame > c.current_frame + c.window_frames);
+  }
+  double d = 0;
+  for (int k = 0; k < data.dims; ++k) {
+    const double diff = double(q.features[k]) - data.features[static_cast<size_t>(r.frame) * data.dims + k];
+    d += diff * diff;
+  }
+  const double expected = d + (is_next ? 0.0 : c.transition_cost);
+  EXPECT_NEAR(r.cost, expected, 1e-5 * std::max(1.0, expected));
+}
+
+class SyntheticExactness : public ::testing::TestWithParam<std::string_view> {};
+
+TEST_P(SyntheticExactness, SameCostAsBruteUnderEveryConstraintCombination) {
+  const SyntheticSearchData data = small_synthetic();
+  auto brute = make("brute", data.input());
+  auto method = make(GetParam(), data.input());
+  ASSERT_NE(brute, nullptr);
+  ASSERT_NE(method, nullptr);
+  const std::vector<Query> queries = constrained_queries(data, 12, 11);  // 72 combinations
+  ASSERT_GE(queries.size(), 800u);
+  int mismatches = 0;
+  for (const Query& q : queries) {
+    const SearchResult expected = brute->search(q.features, q.constraints);
+    const SearchResult got = method->search(q.features, q.constraints);
+    expect_valid(data, q, expected);
+    expect_valid(data, q, got);
+    ASSERT_EQ(got.frame >= 0, expected.frame >= 0);
+    if (!same_cost(got.cost, expected.cost)) ++mismatches;
+  }
+  EXPECT_EQ(mismatches, 0) << "of " << queries.size();
+}
+
+INSTANTIATE_TEST_SUITE_P(ExactMethods, SyntheticExactness,
+                         ::testing::Values("brute-simd", "aabb", "kdtree"), method_test_name);
+
+TEST(SyntheticApprox, NeverBelowExactAlwaysValidMostlyExact) {
+  const SyntheticSearchData data = small_synthetic();
+  auto brute = make("brute", data.input());
+  auto approx = make("approx", data.input());
+  ASSERT_NE(approx, nullptr);
+  const std::vector<Query> queries = constrained_queries(data, 6, 12);
+  int exact = 0;
+  for (const Query& q : queries) {
+    const SearchResult expected = brute->search(q.features, q.constraints);
+    const SearchResult got = approx->search(q.features, q.constraints);
+    expect_valid(data, q, got);
+    // The approximate answer can only be as good as the exact one, never better.
+    EXPECT_GE(got.cost, expected.cost * (1.0f - 1e-5f));
+    // It finds a candidate whenever one exists (it keeps searching until it has one).
+    EXPECT_EQ(got.frame >= 0, expected.frame >= 0);
+    exact += same_cost(got.cost, expected.cost);
+  }
+  // A loose floor: the randomized trees with a 64-check budget find most nearest neighbours
+  // on this data (the benchmark measures the real rate).
+  EXPECT_GT(exact, static_cast<int>(queries.size()) / 2);
+}
+
+TEST(SearchBatch, BatchedResultsEqualSingleSearches) {
+  const SyntheticSearchData data = small_synthetic();
+  auto kdtree = make("kdtree", data.input());
+  ASSERT_NE(kdtree, nullptr);
+  const std::vector<Query> queries = constrained_queries(data, 3, 5);
+  std::vector<float> flat;
+  std::vector<SearchConstraints> constraints;
+  for (const Query& q : queries) {
+    flat.insert(flat.end(), q.features.begin(), q.features.end());
+    constraints.push_back(q.constraints);
+  }
+  std::vector<SearchResult> results(queries.size());
+  SearchBatchRunner runner(2);
+  EXPECT_EQ(runner.thread_count(), 2);
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    std::fill(results.begin(), results.end(), SearchResult{});
+    runner.run(*kdtree, flat, constraints, results);
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const SearchResult single = kdtree->search(queries[i].features, queries[i].constraints);
+      ASSERT_EQ(results[i].frame, single.frame) << i;
+      ASSERT_EQ(results[i].cost, single.cost) << i;
+    }
+  }
+  // One constraint shared by every query.
+  const SearchConstraints shared = constraints[0];
+  runner.run(*kdtree, flat, std::span<const SearchConstraints>(&shared, 1), results);
+  for (size_t i = 0; i < queries.size(); ++i) {
+    EXPECT_EQ(results[i].cost, kdtree->search(queries[i].features, shared).cost);
+  }
+}
+
+TEST(SyntheticData, HasClipsTailsAndAStandingCluster) {
+  const SyntheticSearchData data = small_synthetic();
+  ASSERT_TRUE(data.input().validate().ok());
+  EXPECT_EQ(data.clips.size(), 50u);
+  int standing = 0;
+  for (const ClipRange& clip : data.clips) {
+    EXPECT_GE(clip.frame_count(), 60);
+    EXPECT_LE(clip.frame_count(), 180);
+    // The last 30 frames of each clip are not searchable, the others are.
+    EXPECT_TRUE(data.searchable[clip.end - 30 - 1]);
+    EXPECT_FALSE(data.searchable[clip.end - 30]);
+    standing += (clip.tags & 1) != 0;
+  }
+  EXPECT_GT(standing, 10);
+  EXPECT_LT(standing, 40);
+}
+
+}  // namespace
+}  // namespace mm
