@@ -48,6 +48,24 @@ float quat_angle_between(const glm::quat& a, const glm::quat& b) {
   return glm::length(quat_to_scaled_angle_axis(glm::conjugate(a) * b));
 }
 
+glm::quat quat_between(const glm::vec3& from, const glm::vec3& to) {
+  const float from_length = glm::length(from);
+  const float to_length = glm::length(to);
+  if (!(from_length > 1e-20f) || !(to_length > 1e-20f)) return glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  const glm::vec3 u = from / from_length;
+  const glm::vec3 v = to / to_length;
+  const float d = glm::dot(u, v);
+  if (d < -1.0f + 1e-6f) {
+    // Half a turn: any axis perpendicular to u; take the one least aligned with u's largest axis.
+    const glm::vec3 other = std::abs(u.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    const glm::vec3 axis = glm::normalize(glm::cross(u, other));
+    return glm::quat(0.0f, axis.x, axis.y, axis.z);
+  }
+  // The half-way quaternion (1 + d, u x v), normalized: no trigonometry, exact at d = 1.
+  const glm::vec3 c = glm::cross(u, v);
+  return glm::normalize(glm::quat(1.0f + d, c.x, c.y, c.z));
+}
+
 glm::quat quat_nlerp(const glm::quat& a, const glm::quat& b, float t) {
   const glm::quat bs = negated_if_far(a, b);
   const glm::quat m = (1.0f - t) * a + t * bs;

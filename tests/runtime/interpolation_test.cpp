@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -59,6 +60,25 @@ TEST(QuatLogExp, ShortestPathFlipsNegativeW) {
   // The exact antipode of identity (-1) is identity.
   EXPECT_TRUE(near_vec3(quat_to_scaled_angle_axis(glm::quat(-1.0f, 0.0f, 0.0f, 0.0f)),
                         glm::vec3(0.0f), 0.0f));
+}
+
+TEST(QuatBetween, RotatesFromOntoToIncludingOppositeAndZero) {
+  for (int i = 0; i < 50; ++i) {
+    const glm::vec3 from = test::random_unit_vec3() * test::uniform(0.1f, 3.0f);
+    const glm::vec3 to = test::random_unit_vec3() * test::uniform(0.1f, 3.0f);
+    const glm::quat q = quat_between(from, to);
+    EXPECT_TRUE(near_vec3(q * glm::normalize(from), glm::normalize(to), 1e-5f));
+    // The shortest such rotation turns by exactly the angle between the two directions.
+    const double angle = std::acos(std::clamp(
+        static_cast<double>(glm::dot(glm::normalize(from), glm::normalize(to))), -1.0, 1.0));
+    EXPECT_NEAR(rotation_angle_between(glm::quat(1, 0, 0, 0), q), angle, 1e-4);
+  }
+  const glm::vec3 x(1, 0, 0);
+  const glm::quat half = quat_between(x, -x);
+  EXPECT_TRUE(near_vec3(half * x, -x, 1e-6f));
+  EXPECT_NEAR(glm::length(half), 1.0f, 1e-6f);
+  EXPECT_TRUE(same_rotation(quat_between(x, x), glm::quat(1, 0, 0, 0), 0.0f));
+  EXPECT_TRUE(same_rotation(quat_between(glm::vec3(0.0f), x), glm::quat(1, 0, 0, 0), 0.0f));
 }
 
 // ---- slerp / nlerp ------------------------------------------------------------------------------

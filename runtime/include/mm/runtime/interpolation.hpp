@@ -44,6 +44,11 @@ glm::quat quat_from_scaled_angle_axis(const glm::vec3& scaled_angle_axis);
 // The angle in radians, in [0, pi], of the shortest rotation taking a to b.
 float quat_angle_between(const glm::quat& a, const glm::quat& b);
 
+// The shortest rotation taking direction `from` to direction `to` (neither needs unit length).
+// Opposite directions give a half turn about an axis perpendicular to `from`; a zero vector
+// gives identity.
+glm::quat quat_between(const glm::vec3& from, const glm::vec3& to);
+
 // Normalized linear interpolation from a to b along the shortest path (not constant speed).
 glm::quat quat_nlerp(const glm::quat& a, const glm::quat& b, float t);
 

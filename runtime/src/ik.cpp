@@ -1,0 +1,164 @@
+#include "mm/runtime/ik.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "mm/runtime/interpolation.hpp"
+
+namespace mm {
+
+namespace {
+
+// Bones shorter than this (metres) cannot be bent meaningfully.
+constexpr float kMinBoneLength = 1e-6f;
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool finite(const glm::quat& q) {
+  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
+}
+
+// The unsigned angle between two vectors, accurate near 0 and pi (atan2 rather than acos).
+float angle_between(const glm::vec3& u, const glm::vec3& v) {
+  return std::atan2(glm::length(glm::cross(u, v)), glm::dot(u, v));
+}
+
+// The interior angle opposite side c of a triangle with sides a, b, c (law of cosines).
+float triangle_angle(float a, float b, float opposite) {
+  const float cosine = (a * a + b * b - opposite * opposite) / (2.0f * a * b);
+  return std::acos(std::clamp(cosine, -1.0f, 1.0f));
+}
+
+// A unit vector perpendicular to u (|u| > 0), preferring the direction of `hint`'s part
+// perpendicular to u when it has one.
+glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
+  const glm::vec3 un = glm::normalize(u);
+  glm::vec3 p = hint - glm::dot(hint, un) * un;
+  if (glm::length(p) > 1e-6f * (glm::length(hint) + 1e-30f) && glm::length(p) > 1e-20f) {
+    return glm::normalize(p);
+  }
+  const glm::vec3 other = std::abs(un.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+  return glm::normalize(glm::cross(un, other));
+}
+
+TwoBoneIkResult unchanged(const TwoBoneIkInput& in) {
+  TwoBoneIkResult r;
+  r.root_global = in.root.rotation;
+  r.mid_global = in.mid.rotation;
+  r.root_local = glm::conjugate(in.root_parent_rotation) * in.root.rotation;
+  r.mid_local = glm::conjugate(in.root.rotation) * in.mid.rotation;
+  r.mid_position = in.mid.translation;
+  r.end_position = in.end.translation;
+  return r;
+}
+
+}  // namespace
+
+TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
+  const glm::vec3 a = in.root.translation;
+  const glm::vec3 b = in.mid.translation;
+  const glm::vec3 c = in.end.translation;
+  const float upper = glm::distance(a, b);
+  const float lower = glm::distance(b, c);
+  if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
+      !finite(in.root.rotation) || !finite(in.mid.rotation) ||
+      !finite(in.root_parent_rotation) || !std::isfinite(in.extension_epsilon) ||
+      upper < kMinBoneLength || lower < kMinBoneLength) {
+    return unchanged(in);
+  }
+
+  // Clamp the wanted hip-to-ankle distance to what the two bones can make.
+  const float total = upper + lower;
+  const float epsilon = std::clamp(in.extension_epsilon, 0.0f, 0.5f);
+  const float max_reach = total * (1.0f - epsilon);
+  const float min_reach = std::min(std::abs(upper - lower) + epsilon * total, max_reach);
+  const float target_distance = glm::distance(a, in.target);
+  const float reach = std::clamp(target_distance, min_reach, max_reach);
+
+  // The direction to reach along: toward the target, or (target at the hip) the current one.
+  glm::vec3 direction = in.target - a;
+  if (!(target_distance > 1e-6f * total)) direction = c - a;
+  if (!(glm::length(direction) > 1e-6f * total)) direction = b - a;
+  direction = glm::normalize(direction);
+
+  // 1. Bend about the current bend axis: the knee's interior angle goes to the one that makes
+  // the hip-ankle distance `reach`, and the hip turns so the ankle stays on its old line.
+  const glm::vec3 ab = b - a;
+  const glm::vec3 ac = c - a;
+  glm::vec3 bend_axis = glm::cross(ac, ab);
+  float hip_angle_now = 0.0f;
+  if (glm::length(bend_axis) > 1e-6f * upper * glm::length(ac) && glm::length(ac) > 1e-6f * total) {
+    bend_axis = glm::normalize(bend_axis);
+    hip_angle_now = angle_between(ac, ab);
+  } else {
+    // Straight or folded limb: no plane yet. Bend toward the pole; step 3 settles the twist.
+    bend_axis = glm::normalize(glm::cross(ab, perpendicular(ab, in.pole)));
+  }
+  const float knee_angle_now = angle_between(a - b, c - b);
+  const float hip_angle = triangle_angle(upper, reach, lower);
+  const float knee_angle = triangle_angle(upper, lower, reach);
+  const glm::quat hip_bend = glm::angleAxis(hip_angle - hip_angle_now, bend_axis);
+  const glm::quat knee_bend = glm::angleAxis(knee_angle - knee_angle_now, bend_axis);
+
+  glm::vec3 knee = a + hip_bend * ab;
+  glm::vec3 ankle = knee + knee_bend * (hip_bend * (c - b));
+
+  // 2. Swing the whole chain about the hip so the ankle lies on the line toward the target.
+  const glm::quat swing = quat_between(ankle - a, direction);
+
+  // 3. Twist about that line so the knee is in the half-plane of the pole.
+  const glm::vec3 knee_offset = swing * (knee - a);
+  glm::quat twist(1.0f, 0.0f, 0.0f, 0.0f);
+  const glm::vec3 knee_across = knee_offset - glm::dot(knee_offset, direction) * direction;
+  const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
+  if (glm::length(knee_across) > 1e-6f * upper && glm::length(pole_across) > 1e-6f) {
+    const float angle = std::atan2(glm::dot(direction, glm::cross(knee_across, pole_across)),
+                                   glm::dot(knee_across, pole_across));
+    twist = glm::angleAxis(angle, direction);
+  }
+
+  const glm::quat hip_turn = twist * swing * hip_bend;
+  const glm::quat knee_turn = twist * swing * knee_bend * hip_bend;
+  TwoBoneIkResult r;
+  r.root_global = glm::normalize(hip_turn * in.root.rotation);
+  r.mid_global = glm::normalize(knee_turn * in.mid.rotation);
+  r.root_local = glm::normalize(glm::conjugate(in.root_parent_rotation) * r.root_global);
+  r.mid_local = glm::normalize(glm::conjugate(r.root_global) * r.mid_global);
+  r.mid_position = a + hip_turn * ab;
+  r.end_position = r.mid_position + knee_turn * (c - b);
+  r.reached = target_distance >= min_reach && target_distance <= max_reach;
+  return r;
+}
+
+TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
+                                  std::span<Transform> global, int root, int mid, int end,
+                                  const glm::vec3& target, const glm::vec3& pole,
+                                  float extension_epsilon) {
+  assert(parents.size() == local.size() && parents.size() == global.size());
+  assert(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
+  assert(parents[mid] == root && parents[end] == mid);
+  TwoBoneIkInput in;
+  in.root = global[root];
+  in.mid = global[mid];
+  in.end = global[end];
+  const int root_parent = parents[root];
+  in.root_parent_rotation =
+      root_parent >= 0 ? global[root_parent].rotation : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  in.target = target;
+  in.pole = pole;
+  in.extension_epsilon = extension_epsilon;
+  const TwoBoneIkResult r = solve_two_bone_ik(in);
+  local[root].rotation = r.root_local;
+  local[mid].rotation = r.mid_local;
+  // Parents come first, so one pass from the root on refreshes every descendant.
+  for (size_t i = static_cast<size_t>(root); i < parents.size(); ++i) {
+    const int p = parents[i];
+    global[i] = p < 0 ? local[i] : compose(global[p], local[i]);
+  }
+  return r;
+}
+
+}  // namespace mm
