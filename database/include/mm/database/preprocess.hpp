@@ -1,0 +1,183 @@
+#pragma once
+// Preprocessing: what happens to one imported Clip before it joins a Database.
+//
+//   resample_clip       -> the database rate (slerp rotations, lerp translations and scales)
+//   mirror_clip         -> optional left/right mirror across the YZ plane (x -> -x)
+//   preprocess_clip     -> simulation root (joint 0), joint velocities and angular velocities,
+//                          foot contacts, in the database's per-frame layout
+//
+// Everything here works on one clip and never looks past its ends: finite differences are
+// one-sided at the first and last frame, and the smoothing filters shrink their windows there.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mm/database/clip.hpp"
+#include "mm/database/database.hpp"
+#include "mm/runtime/result.hpp"
+#include "mm/runtime/skeleton.hpp"
+#include "mm/runtime/transform.hpp"
+
+namespace mm {
+
+// ---- Joint roles ---------------------------------------------------------------------------
+
+// The joint names each role may have, tried in order and compared case-insensitively; the
+// first candidate found in the skeleton wins. The defaults recognise the Bandai names (Hips,
+// Foot_L, Toes_L, Head, ...) and common BVH/Mixamo/Blender names (LeftFoot, LeftToeBase,
+// foot.L, ...). Override a role by replacing its list, e.g. roles.left_foot = {"l_ankle"}.
+struct JointRoles {
+  std::vector<std::string> hips = {"Hips", "Hip", "Pelvis", "mixamorig:Hips", "root_hips"};
+  std::vector<std::string> left_foot = {
+      "Foot_L",  "LeftFoot",           "L_Foot", "Foot.L", "LeftAnkle",
+      "l_ankle", "mixamorig:LeftFoot", "lFoot"};
+  std::vector<std::string> right_foot = {
+      "Foot_R",  "RightFoot",           "R_Foot", "Foot.R", "RightAnkle",
+      "r_ankle", "mixamorig:RightFoot", "rFoot"};
+  std::vector<std::string> left_toe = {"Toes_L", "LeftToeBase", "LeftToe", "L_Toe",
+                                       "Toe.L",  "Toes.L",      "l_toes",  "mixamorig:LeftToeBase"};
+  std::vector<std::string> right_toe = {
+      "Toes_R", "RightToeBase", "RightToe", "R_Toe",
+      "Toe.R",  "Toes.R",       "r_toes",   "mixamorig:RightToeBase"};
+  std::vector<std::string> head = {"Head", "mixamorig:Head"};
+};
+
+// Finds every role in `skeleton`. Hips and both feet are required (the default features and
+// the contacts need them): a missing one is an error naming the role, the names looked for and
+// the skeleton's joints. Toes and head are optional (-1 when absent).
+Result<JointRoleIndices> find_joint_roles(const Skeleton& skeleton, const JointRoles& roles);
+
+// ---- Mirroring -----------------------------------------------------------------------------
+
+// Two joints that swap places when a clip is mirrored.
+struct MirrorPair {
+  std::string left;   // exact joint name
+  std::string right;  // exact joint name
+};
+
+// The joint each joint takes its mirrored motion from: pairs detected from name patterns
+// (suffixes _L/_R, .L/.R, -L/-R in either case, prefixes L_/R_ and l_/r_, and the words
+// Left/Right or left/right anywhere), with `overrides` applied first (their names must exist).
+// Unpaired joints map to themselves. Fails when a joint would pair with two others.
+Result<std::vector<int>> mirror_joint_map(const Skeleton& skeleton,
+                                          std::span<const MirrorPair> overrides = {});
+
+// The clip mirrored across the YZ plane: every joint's GLOBAL transform is taken from its
+// mirror joint (joint_map from mirror_joint_map) and reflected (position x -> -x, rotation
+// quat(w, x, y, z) -> quat(w, x, -y, -z)), then locals are recomputed from the globals, so
+// mirrored local translations may differ from the rest offsets. Named "<name>_mirror".
+// Mirroring twice gives the original back (up to float rounding).
+Clip mirror_clip(const Clip& clip, std::span<const int> joint_map);
+
+// ---- Resampling ----------------------------------------------------------------------------
+
+// True when the clip's frame time differs from 1 / rate by more than 0.1 % (BVH files store
+// 0.0333333 for 30 Hz, which counts as 30 Hz).
+bool needs_resampling(const Clip& clip, float rate);
+
+// The clip sampled every 1 / rate seconds from 0 to its duration (a tail shorter than half a
+// frame is dropped; a clip that needs no resampling is copied with its frame time set to exactly
+// 1 / rate): rotations by slerp, translations and scales by lerp between the neighbouring frames.
+Clip resample_clip(const Clip& clip, float rate);
+
+// ---- Simulation root, velocities, contacts -------------------------------------------------
+
+// How joint 0, the simulation root, is derived from the hips.
+struct SimulationRootOptions {
+  // The hips' bone-local axis that points forward; the Bandai hips' local +Z does.
+  glm::vec3 hips_forward_axis{0.0f, 0.0f, 1.0f};
+  // Standard deviation in seconds of the centred Gaussian that smooths the facing direction
+  // vectors (window +-3 sigma, shrunk at the clip ends). 0.3 s brings the hips' +-5..9 degree
+  // swing of a walk (about 1.2 s per stride) down to about a third, and a run's to almost
+  // nothing, while a 90 degree turn over 1.5 s keeps its shape. 0 disables smoothing.
+  float facing_smoothing = 0.3f;
+  // The same for the ground position; 0 (the default) keeps exactly the hips projected to the
+  // ground, including the hips' +-3 cm sideways sway.
+  float position_smoothing = 0.0f;
+};
+
+// How foot contacts are detected. A foot is in contact on a frame when its toe joint is low and
+// slow, or its foot (ankle) joint is low and slow (speeds are 3D, in world space, by central
+// differences). Defaults come from the Bandai data: planted toes sit at 0.042-0.046 m and
+// planted ankles at 0.117-0.125 m above y = 0, planted joints move under 0.3 m/s while a
+// swinging foot of a walk moves at 1-4 m/s.
+struct ContactOptions {
+  float toe_height = 0.06f;   // metres above y = 0
+  float foot_height = 0.15f;  // metres above y = 0
+  float speed = 0.6f;         // metres per second
+  // Width in seconds of the majority (median) filter that removes one-frame flickers; it is
+  // rounded to an odd number of frames (0.1 s at 30 Hz: 3 frames). 0 disables the filter.
+  float filter_window = 0.1f;
+};
+
+// Everything preprocess_clip needs besides the clip.
+struct PreprocessOptions {
+  SimulationRootOptions root;
+  ContactOptions contacts;
+};
+
+// The name of the joint preprocess_clip inserts in front of the source skeleton.
+inline constexpr const char* kSimulationJointName = "Simulation";
+
+// The database skeleton of a source skeleton: a new root joint 0 named "Simulation" (identity
+// rest) followed by the source joints, whose roots become its children. Fails when the source
+// already has a joint with that name.
+Result<Skeleton> add_simulation_root(const Skeleton& source);
+
+// One preprocessed clip in database layout: joint 0 is the simulation root, joints 1.. are the
+// source joints; arrays are frame-major ([frame * joint_count + joint]).
+struct ProcessedClip {
+  std::string name;         // clip name ("<stem>_mirror" for mirrored copies)
+  std::string source_path;  // the file it came from
+  bool mirrored = false;
+  int frame_count = 0;
+  int joint_count = 0;  // source joints + 1
+  float frame_time = 1.0f / 30.0f;
+  std::vector<glm::vec3> local_positions;           // metres
+  std::vector<glm::quat> local_rotations;           // unit
+  std::vector<glm::vec3> local_velocities;          // metres / second, parent frame
+  std::vector<glm::vec3> local_angular_velocities;  // radians / second, parent frame
+  std::vector<uint8_t> contacts;                    // [frame * 2 + 0] left, + 1 right
+};
+
+// Buffers preprocess_clip reuses between clips so that its per-frame loops do not allocate.
+struct PreprocessScratch {
+  std::vector<Transform> globals;  // frames * source joints
+  std::vector<glm::vec3> directions;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> smoothed;
+  std::vector<float> weights;
+  std::vector<uint8_t> raw_contacts;
+};
+
+// Preprocesses one clip already at the database rate. `roles` are indices into the clip's own
+// (source) skeleton, from find_joint_roles.
+//
+// - Simulation root (joint 0): position = the global hips position projected to y = 0
+//   (optionally smoothed); rotation = the yaw-only facing of the hips' forward axis projected on
+//   the ground and smoothed (see SimulationRootOptions). Its local +Z is the facing.
+// - Source root joints: local = inverse(simulation global) * original global, so globals are
+//   unchanged (joint_Root's own translation, present in some takes, is kept). Other joints keep
+//   their locals. Scales are dropped (the database stores rigid transforms).
+// - Velocities by finite differences of the locals (central inside the clip, one-sided at its
+//   ends); angular velocities = scaled angle axis of q[f+1] * conjugate(q[f-1]) / (2 dt) (the
+//   shortest path), a rotation vector in the PARENT's frame (for joint 0: the world).
+// - Contacts as described by ContactOptions.
+Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
+                       const PreprocessOptions& options, ProcessedClip& out,
+                       PreprocessScratch& scratch);
+
+// Finite-difference velocities and angular velocities of frame-major local positions and
+// rotations (frame_count * joint_count each) into the two output arrays of the same size:
+// central differences inside, one-sided at the ends, zero for a single frame.
+void compute_local_velocities(std::span<const glm::vec3> positions,
+                              std::span<const glm::quat> rotations, int frame_count,
+                              int joint_count, float frame_time, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> angular_velocities);
+
+}  // namespace mm

@@ -1,0 +1,327 @@
+#include "mm/database/preprocess.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/pose.hpp"
+
+namespace mm {
+
+namespace {
+
+// The reflection of a global transform across the YZ plane (x -> -x). The rotation R becomes
+// S R S with S = diag(-1, 1, 1): the axis (x, y, z) turns into (-x, y, z) and the angle changes
+// sign, which as a quaternion is (w, x, -y, -z).
+Transform reflect_x(const Transform& t) {
+  Transform out = t;
+  out.translation.x = -t.translation.x;
+  out.rotation = glm::quat(t.rotation.w, t.rotation.x, -t.rotation.y, -t.rotation.z);
+  return out;
+}
+
+// Gaussian-weighted local linear fit of `in` at every frame (window +-3 sigma frames, cut at
+// the clip ends). Inside the clip the window is symmetric and this is a plain normalized
+// Gaussian filter; where the window is cut the linear term removes the lag a cut filter adds.
+void smooth_gaussian_linear(std::span<const glm::vec3> in, float sigma_frames,
+                            std::span<glm::vec3> out, std::vector<float>& weights) {
+  const int n = static_cast<int>(in.size());
+  if (sigma_frames < 0.5f || n < 3) {
+    std::copy(in.begin(), in.end(), out.begin());
+    return;
+  }
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0f * sigma_frames)));
+  weights.resize(radius + 1);
+  for (int k = 0; k <= radius; ++k) {
+    weights[k] = std::exp(-0.5f * static_cast<float>(k * k) / (sigma_frames * sigma_frames));
+  }
+  for (int f = 0; f < n; ++f) {
+    const int lo = std::max(0, f - radius);
+    const int hi = std::min(n - 1, f + radius);
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    glm::dvec3 t0(0.0), t1(0.0);
+    for (int i = lo; i <= hi; ++i) {
+      const int k = i - f;
+      const double w = weights[std::abs(k)];
+      s0 += w;
+      s1 += w * k;
+      s2 += w * k * k;
+      t0 += w * glm::dvec3(in[i]);
+      t1 += (w * k) * glm::dvec3(in[i]);
+    }
+    const double det = s0 * s2 - s1 * s1;
+    out[f] = std::abs(s1) < 1e-9 || det <= 1e-12 ? glm::vec3(t0 / s0)
+                                                 : glm::vec3((s2 * t0 - s1 * t1) / det);
+  }
+}
+
+// Replaces each run of contact values by the majority of its neighbourhood (width frames,
+// odd), so single-frame flickers vanish. Near the clip ends the window is cut; a tie keeps the
+// frame's own value.
+void majority_filter(std::span<const uint8_t> in, int width, int stride, int offset,
+                     std::span<uint8_t> out) {
+  const int n = static_cast<int>(in.size());
+  const int half = width / 2;
+  for (int f = 0; f < n; ++f) {
+    const int lo = std::max(0, f - half);
+    const int hi = std::min(n - 1, f + half);
+    int ones = 0;
+    for (int i = lo; i <= hi; ++i) ones += in[i];
+    const int total = hi - lo + 1;
+    const uint8_t value = 2 * ones > total ? 1 : (2 * ones < total ? 0 : in[f]);
+    out[static_cast<size_t>(f) * stride + offset] = value;
+  }
+}
+
+}  // namespace
+
+Clip mirror_clip(const Clip& clip, std::span<const int> joint_map) {
+  const int joints = clip.joint_count();
+  assert(static_cast<int>(joint_map.size()) == joints);
+  Clip out;
+  out.name = clip.name + "_mirror";
+  out.source_path = clip.source_path;
+  out.skeleton = clip.skeleton;
+  out.frame_time = clip.frame_time;
+  out.frame_count = clip.frame_count;
+  out.local.resize(clip.local.size());
+  const std::vector<int>& parents = clip.skeleton.parents();
+  std::vector<Transform> global(joints), mirrored(joints);
+  for (int f = 0; f < clip.frame_count; ++f) {
+    forward_kinematics(parents, clip.pose(f), global);
+    for (int j = 0; j < joints; ++j) mirrored[j] = reflect_x(global[joint_map[j]]);
+    std::span<Transform> local = out.pose(f);
+    for (int j = 0; j < joints; ++j) {
+      const int p = parents[j];
+      local[j] = p < 0 ? mirrored[j] : compose(inverse(mirrored[p]), mirrored[j]);
+      local[j].rotation = glm::normalize(local[j].rotation);
+      local[j].scale = clip.pose(f)[joint_map[j]].scale;
+    }
+  }
+  return out;
+}
+
+bool needs_resampling(const Clip& clip, float rate) {
+  return std::abs(clip.frame_time * rate - 1.0f) > 1e-3f;
+}
+
+Clip resample_clip(const Clip& clip, float rate) {
+  Clip out;
+  out.name = clip.name;
+  out.source_path = clip.source_path;
+  out.skeleton = clip.skeleton;
+  out.frame_time = 1.0f / rate;
+  if (!needs_resampling(clip, rate)) {
+    out.frame_count = clip.frame_count;
+    out.local = clip.local;
+    return out;
+  }
+  const int joints = clip.joint_count();
+  const double duration = static_cast<double>(clip.frame_count - 1) * clip.frame_time;
+  out.frame_count = clip.frame_count <= 1
+                        ? clip.frame_count
+                        : static_cast<int>(std::floor(duration * rate + 1e-3)) + 1;
+  out.local.resize(static_cast<size_t>(out.frame_count) * joints);
+  for (int f = 0; f < out.frame_count; ++f) {
+    const float time = static_cast<float>(static_cast<double>(f) / rate);
+    sample_pose(clip.local, joints, clip.frame_time, std::min(time, static_cast<float>(duration)),
+                InterpolationMethod::Slerp, WrapMode::Clamp, out.pose(f));
+  }
+  return out;
+}
+
+Result<Skeleton> add_simulation_root(const Skeleton& source) {
+  if (source.find(kSimulationJointName) >= 0) {
+    return Error{std::string("the source skeleton already has a joint named '") +
+                 kSimulationJointName + "', the name of the simulation root the builder inserts"};
+  }
+  const int count = source.joint_count();
+  std::vector<std::string> names;
+  std::vector<int> parents;
+  std::vector<Transform> rest;
+  names.reserve(count + 1);
+  parents.reserve(count + 1);
+  rest.reserve(count + 1);
+  names.emplace_back(kSimulationJointName);
+  parents.push_back(-1);
+  rest.push_back(Transform::identity());
+  for (int j = 0; j < count; ++j) {
+    names.push_back(source.name(j));
+    parents.push_back(source.parent(j) < 0 ? 0 : source.parent(j) + 1);
+    rest.push_back(source.rest(j));
+  }
+  return Skeleton::create(std::move(names), std::move(parents), std::move(rest));
+}
+
+void compute_local_velocities(std::span<const glm::vec3> positions,
+                              std::span<const glm::quat> rotations, int frame_count,
+                              int joint_count, float frame_time, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> angular_velocities) {
+  const size_t joints = static_cast<size_t>(joint_count);
+  assert(positions.size() == static_cast<size_t>(frame_count) * joints);
+  assert(rotations.size() == positions.size() && velocities.size() == positions.size() &&
+         angular_velocities.size() == positions.size());
+  for (int f = 0; f < frame_count; ++f) {
+    const int a = std::max(0, f - 1);
+    const int b = std::min(frame_count - 1, f + 1);
+    const size_t out = static_cast<size_t>(f) * joints;
+    if (a == b) {
+      std::fill_n(velocities.begin() + out, joints, glm::vec3(0.0f));
+      std::fill_n(angular_velocities.begin() + out, joints, glm::vec3(0.0f));
+      continue;
+    }
+    const float inv_dt = 1.0f / (static_cast<float>(b - a) * frame_time);
+    const size_t ia = static_cast<size_t>(a) * joints;
+    const size_t ib = static_cast<size_t>(b) * joints;
+    for (size_t j = 0; j < joints; ++j) {
+      velocities[out + j] = (positions[ib + j] - positions[ia + j]) * inv_dt;
+      angular_velocities[out + j] =
+          quat_to_scaled_angle_axis(rotations[ib + j] * glm::conjugate(rotations[ia + j])) * inv_dt;
+    }
+  }
+}
+
+Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
+                       const PreprocessOptions& options, ProcessedClip& out,
+                       PreprocessScratch& scratch) {
+  const int joints = clip.joint_count();
+  const int frames = clip.frame_count;
+  const float dt = clip.frame_time;
+  const std::string where = "clip '" + clip.name + "': ";
+  if (frames <= 0 || joints <= 0 || clip.local.size() != static_cast<size_t>(frames) * joints) {
+    return Error{where + "no frames, no joints or a wrong number of local transforms"};
+  }
+  for (const int j : {roles.hips, roles.left_foot, roles.right_foot}) {
+    if (j < 0 || j >= joints) return Error{where + "the hips and feet roles must name joints"};
+  }
+  for (const int j : {roles.left_toe, roles.right_toe}) {
+    if (j >= joints) return Error{where + "a toe role is out of range"};
+  }
+  const glm::vec3 axis = options.root.hips_forward_axis;
+  if (!(glm::length(axis) > 1e-6f) || !std::isfinite(glm::length(axis))) {
+    return Error{where + "the hips forward axis must be a finite, non-zero vector"};
+  }
+
+  // Global transforms of every frame (FK), needed for the root, the contacts and the roots'
+  // new locals.
+  const std::vector<int>& parents = clip.skeleton.parents();
+  scratch.globals.resize(static_cast<size_t>(frames) * joints);
+  for (int f = 0; f < frames; ++f) {
+    forward_kinematics(parents, clip.pose(f),
+                       std::span(scratch.globals).subspan(static_cast<size_t>(f) * joints, joints));
+  }
+  auto global = [&](int f, int j) -> const Transform& {
+    return scratch.globals[static_cast<size_t>(f) * joints + j];
+  };
+
+  // Facing: the hips' forward axis on the ground plane. A frame whose axis points straight up
+  // or down has no facing and borrows its nearest neighbour's.
+  scratch.directions.resize(frames);
+  scratch.positions.resize(frames);
+  scratch.smoothed.resize(frames);
+  int first_valid = -1;
+  for (int f = 0; f < frames; ++f) {
+    glm::vec3 d = global(f, roles.hips).rotation * axis;
+    d.y = 0.0f;
+    const float length = glm::length(d);
+    scratch.directions[f] = length > 1e-4f ? d / length : glm::vec3(0.0f);
+    if (length > 1e-4f && first_valid < 0) first_valid = f;
+    glm::vec3 p = global(f, roles.hips).translation;
+    p.y = 0.0f;
+    scratch.positions[f] = p;
+  }
+  const glm::vec3 fallback =
+      first_valid >= 0 ? scratch.directions[first_valid] : glm::vec3(0.0f, 0.0f, 1.0f);
+  for (int f = 0; f < frames; ++f) {
+    if (scratch.directions[f] == glm::vec3(0.0f)) {
+      scratch.directions[f] = f > 0 ? scratch.directions[f - 1] : fallback;
+    }
+  }
+
+  const int out_joints = joints + 1;
+  const size_t values = static_cast<size_t>(frames) * out_joints;
+  out.name = clip.name;
+  out.source_path = clip.source_path;
+  out.frame_count = frames;
+  out.joint_count = out_joints;
+  out.frame_time = dt;
+  out.local_positions.resize(values);
+  out.local_rotations.resize(values);
+  out.local_velocities.resize(values);
+  out.local_angular_velocities.resize(values);
+  out.contacts.resize(static_cast<size_t>(frames) * 2);
+
+  // Joint 0 positions (smoothed or not) go straight into the output.
+  smooth_gaussian_linear(scratch.positions, options.root.position_smoothing / dt, scratch.smoothed,
+                         scratch.weights);
+  for (int f = 0; f < frames; ++f) {
+    glm::vec3 p = scratch.smoothed[f];
+    p.y = 0.0f;
+    out.local_positions[static_cast<size_t>(f) * out_joints] = p;
+  }
+  smooth_gaussian_linear(scratch.directions, options.root.facing_smoothing / dt, scratch.smoothed,
+                         scratch.weights);
+
+  for (int f = 0; f < frames; ++f) {
+    glm::vec3 d = scratch.smoothed[f];
+    d.y = 0.0f;
+    // Opposite directions inside one window can cancel; the raw direction is then the answer.
+    if (glm::length(d) < 1e-3f) d = scratch.directions[f];
+    const float yaw = std::atan2(d.x, d.z);
+    const glm::quat facing(std::cos(0.5f * yaw), 0.0f, std::sin(0.5f * yaw), 0.0f);
+    const size_t base = static_cast<size_t>(f) * out_joints;
+    out.local_rotations[base] = facing;
+    Transform simulation;
+    simulation.rotation = facing;
+    simulation.translation = out.local_positions[base];
+    const Transform to_simulation = inverse(simulation);
+    const std::span<const Transform> pose = clip.pose(f);
+    for (int j = 0; j < joints; ++j) {
+      Transform t = parents[j] < 0 ? compose(to_simulation, global(f, j)) : pose[j];
+      out.local_positions[base + 1 + j] = t.translation;
+      out.local_rotations[base + 1 + j] = glm::normalize(t.rotation);
+    }
+  }
+
+  compute_local_velocities(out.local_positions, out.local_rotations, frames, out_joints, dt,
+                           out.local_velocities, out.local_angular_velocities);
+
+  // Contacts: low and slow toe, or low and slow foot.
+  const ContactOptions& c = options.contacts;
+  scratch.raw_contacts.resize(static_cast<size_t>(frames) * 2);
+  auto speed = [&](int f, int j) {
+    const int a = std::max(0, f - 1);
+    const int b = std::min(frames - 1, f + 1);
+    if (a == b) return 0.0f;
+    return glm::length(global(b, j).translation - global(a, j).translation) /
+           (static_cast<float>(b - a) * dt);
+  };
+  auto low_and_slow = [&](int f, int j, float height) {
+    return j >= 0 && global(f, j).translation.y < height && speed(f, j) < c.speed;
+  };
+  const int feet[2] = {roles.left_foot, roles.right_foot};
+  const int toes[2] = {roles.left_toe, roles.right_toe};
+  for (int f = 0; f < frames; ++f) {
+    for (int side = 0; side < 2; ++side) {
+      scratch.raw_contacts[static_cast<size_t>(side) * frames + f] =
+          (low_and_slow(f, toes[side], c.toe_height) || low_and_slow(f, feet[side], c.foot_height))
+              ? 1
+              : 0;
+    }
+  }
+  int width = static_cast<int>(std::lround(c.filter_window / dt));
+  if (width % 2 == 0) width += 1;
+  for (int side = 0; side < 2; ++side) {
+    const std::span<const uint8_t> raw = std::span<const uint8_t>(scratch.raw_contacts)
+                                             .subspan(static_cast<size_t>(side) * frames, frames);
+    if (width <= 1 || !(c.filter_window > 0.0f)) {
+      for (int f = 0; f < frames; ++f) out.contacts[static_cast<size_t>(f) * 2 + side] = raw[f];
+    } else {
+      majority_filter(raw, width, 2, side, out.contacts);
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace mm
