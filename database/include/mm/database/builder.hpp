@@ -1,0 +1,105 @@
+#pragma once
+// The database builder: files (or in-memory clips) in, one Database out.
+//
+// Per input, in parallel (workers pull inputs from a shared counter, each with its own reusable
+// buffers): import (BVH or glTF), validate, resample to the database rate, find the joint
+// roles, preprocess (simulation root, velocities, contacts; see preprocess.hpp), extract the raw
+// features of the clip (feature_extraction.hpp), optionally the same for its mirrored copy, and
+// tag it (tags.hpp). Then, in input order: check that every clip has the first clip's topology,
+// concatenate the clips into the flat arrays, normalize the features over the searchable frames
+// of the whole database, and validate the result. Every per-clip step is independent of the
+// others and the statistics are summed in a fixed order, so the output is byte-for-byte the
+// same whatever the number of threads.
+//
+// Inputs are files or folders. Folders are scanned recursively for .bvh, .gltf and .glb files
+// (extensions compared case-insensitively), sorted by path; files given by name are taken in
+// the given order, whatever their extension (".gltf"/".glb" are read as glTF, anything else as
+// BVH). A path given twice is read once. Clips appear in the database in input order, a
+// glTF file's animations in file order, and a clip's mirrored copy right after it.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "mm/database/bvh.hpp"
+#include "mm/database/clip.hpp"
+#include "mm/database/database.hpp"
+#include "mm/database/features.hpp"
+#include "mm/database/preprocess.hpp"
+#include "mm/database/tags.hpp"
+#include "mm/runtime/result.hpp"
+
+namespace mm {
+
+// Everything the builder can be told.
+struct BuildOptions {
+  // Database frames per second; every clip is resampled to it. Finite, in (0, 1000].
+  float rate = 30.0f;
+  // Adds a mirrored copy of every clip (named "<name>_mirror", tagged "mirrored").
+  bool mirror = false;
+  // Left/right joint pairs that override the name-pattern detection when mirroring.
+  std::vector<MirrorPair> mirror_pairs;
+  // Optional tag manifest (see tags.hpp); empty for none.
+  std::filesystem::path tags_file;
+  // Tag rules applied in addition to the manifest's (for programs that build in memory).
+  std::vector<TagRule> tag_rules;
+  // Which joints are the hips, feet, toes and head.
+  JointRoles roles;
+  // How the simulation root (joint 0) is derived.
+  SimulationRootOptions root;
+  // How foot contacts are detected.
+  ContactOptions contacts;
+  // The feature channels of the database.
+  FeatureSchema schema = FeatureSchema::default_schema();
+  // Refuse bad inputs (listed in the report) and build from the rest, instead of failing.
+  bool skip_bad = false;
+  // Worker threads; 0 uses every hardware thread. Never more than there are inputs.
+  int threads = 0;
+  // Called after each input is done (done, total), from the worker threads but never two at a
+  // time. May be empty.
+  std::function<void(size_t done, size_t total)> progress;
+  // Settings of the BVH importer (its scale turns file units into metres).
+  BvhOptions bvh;
+};
+
+// An input the builder refused, and why.
+struct RefusedInput {
+  std::filesystem::path path;  // the file (or "<clip name>" for in-memory clips)
+  std::string message;         // what was wrong, naming the file
+};
+
+// What happened during a build.
+struct BuildReport {
+  int inputs = 0;                     // files (or in-memory clips) offered
+  int clips = 0;                      // clips in the database (mirrored copies included)
+  int frames = 0;                     // database frames
+  int searchable_frames = 0;          // frames the search may return
+  double duration_s = 0.0;            // frames / rate
+  uint64_t bytes_read = 0;            // bytes of the files that were read
+  int threads = 0;                    // worker threads used
+  double load_seconds = 0.0;          // wall time of import + preprocessing + raw features
+  double assemble_seconds = 0.0;      // wall time of concatenation, normalization, validation
+  double total_seconds = 0.0;         // wall time of the whole build
+  std::vector<std::string> warnings;  // e.g. feature channels that do not vary
+  std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)
+};
+
+// The files a list of inputs stands for (see the top of this file). Fails on a path that does
+// not exist or when no file is found.
+Result<std::vector<std::filesystem::path>> collect_input_files(
+    std::span<const std::filesystem::path> inputs);
+
+// Builds a database from files and folders. On failure the message names the file and what was
+// wrong with it. `report` may be null.
+Result<Database> build_database(std::span<const std::filesystem::path> inputs,
+                                const BuildOptions& options, BuildReport* report = nullptr);
+
+// Builds a database from clips already in memory (any frame time; resampled to options.rate).
+// Clip names stand in for file names in messages and tags.
+Result<Database> build_database_from_clips(std::span<const Clip> clips, const BuildOptions& options,
+                                           BuildReport* report = nullptr);
+
+}  // namespace mm
