@@ -373,6 +373,12 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
       append(db.local_angular_velocities, clip.motion.local_angular_velocities);
       append(db.contacts, clip.motion.contacts);
       append(db.features, clip.raw_features);
+      if (std::find(clip.searchable.begin(), clip.searchable.end(), uint8_t{1}) ==
+          clip.searchable.end()) {
+        rep.warnings.push_back("clip '" + range.name + "' (" + std::to_string(range.frame_count()) +
+                               " frames) is shorter than the feature times need: none of its "
+                               "frames can be matched (it can still be played into)");
+      }
       append(db.searchable, clip.searchable);
       db.frame_clip.insert(db.frame_clip.end(), static_cast<size_t>(range.frame_count()),
                            static_cast<int>(db.clips.size()));

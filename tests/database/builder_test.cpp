@@ -490,6 +490,18 @@ TEST(BuilderOptions, InMemoryClipsAndSingleClipWarnings) {
   for (float x : db->features) ASSERT_TRUE(std::isfinite(x));
 }
 
+TEST(BuilderOptions, ClipsTooShortToMatchAreReported) {
+  // The normal-style set-1 dash has 20 frames, less than the 1 s the trajectory needs.
+  const fs::path inputs[] = {test::clip_path("dataset-1_dash_normal_001"),
+                             test::clip_path("dataset-1_walk_normal_001")};
+  BuildReport report;
+  Result<Database> db = build_database(inputs, BuildOptions{}, &report);
+  ASSERT_TRUE(db) << db.message();
+  ASSERT_EQ(report.warnings.size(), 1u);
+  EXPECT_NE(report.warnings[0].find("dataset-1_dash_normal_001"), std::string::npos);
+  EXPECT_EQ(report.searchable_frames, db->clips[1].frame_count() - 30);
+}
+
 // ---- End to end --------------------------------------------------------------------------------
 
 TEST(BuilderEndToEnd, BuildSaveLoadAndRecomputeTheSameFeatures) {

@@ -1,0 +1,171 @@
+// `mm build`: makes a database file from BVH / glTF files and folders, with a progress bar and
+// a summary.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+#include "database_summary.hpp"
+#include "mm/database/builder.hpp"
+#include "mm/database/database_file.hpp"
+
+namespace mm::cli {
+namespace {
+
+const char* const kUsage = R"(usage: mm build <files or folders...> -o <out.mmdb> [options]
+
+Builds a motion database: every clip is resampled, given a simulation root (joint 0),
+velocities, foot contacts and tags, and the feature matrix is extracted and normalized.
+Folders are scanned recursively for .bvh, .gltf and .glb files (sorted by path).
+
+options:
+  -o, --output FILE   the database file to write (required)
+  --rate HZ           database frame rate (default 30)
+  --mirror            also add a left/right mirrored copy of every clip (tagged "mirrored")
+  --tags FILE         tag manifest: lines "<glob> <tag> <tag> ..." matched against clip
+                      names; '#' starts a comment (tags from Bandai file names are automatic)
+  --skip-bad          build from the good files and list the refused ones, instead of failing
+  --threads N         worker threads (default 0: all hardware threads)
+  --scale S           BVH units to metres (default 0.01: centimetres)
+  --quiet             no progress and no summary
+  -h, --help          this text
+
+exit status: 0 built, 1 bad input (the message names the file), 2 bad usage
+)";
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "mm build: %s\n\n%s", message.c_str(), kUsage);
+  return 2;
+}
+
+// Draws a progress bar on a terminal, or prints a plain line every 10 % otherwise.
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled), terminal_(isatty(fileno(stderr)) != 0) {}
+  void update(size_t done, size_t total) {
+    if (!enabled_ || total == 0) return;
+    if (terminal_) {
+      const int width = 40;
+      const int filled = static_cast<int>(width * done / total);
+      std::fprintf(stderr, "\r[%s%s] %zu/%zu files", std::string(filled, '#').c_str(),
+                   std::string(width - filled, '.').c_str(), done, total);
+      if (done == total) std::fprintf(stderr, "\n");
+      std::fflush(stderr);
+    } else {
+      const size_t decile = done * 10 / total;
+      if (decile > last_decile_ || done == total) {
+        last_decile_ = decile;
+        std::fprintf(stderr, "mm build: %zu/%zu files\n", done, total);
+      }
+    }
+  }
+
+ private:
+  bool enabled_;
+  bool terminal_;
+  size_t last_decile_ = 0;
+};
+
+int run_build(const std::vector<std::string>& args) {
+  std::vector<std::filesystem::path> inputs;
+  std::string output;
+  BuildOptions options;
+  bool quiet = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    // The value after an option, or null when the arguments end.
+    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "-o" || a == "--output") {
+      const std::string* v = value();
+      if (!v) return usage_error(a + " needs a file name");
+      output = *v;
+    } else if (a == "--rate") {
+      const std::string* v = value();
+      const std::optional<double> rate = v ? parse_number(*v) : std::nullopt;
+      if (!rate || *rate <= 0.0 || *rate > 1000.0) {
+        return usage_error("--rate needs a frame rate in (0, 1000] Hz");
+      }
+      options.rate = static_cast<float>(*rate);
+    } else if (a == "--mirror") {
+      options.mirror = true;
+    } else if (a == "--tags") {
+      const std::string* v = value();
+      if (!v) return usage_error("--tags needs a file name");
+      options.tags_file = *v;
+    } else if (a == "--skip-bad") {
+      options.skip_bad = true;
+    } else if (a == "--threads") {
+      const std::string* v = value();
+      const std::optional<long long> n = v ? parse_count(*v) : std::nullopt;
+      if (!n || *n > 256) return usage_error("--threads needs a count from 0 to 256");
+      options.threads = static_cast<int>(*n);
+    } else if (a == "--scale") {
+      const std::string* v = value();
+      const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
+      if (!s || *s <= 0.0) return usage_error("--scale needs a positive number");
+      options.bvh.scale = static_cast<float>(*s);
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error("unknown option '" + a + "'");
+    } else {
+      inputs.emplace_back(a);
+    }
+  }
+  if (inputs.empty()) return usage_error("no input files or folders");
+  if (output.empty()) return usage_error("no output file (-o <out.mmdb>)");
+
+  const auto start = std::chrono::steady_clock::now();
+  Progress progress(!quiet);
+  options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
+  BuildReport report;
+  Result<Database> db = build_database(inputs, options, &report);
+  if (!db) {
+    std::fprintf(stderr, "mm build: %s\n", db.message().c_str());
+    return 1;
+  }
+  if (Status s = save_database(*db, output); !s) {
+    std::fprintf(stderr, "mm build: %s\n", s.message().c_str());
+    return 1;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  for (const std::string& w : report.warnings)
+    std::fprintf(stderr, "mm build: warning: %s\n", w.c_str());
+  if (!report.refused.empty()) {
+    std::fprintf(stderr, "mm build: refused %zu of %d files:\n", report.refused.size(),
+                 report.inputs);
+    for (const RefusedInput& r : report.refused) {
+      std::fprintf(stderr, "  %s\n    %s\n", r.path.string().c_str(), r.message.c_str());
+    }
+  }
+  if (!quiet) {
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(output, ec);
+    std::printf("wrote %s\n", output.c_str());
+    std::printf("input:       %d files, %s read, %d refused\n", report.inputs,
+                human_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
+    print_database_summary(stdout, *db, ec ? 0 : static_cast<uint64_t>(size));
+    std::printf(
+        "time:        %.2f s (import and preprocessing %.2f s on %d threads, assembly "
+        "%.2f s, writing %.2f s)\n",
+        seconds, report.load_seconds, report.threads, report.assemble_seconds,
+        seconds - report.total_seconds);
+  }
+  return 0;
+}
+
+const bool registered = register_command(
+    {"build", "make a motion database from BVH/glTF files and folders", &run_build});
+
+}  // namespace
+}  // namespace mm::cli

@@ -1,0 +1,160 @@
+#include "database_summary.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace mm::cli {
+
+namespace {
+
+const char* kind_name(FeatureKind kind) {
+  switch (kind) {
+    case FeatureKind::BonePosition:
+      return "bone-position";
+    case FeatureKind::BoneVelocity:
+      return "bone-velocity";
+    case FeatureKind::TrajectoryPosition:
+      return "trajectory-position";
+    case FeatureKind::TrajectoryDirection:
+      return "trajectory-direction";
+    case FeatureKind::BoneDirection:
+      return "bone-direction";
+  }
+  return "unknown";
+}
+
+std::string role_name(const Database& db, int joint) {
+  return joint >= 0 && joint < db.joint_count() ? db.skeleton.name(joint) : std::string("-");
+}
+
+}  // namespace
+
+std::optional<double> parse_number(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  if (errno != 0 || end != text.c_str() + text.size() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+std::optional<long long> parse_count(const std::string& text) {
+  if (text.empty() ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return std::nullopt;
+  }
+  char* end = nullptr;
+  errno = 0;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (errno != 0 || end != text.c_str() + text.size()) return std::nullopt;
+  return value;
+}
+
+std::string human_bytes(uint64_t bytes) {
+  char buffer[32];
+  if (bytes >= 1000000) {
+    std::snprintf(buffer, sizeof buffer, "%.1f MB", bytes / 1e6);
+  } else if (bytes >= 1000) {
+    std::snprintf(buffer, sizeof buffer, "%.1f KB", bytes / 1e3);
+  } else {
+    std::snprintf(buffer, sizeof buffer, "%llu B", static_cast<unsigned long long>(bytes));
+  }
+  return buffer;
+}
+
+void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes) {
+  int mirrored = 0;
+  for (const ClipRange& c : db.clips) mirrored += c.mirrored ? 1 : 0;
+  const long long searchable = std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1});
+  const double rate = db.frame_time > 0.0f ? 1.0 / db.frame_time : 0.0;
+  std::fprintf(out, "clips:       %zu", db.clips.size());
+  if (mirrored) std::fprintf(out, " (%d of them mirrored)", mirrored);
+  std::fprintf(out, "\nframes:      %d at %.4g Hz (%.1f s, %.1f min)\n", db.frame_count, rate,
+               db.frame_count * static_cast<double>(db.frame_time),
+               db.frame_count * static_cast<double>(db.frame_time) / 60.0);
+  std::fprintf(out, "searchable:  %lld frames (%.1f %%)\n", searchable,
+               db.frame_count ? 100.0 * searchable / db.frame_count : 0.0);
+  std::fprintf(
+      out, "joints:      %d (joint 0 '%s'); roles: hips %s, feet %s / %s, toes %s / %s, head %s\n",
+      db.joint_count(), db.joint_count() ? db.skeleton.name(0).c_str() : "-",
+      role_name(db, db.roles.hips).c_str(), role_name(db, db.roles.left_foot).c_str(),
+      role_name(db, db.roles.right_foot).c_str(), role_name(db, db.roles.left_toe).c_str(),
+      role_name(db, db.roles.right_toe).c_str(), role_name(db, db.roles.head).c_str());
+  std::fprintf(out, "features:    %d dimensions in %zu channels:", db.feature_dims(),
+               db.schema.channels.size());
+  for (const FeatureChannel& c : db.schema.channels) std::fprintf(out, " %s", c.name.c_str());
+  std::fprintf(out, "\ntags:        %zu\n", db.tag_names.size());
+  for (size_t t = 0; t < db.tag_names.size() && t < 64; ++t) {
+    int clips = 0;
+    long long frames = 0;
+    for (const ClipRange& c : db.clips) {
+      if (c.tags & (uint64_t{1} << t)) {
+        ++clips;
+        frames += c.frame_count();
+      }
+    }
+    std::fprintf(out, "  %-24s %5d clips %8lld frames\n", db.tag_names[t].c_str(), clips, frames);
+  }
+  if (file_bytes > 0) std::fprintf(out, "file size:   %s\n", human_bytes(file_bytes).c_str());
+}
+
+void print_feature_statistics(FILE* out, const Database& db) {
+  // Per-column deviations from the stored (normalized) matrix over the searchable frames,
+  // scaled back to feature units.
+  const int dims = db.feature_dims();
+  std::vector<double> sum(dims, 0.0), sum_squares(dims, 0.0);
+  long long rows = 0;
+  for (int f = 0; f < db.frame_count; ++f) {
+    if (!db.searchable[f]) continue;
+    ++rows;
+    const float* row = db.features.data() + static_cast<size_t>(f) * dims;
+    for (int c = 0; c < dims; ++c) {
+      sum[c] += row[c];
+      sum_squares[c] += static_cast<double>(row[c]) * row[c];
+    }
+  }
+  std::fprintf(out,
+               "feature statistics over the %lld searchable frames (group std = the channel's "
+               "normalization deviation = scale * weight):\n",
+               rows);
+  for (size_t i = 0; i < db.schema.channels.size(); ++i) {
+    const FeatureChannel& c = db.schema.channels[i];
+    const int first = db.schema.offset(static_cast<int>(i));
+    std::string source;
+    if (c.kind == FeatureKind::TrajectoryPosition || c.kind == FeatureKind::TrajectoryDirection) {
+      source = "times";
+      for (float t : c.times) {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, " %g", t);
+        source += buffer;
+      }
+      source += " s";
+    } else {
+      source = "bone " + c.bone;
+    }
+    const double group_std = static_cast<double>(db.feature_scale[first]) * c.weight;
+    std::fprintf(out, "  %-22s %-20s %-24s columns %2d-%2d  weight %-5g group std %.4f\n",
+                 c.name.c_str(), kind_name(c.kind), source.c_str(), first, first + c.dims() - 1,
+                 c.weight, group_std);
+    std::fprintf(out, "      mean:");
+    for (int k = first; k < first + c.dims(); ++k)
+      std::fprintf(out, " %8.4f", db.feature_offset[k]);
+    std::fprintf(out, "\n      std: ");
+    for (int k = first; k < first + c.dims(); ++k) {
+      double column_std = 0.0;
+      if (rows > 0) {
+        const double mean = sum[k] / rows;
+        column_std =
+            std::sqrt(std::max(0.0, sum_squares[k] / rows - mean * mean)) * db.feature_scale[k];
+      }
+      std::fprintf(out, " %8.4f", column_std);
+    }
+    std::fprintf(out, "\n");
+  }
+}
+
+}  // namespace mm::cli

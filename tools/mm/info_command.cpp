@@ -1,0 +1,84 @@
+// `mm info`: the summary and feature statistics of an existing database file.
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "command.hpp"
+#include "database_summary.hpp"
+#include "mm/database/database_file.hpp"
+
+namespace mm::cli {
+namespace {
+
+const char* const kUsage = R"(usage: mm info <file.mmdb> [options]
+
+Loads a database file (checking its checksum and every array) and prints its clips, frames,
+joints, tags with counts, feature dimensions, searchable frames and file size, then the
+feature statistics per channel: name, kind, bone or times, columns, weight, and the mean and
+standard deviation per column.
+
+options:
+  --clips        also list every clip: index, frames, name, tags
+  -h, --help     this text
+
+exit status: 0 fine, 1 unreadable or corrupt file, 2 bad usage
+)";
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "mm info: %s\n\n%s", message.c_str(), kUsage);
+  return 2;
+}
+
+void print_clips(const Database& db) {
+  std::printf("clips:\n");
+  for (size_t c = 0; c < db.clips.size(); ++c) {
+    const ClipRange& clip = db.clips[c];
+    std::string tags;
+    for (size_t t = 0; t < db.tag_names.size() && t < 64; ++t) {
+      if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : " ") + db.tag_names[t];
+    }
+    std::printf("  %4zu  %6d frames  %-48s %s\n", c, clip.frame_count(), clip.name.c_str(),
+                tags.c_str());
+  }
+}
+
+int run_info(const std::vector<std::string>& args) {
+  std::string path;
+  bool list_clips = false;
+  for (const std::string& a : args) {
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--clips") {
+      list_clips = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error("unknown option '" + a + "'");
+    } else if (path.empty()) {
+      path = a;
+    } else {
+      return usage_error("one database file at a time (got '" + path + "' and '" + a + "')");
+    }
+  }
+  if (path.empty()) return usage_error("no database file");
+
+  Result<Database> db = load_database(path);
+  if (!db) {
+    std::fprintf(stderr, "mm info: %s\n", db.message().c_str());
+    return 1;
+  }
+  std::error_code ec;
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  std::printf("database:    %s (format version %u)\n", path.c_str(), kDatabaseFormatVersion);
+  print_database_summary(stdout, *db, ec ? 0 : static_cast<uint64_t>(size));
+  print_feature_statistics(stdout, *db);
+  if (list_clips) print_clips(*db);
+  return 0;
+}
+
+const bool registered =
+    register_command({"info", "summary and feature statistics of a database file", &run_info});
+
+}  // namespace
+}  // namespace mm::cli
