@@ -1,0 +1,95 @@
+#pragma once
+// glTF 2.0 import and export of skeletal animation (through tinygltf).
+//
+// Import (load_gltf) reads one skin of a .gltf (JSON, buffers embedded or in files next to it)
+// or .glb file and turns it into a Skeleton, its inverse bind matrices, and one Clip per
+// animation, sampled at a fixed rate:
+// - Joints: the skin's joints plus any non-joint node lying between two joints (so the
+//   hierarchy stays expressible), stored depth-first, parent before child, roots in the order
+//   their first joint appears in the skin, children in the nodes' child order. The ancestors
+//   of a skeleton root are not joints: their transforms (rest and animated) are folded into the
+//   root's local transform, so globals come out in scene space. Joint names are the node
+//   names; an empty or repeated name becomes "<name>_<node index>" ("node_<index>" if empty).
+// - Rest transforms come from the nodes' TRS (a "matrix" is decomposed into TRS).
+// - inverse_bind_matrices: the skin's, per skeleton joint (identity if the skin has none);
+//   for the inserted non-joint nodes, the inverse of their rest global transform.
+// - Animations: translation, rotation and scale channels with STEP, LINEAR (rotations: slerp
+//   along the shortest path) or CUBICSPLINE (Hermite with the in/out tangents scaled by the
+//   keyframe interval; rotations renormalized) samplers, sampled every 1 / sample_rate
+//   seconds from the earliest to the latest keyframe time of the channels that reach the
+//   skeleton (a tail shorter than one frame is dropped; a sample within a few float ulps of a
+//   key takes that key exactly, as float key times are rounded). Joints without a channel keep
+//   their node's rest TRS. Channels on nodes outside the skeleton and its roots' ancestors, and
+//   "weights" (morph target) channels, are ignored; an animation none of whose channels
+//   reaches the skeleton produces no clip. A clip is named after its animation; an unnamed
+//   one takes the file stem (plus "_<animation index>" when the file has several).
+// - Folding ancestors uses mm::compose, exact for rotations, translations and uniform scale; a
+//   non-uniform scale above a rotated root is approximated (glTF would need a sheared matrix).
+//   The skin's optional "skeleton" property is not needed and not read.
+// - Everything is validated (indices, accessor types and bounds, counts, finite values,
+//   increasing key times, the GLB container); an error names the file and what is wrong.
+//   Sparse accessors and images are not read (images are skipped, never decoded).
+//
+// Export (save_gltf) writes a pose sequence and its skeleton as a file Blender and other
+// importers open as an animated armature: one node per joint with its rest TRS, a skin over
+// all joints whose inverse bind matrices are the inverses of the rest globals, a one-triangle
+// mesh (1 cm, at the first joint's rest position, fully weighted to joint 0) so every
+// importer sees the skin, and one animation with a LINEAR translation and rotation channel per
+// joint (and a scale channel for joints whose scale leaves the rest scale), one key per frame.
+// ".glb" writes a binary file; ".gltf" writes one JSON file with the buffer embedded as base64.
+//
+// Units as everywhere in the project: metres, seconds, Y up, right-handed.
+
+#include <filesystem>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mm/database/clip.hpp"
+#include "mm/runtime/result.hpp"
+#include "mm/runtime/skeleton.hpp"
+#include "mm/runtime/transform.hpp"
+
+namespace mm {
+
+// Settings of the glTF importer.
+struct GltfImportOptions {
+  // Animations are resampled to this fixed rate (Hz); must be finite and > 0.
+  float sample_rate = 30.0f;
+  // Index of the skin (in the file's "skins" array) that defines the skeleton.
+  int skin = 0;
+};
+
+// What a glTF file holds for us: one skeleton and its animations.
+struct GltfAsset {
+  // The skin's joint hierarchy (see the header comment for which nodes become joints).
+  Skeleton skeleton;
+  // One matrix per skeleton joint (same order), mapping scene space to the joint's bind space.
+  std::vector<glm::mat4> inverse_bind_matrices;
+  // One clip per animation that moves the skeleton, in file order, sharing `skeleton`.
+  std::vector<Clip> clips;
+};
+
+// Reads a .gltf or .glb file (recognized by its content: binary files start with "glTF").
+Result<GltfAsset> load_gltf(const std::filesystem::path& path,
+                            const GltfImportOptions& options = {});
+
+// Parses a glTF file already in memory; path_for_messages names it in errors, becomes each
+// clip's source_path, and its folder is where external buffers are looked up.
+Result<GltfAsset> parse_gltf(std::span<const unsigned char> bytes,
+                             const std::filesystem::path& path_for_messages,
+                             const GltfImportOptions& options = {});
+
+// Writes a clip (skeleton, frames, frame time) as glTF; the format follows the extension of
+// `out` (".glb" binary, ".gltf" single JSON file). The animation is named after the clip.
+Status save_gltf(const Clip& clip, const std::filesystem::path& out);
+
+// Writes any pose sequence: frame_count poses of skeleton.joint_count() local transforms each,
+// frame-major (frames[f * joint_count + j]), frame_time seconds apart, as an animation named
+// `name`. The format follows the extension of `out` as above.
+Status save_gltf(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
+                 float frame_time, std::string_view name, const std::filesystem::path& out);
+
+}  // namespace mm
