@@ -59,7 +59,8 @@ SearchInput search_input(const Database& database) {
 }
 
 std::span<const std::string_view> search_method_names() {
-  static constexpr std::string_view names[] = {"brute", "brute-simd", "aabb", "kdtree", "approx"};
+  static constexpr std::string_view names[] = {"brute", "brute-simd", "aabb", "kdtree", "boxtree",
+                                                   "approx"};
   return names;
 }
 
@@ -70,6 +71,7 @@ Result<std::unique_ptr<Searcher>> make_searcher(std::string_view method, const S
   if (method == "brute-simd") return search_detail::make_brute_simd(input);
   if (method == "aabb") return search_detail::make_aabb(input);
   if (method == "kdtree") return search_detail::make_kdtree(input, options);
+  if (method == "boxtree") return search_detail::make_boxtree(input, options);
   if (method == "approx") return search_detail::make_approx(input, options);
   std::string known;
   for (std::string_view name : search_method_names()) {
@@ -94,6 +96,11 @@ CandidateSet make_candidate_set(const SearchInput& input) {
   set.frame_clip.assign(input.frame_clip.begin(), input.frame_clip.end());
   set.frame_row.assign(static_cast<size_t>(set.frame_count), -1);
   const auto dims = static_cast<size_t>(input.dims);
+  const auto searchable = static_cast<size_t>(
+      std::count_if(input.searchable.begin(), input.searchable.end(), [](uint8_t s) { return s != 0; }));
+  set.rows.reserve(searchable * dims);
+  set.row_frame.reserve(searchable);
+  set.row_tags.reserve(searchable);
   for (int f = 0; f < set.frame_count; ++f) {
     if (!input.searchable[static_cast<size_t>(f)]) continue;
     set.frame_row[static_cast<size_t>(f)] = set.row_count();

@@ -2,6 +2,7 @@
 // Internal to the search: the candidate rows every method starts from, the per-query rules
 // (continuation, window, tags) shared by the fast methods, and each method's factory.
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -54,6 +55,75 @@ QueryPlan plan_query(const CandidateSet& set, const float* query,
 SearchResult finish_query(const CandidateSet& set, const QueryPlan& plan, const float* query,
                           int best_row, const SearchConstraints& constraints);
 
+// An orthonormal change of basis of the feature space: the principal axes of the rows, largest
+// variance first. Distances are preserved up to rounding, and trees split along the directions
+// the data actually spreads in.
+struct FeatureRotation {
+  int dims = 0;
+  int padded_dims = 0;           // dims rounded up to a multiple of 8
+  std::vector<float> mean;       // dims: subtracted before rotating
+  std::vector<float> axes;       // dims * padded_dims: axes[d * padded_dims + k] is component d
+                                 // of axis k (zero for k >= dims)
+  std::vector<double> variance;  // dims: variance along each axis, descending
+
+  bool empty() const { return dims == 0; }
+  // y = axes^T (x - mean) in float; y holds padded_dims floats (the padding comes out 0).
+  void apply(const float* x, float* y) const;
+  // Bound on |computed y - exact y| per unit of |x - mean|: each coordinate sums dims products
+  // in float (2 * dims roundings of 2^-24 relative to the sum of |terms| <= |x - mean|), over
+  // sqrt(dims) coordinates, with a factor 2 of margin.
+  float error_per_norm() const {
+    const auto n = static_cast<float>(dims);
+    return 2.0f * std::sqrt(n) * (2.0f * n + 2.0f) * 5.97e-8f;
+  }
+  size_t memory_bytes() const {
+    return (mean.capacity() + axes.capacity()) * sizeof(float) + variance.capacity() * sizeof(double);
+  }
+};
+
+// Principal axes of `row_count` rows (row-major, `dims` columns), estimated from at most
+// `max_sample_rows` evenly spaced rows (the rotation only needs to be orthonormal to be exact).
+FeatureRotation principal_axes(const float* rows, int row_count, int dims, int max_sample_rows);
+
+// Euclidean norm of a row.
+float row_norm(const float* x, int dims);
+
+// Decides rows found in a rotated space by their canonical (unrotated) distance, so a rotated
+// structure returns exactly what brute force returns. Rotation and float rounding move a
+// distance by at most `slack(d)`; the scan threshold is the best canonical distance plus that.
+struct ExactRanker {
+  const CandidateSet* set = nullptr;
+  const float* query = nullptr;          // unrotated
+  const int* scanned_to_set = nullptr;   // scanned row -> candidate row (null: the same)
+  float best_distance = 0.0f;            // canonical distance of the best row so far (or bound)
+  float rotation_error = 0.0f;           // bound on |rotated difference - exact difference|
+  float relative_error = 0.0f;           // relative rounding of one distance computation
+
+  // Prepares the ranker for one query: `rotated_query_norm` is |rotated query| and
+  // `max_row_norm` the largest |rotated row| (both about |x - mean|), `bound` the plan's bound.
+  void start(const CandidateSet& candidates, const FeatureRotation& rotation,
+             const float* unrotated_query, float bound, float rotated_query_norm,
+             float max_row_norm) {
+    set = &candidates;
+    query = unrotated_query;
+    best_distance = bound;
+    // The query's and the row's rotation errors add up; 1.01 covers the norms themselves
+    // being computed from rounded values.
+    rotation_error = 1.01f * rotation.error_per_norm() * (rotated_query_norm + max_row_norm);
+    // A distance sums dims squares in float (FMA or not), computed in both spaces.
+    relative_error = 2.0f * (static_cast<float>(candidates.dims) + 2.0f) * 5.97e-8f;
+  }
+  // Upper bound on |rotated distance - canonical distance| near distance d.
+  float slack(float d) const {
+    const float e = rotation_error;
+    return 2.0f * relative_error * d + 2.0f * std::sqrt(d) * e + e * e;
+  }
+  // The scan threshold that goes with best_distance.
+  float threshold() const { return best_distance + slack(best_distance); }
+  // RowFilter::offer hook: context is an ExactRanker.
+  static void offer(void* context, int row, float scanned_distance, search_kernels::ScanBest& best);
+};
+
 // Factories of the methods (input already validated, options checked by each).
 Result<std::unique_ptr<Searcher>> make_brute(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_brute_simd(const SearchInput& input);
@@ -62,5 +132,7 @@ Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
                                               const SearchOptions& options);
 Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
                                               const SearchOptions& options);
+Result<std::unique_ptr<Searcher>> make_boxtree(const SearchInput& input,
+                                               const SearchOptions& options);
 
 }  // namespace mm::search_detail

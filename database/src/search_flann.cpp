@@ -1,19 +1,22 @@
 // The FLANN-based methods: `kdtree` (flann::KDTreeSingleIndex, exact) and `approx`
 // (flann::KDTreeIndex, randomized trees with a leaf-check budget).
 //
-// Both index the searchable rows only (the mask is fixed when the database is built) and apply
-// the per-query rules inside a custom FLANN result set: a row that fails the tag filter or lies
-// in the window is never recorded, and the bound starts at the continuation's distance minus
-// the transition cost. The single tree prunes a branch only when its lower bound is >= the best
-// recorded distance, so the search stays exact under every constraint.
+// Both index the searchable rows only (the mask is fixed when the database is built),
+// optionally in principal-axes coordinates, and apply the per-query rules inside a custom
+// FLANN result set: a row that fails the tag filter or lies in the window is never recorded,
+// and the bound starts at the continuation's distance minus the transition cost. Rows found in
+// the rotated space are decided by their unrotated distance (ExactRanker). The single tree
+// prunes a branch only when its lower bound reaches the threshold, so it stays exact under
+// every constraint.
 //
 // FLANN allocates inside findNeighbors(): KDTreeSingleIndex a vector of dims floats per query,
-// KDTreeIndex a branch heap (reserve of one entry per row) and a visited bitset of one bit per
+// KDTreeIndex a branch heap (a reserve of one entry per row) and a visited bitset of one bit per
 // row. Those are FLANN's internals; nothing else on these paths allocates.
 
 #include <flann/flann.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "search_detail.hpp"
@@ -24,66 +27,97 @@ namespace {
 
 using FlannDistance = flann::L2<float>;
 
-// Keeps the single best row that passes the filter, with a distance strictly below the bound.
+// Keeps the single best row that passes the filter, below a threshold that only shrinks.
 class ConstrainedBestResultSet final : public flann::ResultSet<float> {
  public:
-  ConstrainedBestResultSet(const search_kernels::RowFilter& filter, float bound)
-      : filter_(filter), best_distance_(bound) {}
+  ConstrainedBestResultSet(const search_kernels::RowFilter& filter, float threshold)
+      : filter_(filter) {
+    best_.distance = threshold;
+  }
 
   // FLANN's randomized trees keep searching past the check budget while this is false: a
   // result exists once a bound (the continuation) or a passing row is known.
   bool full() const override {
-    return best_row_ >= 0 || best_distance_ < std::numeric_limits<float>::infinity();
+    return best_.row >= 0 || best_.distance < std::numeric_limits<float>::infinity();
   }
   void addPoint(float distance, size_t index) override {
     const int row = static_cast<int>(index);
-    if (distance < best_distance_ && filter_.passes(row)) {
-      best_distance_ = distance;
-      best_row_ = row;
+    if (!(distance < best_.distance) || !filter_.passes(row)) return;
+    if (filter_.offer != nullptr) {
+      filter_.offer(filter_.offer_context, row, distance, best_);
+    } else {
+      best_.distance = distance;
+      best_.row = row;
     }
   }
-  float worstDist() const override { return best_distance_; }
+  float worstDist() const override { return best_.distance; }
 
-  int best_row() const { return best_row_; }
+  int best_row() const { return best_.row; }
 
  private:
   const search_kernels::RowFilter& filter_;
-  float best_distance_;
-  int best_row_ = -1;
+  search_kernels::ScanBest best_;
 };
 
-// FLANN reports usedMemory() for its node pool and index array; add the reordered copy of the
-// rows (KDTreeSingleIndex with reorder) and the per-row pointer table every FLANN index keeps.
-size_t flann_dataset_overhead(size_t rows) { return rows * sizeof(float*); }
+// What differs between the exact and the randomized FLANN index.
+struct ExactTraits {
+  using Index = flann::KDTreeSingleIndex<FlannDistance>;
+  static constexpr std::string_view kName = "kdtree";
+  static constexpr bool kExact = true;
+  // KDTreeSingleIndex with reorder copies the rows into tree order.
+  static constexpr bool kCopiesRows = true;
+};
+struct ApproxTraits {
+  using Index = flann::KDTreeIndex<FlannDistance>;
+  static constexpr std::string_view kName = "approx";
+  static constexpr bool kExact = false;
+  static constexpr bool kCopiesRows = false;
+};
 
-class FlannKdTreeSearcher final : public Searcher {
+template <class Traits>
+class FlannSearcher final : public Searcher {
  public:
-  static Result<std::unique_ptr<Searcher>> make(const SearchInput& input, int leaf_size) {
-    auto searcher = std::unique_ptr<FlannKdTreeSearcher>(new FlannKdTreeSearcher(input));
-    if (searcher->set_.row_count() > 0) {
-      try {
-        flann::Matrix<float> rows(searcher->set_.rows.data(),
-                                  static_cast<size_t>(searcher->set_.row_count()),
-                                  static_cast<size_t>(searcher->set_.dims));
-        searcher->index_ = std::make_unique<flann::KDTreeSingleIndex<FlannDistance>>(
-            rows, flann::KDTreeSingleIndexParams(leaf_size, true));
-        searcher->index_->buildIndex();
-      } catch (const std::exception& e) {
-        return Error{std::string("kdtree: FLANN failed to build the index: ") + e.what()};
+  // `params` builds the index; `search_params` is used for every query.
+  static Result<std::unique_ptr<Searcher>> make(const SearchInput& input, bool rotate,
+                                                const flann::IndexParams& params,
+                                                const flann::SearchParams& search_params) {
+    auto searcher = std::unique_ptr<FlannSearcher>(new FlannSearcher(input, search_params));
+    CandidateSet& set = searcher->set_;
+    const int rows = set.row_count();
+    if (rows == 0) return std::unique_ptr<Searcher>(std::move(searcher));
+    if (rotate) {
+      searcher->rotation_ = principal_axes(set.rows.data(), rows, set.dims, 4096);
+      searcher->points_.resize(set.rows.size());
+      float rotated[kMaxSearchDims];
+      for (int r = 0; r < rows; ++r) {
+        searcher->rotation_.apply(set.row(r), rotated);
+        std::copy_n(rotated, set.dims, searcher->points_.data() + static_cast<size_t>(r) * set.dims);
+        searcher->max_row_norm_ = std::max(searcher->max_row_norm_, row_norm(rotated, set.dims));
       }
+    }
+    try {
+      float* data = rotate ? searcher->points_.data() : set.rows.data();
+      flann::Matrix<float> matrix(data, static_cast<size_t>(rows), static_cast<size_t>(set.dims));
+      searcher->index_ = std::make_unique<typename Traits::Index>(matrix, params);
+      searcher->index_->buildIndex();
+    } catch (const std::exception& e) {
+      return Error{std::string(Traits::kName) + ": FLANN failed to build the index: " + e.what()};
     }
     return std::unique_ptr<Searcher>(std::move(searcher));
   }
 
-  std::string_view method() const override { return "kdtree"; }
+  std::string_view method() const override { return Traits::kName; }
   int dims() const override { return set_.dims; }
-  bool exact() const override { return true; }
+  bool exact() const override { return Traits::kExact; }
   size_t memory_bytes() const override {
-    size_t bytes = set_.memory_bytes();
+    size_t bytes = set_.memory_bytes() + points_.capacity() * sizeof(float) +
+                   rotation_.memory_bytes();
     if (index_) {
       const size_t rows = static_cast<size_t>(set_.row_count());
-      bytes += static_cast<size_t>(index_->usedMemory()) + flann_dataset_overhead(rows) +
-               rows * static_cast<size_t>(set_.dims) * sizeof(float);
+      // usedMemory() counts FLANN's node pool and index array; add its per-row pointer table
+      // and, for the reordering single tree, its copy of the rows.
+      bytes += static_cast<size_t>(index_->usedMemory()) + rows * sizeof(float*);
+      if (Traits::kCopiesRows) bytes += rows * static_cast<size_t>(set_.dims) * sizeof(float);
     }
     return bytes;
   }
@@ -91,69 +125,38 @@ class FlannKdTreeSearcher final : public Searcher {
   SearchResult search(std::span<const float> query,
                       const SearchConstraints& constraints) const override {
     assert(static_cast<int>(query.size()) == set_.dims);
-    const QueryPlan plan = plan_query(set_, query.data(), constraints);
-    if (!(plan.bound > 0.0f) || !index_) return finish_query(set_, plan, query.data(), -1, constraints);
-    ConstrainedBestResultSet result(plan.filter, plan.bound);
-    // KDTreeSingleIndex ignores the check count and eps is 0: the search is exact.
-    index_->findNeighbors(result, query.data(), flann::SearchParams());
+    QueryPlan plan = plan_query(set_, query.data(), constraints);
+    if (!(plan.bound > 0.0f) || !index_) {
+      return finish_query(set_, plan, query.data(), -1, constraints);
+    }
+    float threshold = plan.bound;
+    const float* point = query.data();
+    float rotated[kMaxSearchDims];
+    ExactRanker ranker;
+    if (!rotation_.empty()) {
+      rotation_.apply(query.data(), rotated);
+      point = rotated;
+      ranker.start(set_, rotation_, query.data(), plan.bound, row_norm(rotated, set_.dims),
+                   max_row_norm_);
+      plan.filter.offer = &ExactRanker::offer;
+      plan.filter.offer_context = &ranker;
+      threshold = ranker.threshold();
+    }
+    ConstrainedBestResultSet result(plan.filter, threshold);
+    index_->findNeighbors(result, point, search_params_);
     return finish_query(set_, plan, query.data(), result.best_row(), constraints);
   }
 
  private:
-  explicit FlannKdTreeSearcher(const SearchInput& input) : set_(make_candidate_set(input)) {}
+  FlannSearcher(const SearchInput& input, const flann::SearchParams& search_params)
+      : set_(make_candidate_set(input)), search_params_(search_params) {}
 
   CandidateSet set_;
-  std::unique_ptr<flann::KDTreeSingleIndex<FlannDistance>> index_;
-};
-
-class FlannApproxSearcher final : public Searcher {
- public:
-  static Result<std::unique_ptr<Searcher>> make(const SearchInput& input, int trees, int checks) {
-    auto searcher = std::unique_ptr<FlannApproxSearcher>(new FlannApproxSearcher(input, checks));
-    if (searcher->set_.row_count() > 0) {
-      try {
-        flann::Matrix<float> rows(searcher->set_.rows.data(),
-                                  static_cast<size_t>(searcher->set_.row_count()),
-                                  static_cast<size_t>(searcher->set_.dims));
-        searcher->index_ = std::make_unique<flann::KDTreeIndex<FlannDistance>>(
-            rows, flann::KDTreeIndexParams(trees));
-        searcher->index_->buildIndex();
-      } catch (const std::exception& e) {
-        return Error{std::string("approx: FLANN failed to build the index: ") + e.what()};
-      }
-    }
-    return std::unique_ptr<Searcher>(std::move(searcher));
-  }
-
-  std::string_view method() const override { return "approx"; }
-  int dims() const override { return set_.dims; }
-  bool exact() const override { return false; }
-  size_t memory_bytes() const override {
-    size_t bytes = set_.memory_bytes();
-    if (index_) {
-      bytes += static_cast<size_t>(index_->usedMemory()) +
-               flann_dataset_overhead(static_cast<size_t>(set_.row_count()));
-    }
-    return bytes;
-  }
-
-  SearchResult search(std::span<const float> query,
-                      const SearchConstraints& constraints) const override {
-    assert(static_cast<int>(query.size()) == set_.dims);
-    const QueryPlan plan = plan_query(set_, query.data(), constraints);
-    if (!(plan.bound > 0.0f) || !index_) return finish_query(set_, plan, query.data(), -1, constraints);
-    ConstrainedBestResultSet result(plan.filter, plan.bound);
-    index_->findNeighbors(result, query.data(), flann::SearchParams(checks_));
-    return finish_query(set_, plan, query.data(), result.best_row(), constraints);
-  }
-
- private:
-  FlannApproxSearcher(const SearchInput& input, int checks)
-      : set_(make_candidate_set(input)), checks_(checks) {}
-
-  CandidateSet set_;
-  int checks_;
-  std::unique_ptr<flann::KDTreeIndex<FlannDistance>> index_;
+  flann::SearchParams search_params_;
+  FeatureRotation rotation_;  // empty axes when the index is over the raw rows
+  std::vector<float> points_;  // rotated rows (FLANN keeps pointers into them)
+  float max_row_norm_ = 0.0f;
+  std::unique_ptr<typename Traits::Index> index_;
 };
 
 }  // namespace
@@ -163,7 +166,11 @@ Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
   if (options.kdtree_leaf_size < 1) {
     return Error{"kdtree: leaf size must be >= 1, got " + std::to_string(options.kdtree_leaf_size)};
   }
-  return FlannKdTreeSearcher::make(input, options.kdtree_leaf_size);
+  // KDTreeSingleIndex ignores the check count, and eps 0 keeps it exact.
+  return FlannSearcher<ExactTraits>::make(
+      input, options.principal_axes,
+      flann::KDTreeSingleIndexParams(options.kdtree_leaf_size, /*reorder=*/true),
+      flann::SearchParams());
 }
 
 Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
@@ -175,7 +182,9 @@ Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
     return Error{"approx: the check budget must be >= 1 (unlimited checks are not allowed), got " +
                  std::to_string(options.approx_checks)};
   }
-  return FlannApproxSearcher::make(input, options.approx_trees, options.approx_checks);
+  return FlannSearcher<ApproxTraits>::make(input, options.principal_axes,
+                                           flann::KDTreeIndexParams(options.approx_trees),
+                                           flann::SearchParams(options.approx_checks));
 }
 
 }  // namespace mm::search_detail

@@ -22,8 +22,12 @@ __attribute__((noinline)) void consider_lanes(const float* distances, int first_
   for (int lane = 0; lane < kBlockRows; ++lane) {
     const float distance = distances[lane];
     if (distance < best.distance && filter.passes(first_row + lane)) {
-      best.distance = distance;
-      best.row = first_row + lane;
+      if (filter.offer != nullptr) {
+        filter.offer(filter.offer_context, first_row + lane, distance, best);
+      } else {
+        best.distance = distance;
+        best.row = first_row + lane;
+      }
     }
   }
 }

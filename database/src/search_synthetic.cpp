@@ -70,4 +70,25 @@ SyntheticSearchData make_synthetic_search_data(const SyntheticSearchSpec& spec) 
   return data;
 }
 
+NoisyQueries make_noisy_queries(const SearchInput& input, int count, float noise, uint64_t seed) {
+  NoisyQueries queries;
+  queries.dims = input.dims;
+  std::vector<int> frames;
+  for (int f = 0; f < input.frame_count(); ++f) {
+    if (input.searchable[static_cast<size_t>(f)]) frames.push_back(f);
+  }
+  if (frames.empty() || count <= 0) return queries;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<float> gauss(0.0f, 1.0f);
+  const auto dims = static_cast<size_t>(input.dims);
+  queries.features.reserve(static_cast<size_t>(count) * dims);
+  for (int i = 0; i < count; ++i) {
+    const int frame = frames[static_cast<size_t>(rng() % frames.size())];
+    queries.source_frames.push_back(frame);
+    const float* row = input.features.data() + static_cast<size_t>(frame) * dims;
+    for (size_t d = 0; d < dims; ++d) queries.features.push_back(row[d] + noise * gauss(rng));
+  }
+  return queries;
+}
+
 }  // namespace mm

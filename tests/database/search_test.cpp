@@ -458,7 +458,8 @@ TEST_P(SyntheticExactness, SameCostAsBruteUnderEveryConstraintCombination) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ExactMethods, SyntheticExactness,
-                         ::testing::Values("brute-simd", "aabb", "kdtree"), method_test_name);
+                         ::testing::Values("brute-simd", "aabb", "kdtree", "boxtree"),
+                         method_test_name);
 
 TEST(SyntheticApprox, NeverBelowExactAlwaysValidMostlyExact) {
   const SyntheticSearchData data = small_synthetic();

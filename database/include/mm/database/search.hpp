@@ -75,7 +75,12 @@ struct SearchResult {
 // Tunables of the search structures; every method reads the fields it needs.
 struct SearchOptions {
   // Rows per leaf of the FLANN exact KD-tree (`kdtree`).
-  int kdtree_leaf_size = 16;
+  int kdtree_leaf_size = 32;
+  // Rows per leaf of the box tree (`boxtree`): a positive multiple of 8 (one SIMD block).
+  int boxtree_leaf_size = 32;
+  // Build the trees (`kdtree`, `boxtree`, `approx`) over the principal axes of the rows
+  // instead of the raw columns. Results stay exact: rows are decided by their unrotated distance.
+  bool principal_axes = true;
   // Randomized trees of the approximate method (`approx`).
   int approx_trees = 4;
   // Leaf checks per query of the approximate method (its budget; never unlimited).
@@ -102,7 +107,7 @@ class Searcher {
 };
 
 // The method names make_searcher() accepts, the reference first:
-// brute, brute-simd, aabb, kdtree, approx.
+// brute, brute-simd, aabb, kdtree, boxtree, approx.
 std::span<const std::string_view> search_method_names();
 
 // Builds the named search structure over `input`; fails on an unknown name, invalid input or

@@ -33,6 +33,12 @@ size_t blocked_float_count(int row_count, int dims);
 // overflows to infinity and never wins.
 void pack_blocks(const float* rows, int row_count, int dims, float* out);
 
+// Best row of a scan: the lowest distance strictly below the starting bound (row -1 if none).
+struct ScanBest {
+  int row = -1;
+  float distance = std::numeric_limits<float>::infinity();
+};
+
 // Which rows a scan may return. Rows are indices into the blocked rows; a row passes when it
 // is < row_count, its tags contain every include tag and none of the exclude tags, and its
 // frame lies outside [window_first, window_last].
@@ -48,6 +54,11 @@ struct RowFilter {
   // tag filter without computing distances (both null when no block may be skipped).
   const uint64_t* block_tags_or = nullptr;
   const uint64_t* block_tags_and = nullptr;
+  // Optional: for rows scanned in a transformed space (e.g. rotated), decides by the exact
+  // distance. Called for each passing row whose scanned distance is below best.distance; it
+  // updates `best` itself (best.distance is then the pruning threshold in the scanned space).
+  void (*offer)(void* context, int row, float scanned_distance, ScanBest& best) = nullptr;
+  void* offer_context = nullptr;
 
   // True when `row` may be returned.
   bool passes(int row) const {
@@ -63,12 +74,6 @@ struct RowFilter {
     return (block_tags_or[block] & include_tags) == include_tags &&
            (block_tags_and[block] & exclude_tags) == 0;
   }
-};
-
-// Best row of a scan: the lowest distance strictly below the starting bound (row -1 if none).
-struct ScanBest {
-  int row = -1;
-  float distance = std::numeric_limits<float>::infinity();
 };
 
 // Scans blocks [first_block, last_block) of `blocks` (the packed layout) for the passing row

@@ -4,6 +4,7 @@
 // dense cluster of low-variance "standing" clips, the hard case for search trees.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mm/database/database.hpp"
@@ -38,5 +39,23 @@ struct SyntheticSearchData {
 
 // Generates data following `spec` (sizes are clamped to sane minimums).
 SyntheticSearchData make_synthetic_search_data(const SyntheticSearchSpec& spec);
+
+// Benchmark and test queries: searchable frames drawn uniformly, plus Gaussian noise.
+struct NoisyQueries {
+  int dims = 0;
+  std::vector<float> features;     // count * dims: the source row plus noise
+  std::vector<int> source_frames;  // per query: the frame it was drawn from
+
+  int count() const { return static_cast<int>(source_frames.size()); }
+  // The features of query i.
+  std::span<const float> query(int i) const {
+    return {features.data() + static_cast<size_t>(i) * dims, static_cast<size_t>(dims)};
+  }
+};
+
+// `count` queries: uniformly drawn searchable frames of `input` plus Gaussian noise of standard
+// deviation `noise` (normalized units) per column; deterministic for a given seed. Empty when no
+// frame is searchable.
+NoisyQueries make_noisy_queries(const SearchInput& input, int count, float noise, uint64_t seed);
 
 }  // namespace mm

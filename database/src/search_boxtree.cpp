@@ -1,0 +1,403 @@
+// `boxtree`: an exact k-d tree whose every node keeps the tight bounding box of its rows, with
+// leaves of a few blocks of 8 rows scanned by the vector kernel.
+//
+// Why not only FLANN's single KD-tree: FLANN bounds a branch by the distance to the cutting
+// planes on its path (and to the root box), so for a noisy query near a dense, low-variance
+// cluster (the standing gestures) the bound misses the query's offset in every dimension the
+// path did not cut, and the search visits most of the cluster row by row. A tight box per node
+// bounds the distance in all dimensions at once, so whole subtrees of the cluster are skipped,
+// and what cannot be skipped is scanned 8 rows per instruction instead of one.
+//
+// The tree is built over the principal axes of the rows (optional): splits then follow the
+// directions the motion actually varies in. Rows found in the rotated space are decided by their
+// canonical distance (ExactRanker), so the answer stays exactly brute force's.
+//
+// Per node the OR and AND of its rows' tags skip subtrees that cannot pass a tag filter; the
+// window and the continuation are handled by the row filter and the starting bound.
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+
+#include "search_detail.hpp"
+
+namespace mm::search_detail {
+
+namespace {
+
+using search_kernels::kBlockRows;
+
+// Eight floats as a GCC vector: 256-bit AVX code in the AVX2 build of the traversal, two SSE
+// registers in the portable one.
+typedef float Float8 __attribute__((vector_size(32)));
+
+// Squared distance from `query` to the box [lo, hi]; all three padded to a multiple of 8 (the
+// padding columns hold zeros, which add nothing).
+__attribute__((always_inline)) inline float box_distance(const float* query, const float* lo,
+                                                         const float* hi, int padded_dims) {
+  const Float8 zero = {};
+  Float8 acc = {};
+  for (int d = 0; d < padded_dims; d += 8) {
+    Float8 q;
+    Float8 l;
+    Float8 h;
+    std::memcpy(&q, query + d, sizeof q);
+    std::memcpy(&l, lo + d, sizeof l);
+    std::memcpy(&h, hi + d, sizeof h);
+    const Float8 below = l - q;
+    const Float8 above = q - h;
+    Float8 gap = below > above ? below : above;
+    gap = gap > zero ? gap : zero;
+    acc += gap * gap;
+  }
+  float lanes[8];
+  std::memcpy(lanes, &acc, sizeof lanes);
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+}
+
+struct Node {
+  int first_block = 0;   // the node's rows are blocks [first_block, last_block)
+  int last_block = 0;
+  int first_child = -1;  // -1 for a leaf; children are first_child and first_child + 1
+};
+
+// Everything a traversal reads, as plain views.
+struct TreeView {
+  const Node* nodes;
+  const float* boxes;  // per node: padded_dims lows, then padded_dims highs
+  const uint64_t* node_tags_or;
+  const uint64_t* node_tags_and;
+  const float* blocks;
+  int dims;
+  int padded_dims;
+  search_kernels::ScanBlocksFn scan;
+};
+
+constexpr int kMaxTreeDepth = 60;
+
+// Depth-first, nearer child first; a subtree is entered only while its box is closer than the
+// best so far. `best` carries the threshold in and the answer out.
+__attribute__((always_inline)) inline void traverse(const TreeView& tree, const float* query,
+                                                    const search_kernels::RowFilter& filter,
+                                                    bool tag_filter, search_kernels::ScanBest& best) {
+  struct Pending {
+    int node;
+    float distance;
+  };
+  Pending stack[2 * kMaxTreeDepth + 2];
+  int size = 0;
+  const size_t box_stride = 2 * static_cast<size_t>(tree.padded_dims);
+  auto node_box_distance = [&](int node) {
+    if (tag_filter && ((tree.node_tags_or[node] & filter.include_tags) != filter.include_tags ||
+                       (tree.node_tags_and[node] & filter.exclude_tags) != 0)) {
+      return std::numeric_limits<float>::infinity();
+    }
+    const float* box = tree.boxes + static_cast<size_t>(node) * box_stride;
+    return box_distance(query, box, box + tree.padded_dims, tree.padded_dims);
+  };
+  stack[size++] = {0, node_box_distance(0)};
+  while (size > 0) {
+    const Pending top = stack[--size];
+    if (!(top.distance < best.distance)) continue;
+    const Node& node = tree.nodes[top.node];
+    if (node.first_child < 0) {
+      tree.scan(tree.blocks, node.first_block, node.last_block, tree.dims, query, filter, best);
+      continue;
+    }
+    const int a = node.first_child;
+    const int b = node.first_child + 1;
+    const float da = node_box_distance(a);
+    const float db = node_box_distance(b);
+    // Push the farther child first so the nearer one is searched first.
+    if (da <= db) {
+      if (db < best.distance) stack[size++] = {b, db};
+      if (da < best.distance) stack[size++] = {a, da};
+    } else {
+      if (da < best.distance) stack[size++] = {a, da};
+      if (db < best.distance) stack[size++] = {b, db};
+    }
+  }
+}
+
+__attribute__((target("avx2,fma"))) void traverse_avx2(const TreeView& tree, const float* query,
+                                                       const search_kernels::RowFilter& filter,
+                                                       bool tag_filter,
+                                                       search_kernels::ScanBest& best) {
+  traverse(tree, query, filter, tag_filter, best);
+}
+
+void traverse_portable(const TreeView& tree, const float* query,
+                       const search_kernels::RowFilter& filter, bool tag_filter,
+                       search_kernels::ScanBest& best) {
+  traverse(tree, query, filter, tag_filter, best);
+}
+
+class BoxTreeSearcher final : public Searcher {
+ public:
+  BoxTreeSearcher(const SearchInput& input, int leaf_rows, bool rotate)
+      : set_(make_candidate_set(input)) {
+    const int rows = set_.row_count();
+    const int dims = set_.dims;
+    padded_dims_ = (dims + 7) / 8 * 8;
+    leaf_rows_ = std::max(kBlockRows, leaf_rows / kBlockRows * kBlockRows);
+    // The rows in the space the tree lives in (the raw columns or the principal-axes
+    // coordinates), kept in tree order while the tree is split: every split partitions its
+    // range in place, so the build streams through memory instead of chasing indices.
+    std::vector<float> work(set_.rows.size());
+    if (rotate && rows > 0) {
+      rotation_ = principal_axes(set_.rows.data(), rows, dims, 4096);
+      float rotated[kMaxSearchDims];
+      for (int r = 0; r < rows; ++r) {
+        rotation_.apply(set_.row(r), rotated);
+        std::copy_n(rotated, dims, work.data() + static_cast<size_t>(r) * dims);
+        max_row_norm_ = std::max(max_row_norm_, row_norm(rotated, dims));
+      }
+    } else {
+      std::copy(set_.rows.begin(), set_.rows.end(), work.begin());
+    }
+    // The packed blocks are written last; until then their storage is the split's second
+    // row buffer.
+    blocks_.resize(std::max(search_kernels::blocked_float_count(rows, dims), work.size()));
+    SplitBuffers buffers;
+    buffers.rows[0] = work.data();
+    buffers.rows[1] = blocks_.data();
+    buffers.ids[0].resize(static_cast<size_t>(rows));
+    std::iota(buffers.ids[0].begin(), buffers.ids[0].end(), 0);
+    buffers.ids[1].resize(static_cast<size_t>(rows));
+    if (rows > 0) {
+      nodes_.emplace_back();
+      buffers.keys.resize(static_cast<size_t>(rows));
+      split(0, 0, rows, buffers, 0, 1);
+    }
+    tree_row_ = std::move(buffers.ids[0]);
+    blocks_.resize(search_kernels::blocked_float_count(rows, dims));
+    search_kernels::pack_blocks(work.data(), rows, dims, blocks_.data());
+    // Frames and tags in tree order for the filter.
+    tree_frame_.resize(static_cast<size_t>(rows));
+    tree_tags_.resize(static_cast<size_t>(rows));
+    for (int i = 0; i < rows; ++i) {
+      const int r = tree_row_[static_cast<size_t>(i)];
+      tree_frame_[static_cast<size_t>(i)] = set_.row_frame[static_cast<size_t>(r)];
+      tree_tags_[static_cast<size_t>(i)] = set_.row_tags[static_cast<size_t>(r)];
+    }
+    const int block_count = (rows + kBlockRows - 1) / kBlockRows;
+    block_tags_or_.assign(static_cast<size_t>(block_count), 0);
+    block_tags_and_.assign(static_cast<size_t>(block_count), ~uint64_t{0});
+    for (int i = 0; i < rows; ++i) {
+      block_tags_or_[static_cast<size_t>(i / kBlockRows)] |= tree_tags_[static_cast<size_t>(i)];
+      block_tags_and_[static_cast<size_t>(i / kBlockRows)] &= tree_tags_[static_cast<size_t>(i)];
+    }
+    compute_boxes(work, rows);
+    traverse_ = search_kernels::avx2_supported() ? &traverse_avx2 : &traverse_portable;
+    scan_ = search_kernels::scan_blocks();
+  }
+
+  std::string_view method() const override { return "boxtree"; }
+  int dims() const override { return set_.dims; }
+  bool exact() const override { return true; }
+  size_t memory_bytes() const override {
+    return set_.memory_bytes() + rotation_.memory_bytes() +
+           tree_row_.capacity() * sizeof(int) + tree_frame_.capacity() * sizeof(int) +
+           tree_tags_.capacity() * sizeof(uint64_t) + blocks_.capacity() * sizeof(float) +
+           (block_tags_or_.capacity() + block_tags_and_.capacity()) * sizeof(uint64_t) +
+           nodes_.capacity() * sizeof(Node) + boxes_.capacity() * sizeof(float) +
+           (node_tags_or_.capacity() + node_tags_and_.capacity()) * sizeof(uint64_t);
+  }
+
+  SearchResult search(std::span<const float> query,
+                      const SearchConstraints& constraints) const override {
+    assert(static_cast<int>(query.size()) == set_.dims);
+    QueryPlan plan = plan_query(set_, query.data(), constraints);
+    if (!(plan.bound > 0.0f) || nodes_.empty()) {
+      return finish_query(set_, plan, query.data(), -1, constraints);
+    }
+    // The filter sees rows in tree order.
+    plan.filter.row_tags = tree_tags_.data();
+    plan.filter.row_frame = tree_frame_.data();
+    const bool tag_filter = constraints.include_tags != 0 || constraints.exclude_tags != 0;
+    if (tag_filter) {
+      plan.filter.block_tags_or = block_tags_or_.data();
+      plan.filter.block_tags_and = block_tags_and_.data();
+    }
+    alignas(32) float point[kMaxSearchDims + 8] = {};
+    search_kernels::ScanBest best;
+    ExactRanker ranker;
+    if (!rotation_.empty()) {
+      rotation_.apply(query.data(), point);
+      ranker.start(set_, rotation_, query.data(), plan.bound, row_norm(point, set_.dims),
+                   max_row_norm_);
+      ranker.scanned_to_set = tree_row_.data();
+      plan.filter.offer = &ExactRanker::offer;
+      plan.filter.offer_context = &ranker;
+      best.distance = ranker.threshold();
+    } else {
+      std::copy(query.begin(), query.end(), point);
+      best.distance = plan.bound;
+    }
+    const TreeView view{nodes_.data(), boxes_.data(), node_tags_or_.data(), node_tags_and_.data(),
+                        blocks_.data(), set_.dims, padded_dims_, scan_};
+    traverse_(view, point, plan.filter, tag_filter, best);
+    const int best_row = best.row >= 0 ? tree_row_[static_cast<size_t>(best.row)] : -1;
+    return finish_query(set_, plan, query.data(), best_row, constraints);
+  }
+
+ private:
+  // Buffers of the split: one key per row, the two row buffers a split alternates between,
+  // and the row ids that travel with the rows.
+  struct SplitBuffers {
+    std::vector<float> keys;
+    float* rows[2] = {nullptr, nullptr};  // rows[0] is where the tree-ordered rows end up
+    std::vector<int> ids[2];
+  };
+
+  // Splits node `id` over tree rows [first, last) (first is a multiple of 8), unless it is small
+  // enough for a leaf: at a block boundary near the median of the widest dimension, estimated
+  // from at most ~32 evenly spaced rows (exact boxes come later, bottom-up). The range's rows
+  // are in buffer `from`; a split partitions them into the other buffer (one streaming pass),
+  // and a leaf copies them to buffer 0 if they are not there already.
+  void split(int id, int first, int last, SplitBuffers& buffers, int from, int depth) {
+    const int dims = set_.dims;
+    const auto row_size = static_cast<size_t>(dims);
+    const float* source = buffers.rows[from];
+    nodes_[static_cast<size_t>(id)].first_block = first / kBlockRows;
+    nodes_[static_cast<size_t>(id)].last_block = (last + kBlockRows - 1) / kBlockRows;
+    const int count = last - first;
+    auto make_leaf = [&] {
+      if (from != 0) {
+        std::copy_n(source + static_cast<size_t>(first) * row_size, static_cast<size_t>(count) * row_size,
+                    buffers.rows[0] + static_cast<size_t>(first) * row_size);
+        std::copy_n(buffers.ids[from].data() + first, count, buffers.ids[0].data() + first);
+      }
+    };
+    if (count <= leaf_rows_ || depth >= kMaxTreeDepth) return make_leaf();
+    float lo[kMaxSearchDims];
+    float hi[kMaxSearchDims];
+    auto widest_dimension = [&](int step) {
+      std::fill(lo, lo + dims, std::numeric_limits<float>::infinity());
+      std::fill(hi, hi + dims, -std::numeric_limits<float>::infinity());
+      for (int i = first; i < last; i += step) {
+        const float* row = source + static_cast<size_t>(i) * row_size;
+        for (int d = 0; d < dims; ++d) {
+          lo[d] = std::min(lo[d], row[d]);
+          hi[d] = std::max(hi[d], row[d]);
+        }
+      }
+      int widest = 0;
+      for (int d = 1; d < dims; ++d) {
+        if (hi[d] - lo[d] > hi[widest] - lo[widest]) widest = d;
+      }
+      return widest;
+    };
+    int split_dim = widest_dimension(std::max(1, count / 32));
+    if (!(hi[split_dim] > lo[split_dim])) split_dim = widest_dimension(1);
+    if (!(hi[split_dim] > lo[split_dim])) return make_leaf();  // all rows equal
+    // The split position is a block boundary, so that every leaf but the last is whole blocks.
+    const int half_blocks = std::max(1, (count / kBlockRows) / 2);
+    const int left_size = half_blocks * kBlockRows;
+    if (left_size >= count) return make_leaf();
+    // The pivot is the key of rank left_size: rows below it go left, rows above it right, and
+    // rows equal to it fill the left side up to its size.
+    float* keys = buffers.keys.data() + first;
+    for (int i = 0; i < count; ++i) keys[i] = source[static_cast<size_t>(first + i) * row_size + split_dim];
+    std::nth_element(keys, keys + left_size, keys + count);
+    const float pivot = keys[left_size];
+    int less = 0;
+    for (int i = 0; i < left_size; ++i) less += keys[i] < pivot;
+    int equal_to_left = left_size - less;
+    const int to_buffer = 1 - from;
+    float* target = buffers.rows[to_buffer] + static_cast<size_t>(first) * row_size;
+    int* target_ids = buffers.ids[to_buffer].data() + first;
+    const int* source_ids = buffers.ids[from].data() + first;
+    int left = 0;
+    int right = left_size;
+    for (int i = 0; i < count; ++i) {
+      const float* row = source + static_cast<size_t>(first + i) * row_size;
+      const float key = row[split_dim];
+      const bool goes_left = key < pivot || (key == pivot && equal_to_left-- > 0);
+      const int to = goes_left ? left++ : right++;
+      float* out = target + static_cast<size_t>(to) * row_size;
+      for (size_t d = 0; d < row_size; ++d) out[d] = row[d];
+      target_ids[to] = source_ids[i];
+    }
+    const int child = static_cast<int>(nodes_.size());
+    nodes_[static_cast<size_t>(id)].first_child = child;
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    split(child, first, first + left_size, buffers, to_buffer, depth + 1);
+    split(child + 1, first + left_size, last, buffers, to_buffer, depth + 1);
+  }
+
+  // Tight boxes and tag summaries, bottom-up: children always come after their parent, so a
+  // reverse sweep sees both children before the parent. Leaves read their rows in tree order.
+  void compute_boxes(const std::vector<float>& ordered, int rows) {
+    const int dims = set_.dims;
+    const size_t box_stride = 2 * static_cast<size_t>(padded_dims_);
+    boxes_.assign(nodes_.size() * box_stride, 0.0f);
+    node_tags_or_.assign(nodes_.size(), 0);
+    node_tags_and_.assign(nodes_.size(), ~uint64_t{0});
+    for (size_t n = nodes_.size(); n-- > 0;) {
+      const Node& node = nodes_[n];
+      float* lo = boxes_.data() + n * box_stride;
+      float* hi = lo + padded_dims_;
+      if (node.first_child < 0) {
+        std::fill(lo, lo + dims, std::numeric_limits<float>::infinity());
+        std::fill(hi, hi + dims, -std::numeric_limits<float>::infinity());
+        const int last = std::min(rows, node.last_block * kBlockRows);
+        for (int i = node.first_block * kBlockRows; i < last; ++i) {
+          const float* row = ordered.data() + static_cast<size_t>(i) * dims;
+          for (int d = 0; d < dims; ++d) {
+            lo[d] = std::min(lo[d], row[d]);
+            hi[d] = std::max(hi[d], row[d]);
+          }
+        }
+        for (int b = node.first_block; b < node.last_block; ++b) {
+          node_tags_or_[n] |= block_tags_or_[static_cast<size_t>(b)];
+          node_tags_and_[n] &= block_tags_and_[static_cast<size_t>(b)];
+        }
+      } else {
+        const auto a = static_cast<size_t>(node.first_child);
+        const float* lo_a = boxes_.data() + a * box_stride;
+        const float* lo_b = lo_a + box_stride;
+        for (int d = 0; d < dims; ++d) {
+          lo[d] = std::min(lo_a[d], lo_b[d]);
+          hi[d] = std::max(lo_a[padded_dims_ + d], lo_b[padded_dims_ + d]);
+        }
+        node_tags_or_[n] = node_tags_or_[a] | node_tags_or_[a + 1];
+        node_tags_and_[n] = node_tags_and_[a] & node_tags_and_[a + 1];
+      }
+    }
+  }
+
+  CandidateSet set_;
+  FeatureRotation rotation_;  // empty when the tree is over the raw columns
+  float max_row_norm_ = 0.0f;
+  int padded_dims_ = 8;
+  int leaf_rows_ = 32;
+  std::vector<int> tree_row_;         // tree order -> candidate row
+  std::vector<int> tree_frame_;       // tree order -> frame
+  std::vector<uint64_t> tree_tags_;   // tree order -> clip tags
+  std::vector<float> blocks_;         // tree-ordered rows (rotated unless raw), packed
+  std::vector<uint64_t> block_tags_or_;
+  std::vector<uint64_t> block_tags_and_;
+  std::vector<Node> nodes_;           // node 0 is the root
+  std::vector<float> boxes_;          // per node: lows then highs, padded_dims_ each
+  std::vector<uint64_t> node_tags_or_;
+  std::vector<uint64_t> node_tags_and_;
+  void (*traverse_)(const TreeView&, const float*, const search_kernels::RowFilter&, bool,
+                    search_kernels::ScanBest&) = nullptr;
+  search_kernels::ScanBlocksFn scan_ = nullptr;
+};
+
+}  // namespace
+
+Result<std::unique_ptr<Searcher>> make_boxtree(const SearchInput& input,
+                                               const SearchOptions& options) {
+  if (options.boxtree_leaf_size < kBlockRows || options.boxtree_leaf_size % kBlockRows != 0) {
+    return Error{"boxtree: leaf size must be a positive multiple of 8 rows, got " +
+                 std::to_string(options.boxtree_leaf_size)};
+  }
+  return std::unique_ptr<Searcher>(std::make_unique<BoxTreeSearcher>(
+      input, options.boxtree_leaf_size, options.principal_axes));
+}
+
+}  // namespace mm::search_detail

@@ -1,0 +1,476 @@
+// `mm search-bench`: builds every search structure over one database, runs the same noisy
+// queries through each, and prints build time, memory, latency percentiles, exactness against
+// `brute`, and speed-ups over `brute` and `brute-simd` measured in the same run.
+
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "mm/database/database_file.hpp"
+#include "mm/database/search.hpp"
+#include "mm/database/search_kernels.hpp"
+#include "mm/database/search_synthetic.hpp"
+
+namespace mm::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const char* const kUsage = R"(usage: mm search-bench (--db <file.mmdb> | --synthetic) [options]
+
+Builds each search structure over the database (timed), runs the same queries through every
+method and prints, per method: build time, memory, median and p99 latency per query, the rate
+of exact matches (same cost as brute within 1e-5 relative), the mean cost ratio to the exact
+cost, and the speed-up of the median over brute and over brute-simd (always run as baselines).
+
+options:
+  --db FILE              the database (.mmdb, from `mm build`)
+  --synthetic            use generated curve-like data instead (no file needed)
+  --queries N            number of queries (default 2000)
+  --noise S              Gaussian noise added to each query, normalized units (default 0.1)
+  --methods LIST         comma-separated methods (default: all; known: brute, brute-simd, aabb,
+                         kdtree, boxtree, approx)
+  --json FILE            also write the results as JSON
+  --seed N               query seed (default 1)
+  --playing              each query plays its source frame (continuation, window, transition
+                         cost apply); by default nothing plays (plain nearest neighbour)
+  --window N             window of skipped frames when --playing (default 20)
+  --transition-cost C    transition cost when --playing (default 0.5)
+  --include-tags MASK    tag filter: required tag bits (number, default 0)
+  --exclude-tags MASK    tag filter: forbidden tag bits (number, default 0)
+  --leaf-size N          kdtree leaf size in rows (default 32)
+  --boxtree-leaf-size N  boxtree leaf size in rows, a multiple of 8 (default 32)
+  --raw-axes             build the trees over the raw columns instead of the principal axes
+  --repeat R             time every query R times and keep its fastest run (default 1), which
+                         removes interference from other processes on a shared machine
+  --clock wall|cpu       wall time (default) or the thread's CPU time (ignores preemption)
+  --approx-trees N       approx: randomized trees (default 4)
+  --approx-checks N      approx: leaf checks per query (default 64)
+  --batch                also time batched queries on 1 and 2 threads
+  --quiet                no progress on the terminal
+)";
+
+struct Arguments {
+  std::string db_path;
+  bool synthetic = false;
+  int queries = 2000;
+  float noise = 0.1f;
+  std::vector<std::string> methods;
+  std::string json_path;
+  uint64_t seed = 1;
+  bool playing = false;
+  int window = 20;
+  float transition_cost = 0.5f;
+  uint64_t include_tags = 0;
+  uint64_t exclude_tags = 0;
+  SearchOptions options;
+  bool batch = false;
+  bool quiet = false;
+  int repeat = 1;
+  bool cpu_clock = false;
+};
+
+std::vector<std::string> split_list(const std::string& list) {
+  std::vector<std::string> items;
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    if (comma > start) items.push_back(list.substr(start, comma - start));
+    start = comma + 1;
+  }
+  return items;
+}
+
+// Parses the arguments; returns an exit code >= 0 when the program should stop (help, error).
+int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
+  auto number = [&](size_t& i, const std::string& flag, double lo, double hi, double& value) {
+    if (i + 1 >= args.size()) {
+      std::fprintf(stderr, "mm search-bench: %s needs a value\n", flag.c_str());
+      return false;
+    }
+    const std::string& text = args[++i];
+    char* end = nullptr;
+    value = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(value) || value < lo || value > hi) {
+      std::fprintf(stderr, "mm search-bench: %s expects a number in [%g, %g], got '%s'\n",
+                   flag.c_str(), lo, hi, text.c_str());
+      return false;
+    }
+    return true;
+  };
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    double v = 0;
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--db" && i + 1 < args.size()) {
+      out.db_path = args[++i];
+    } else if (a == "--synthetic") {
+      out.synthetic = true;
+    } else if (a == "--queries") {
+      if (!number(i, a, 1, 1e7, v)) return 2;
+      out.queries = static_cast<int>(v);
+    } else if (a == "--noise") {
+      if (!number(i, a, 0, 100, v)) return 2;
+      out.noise = static_cast<float>(v);
+    } else if (a == "--methods" && i + 1 < args.size()) {
+      out.methods = split_list(args[++i]);
+    } else if (a == "--json" && i + 1 < args.size()) {
+      out.json_path = args[++i];
+    } else if (a == "--seed") {
+      if (!number(i, a, 0, 1e15, v)) return 2;
+      out.seed = static_cast<uint64_t>(v);
+    } else if (a == "--playing") {
+      out.playing = true;
+    } else if (a == "--window") {
+      if (!number(i, a, 0, 1e6, v)) return 2;
+      out.window = static_cast<int>(v);
+    } else if (a == "--transition-cost") {
+      if (!number(i, a, 0, 1e9, v)) return 2;
+      out.transition_cost = static_cast<float>(v);
+    } else if (a == "--include-tags") {
+      if (!number(i, a, 0, 1.8e19, v)) return 2;
+      out.include_tags = static_cast<uint64_t>(v);
+    } else if (a == "--exclude-tags") {
+      if (!number(i, a, 0, 1.8e19, v)) return 2;
+      out.exclude_tags = static_cast<uint64_t>(v);
+    } else if (a == "--leaf-size") {
+      if (!number(i, a, 1, 1e6, v)) return 2;
+      out.options.kdtree_leaf_size = static_cast<int>(v);
+    } else if (a == "--boxtree-leaf-size") {
+      if (!number(i, a, 8, 1e6, v)) return 2;
+      out.options.boxtree_leaf_size = static_cast<int>(v);
+    } else if (a == "--raw-axes") {
+      out.options.principal_axes = false;
+    } else if (a == "--repeat") {
+      if (!number(i, a, 1, 1000, v)) return 2;
+      out.repeat = static_cast<int>(v);
+    } else if (a == "--clock" && i + 1 < args.size()) {
+      const std::string& clock = args[++i];
+      if (clock != "wall" && clock != "cpu") {
+        std::fprintf(stderr, "mm search-bench: --clock expects wall or cpu, got '%s'\n", clock.c_str());
+        return 2;
+      }
+      out.cpu_clock = clock == "cpu";
+    } else if (a == "--approx-trees") {
+      if (!number(i, a, 1, 64, v)) return 2;
+      out.options.approx_trees = static_cast<int>(v);
+    } else if (a == "--approx-checks") {
+      if (!number(i, a, 1, 1e9, v)) return 2;
+      out.options.approx_checks = static_cast<int>(v);
+    } else if (a == "--batch") {
+      out.batch = true;
+    } else if (a == "--quiet") {
+      out.quiet = true;
+    } else {
+      std::fprintf(stderr, "mm search-bench: unknown or incomplete argument '%s'\n\n%s", a.c_str(),
+                   kUsage);
+      return 2;
+    }
+  }
+  if (out.db_path.empty() == !out.synthetic) {
+    std::fprintf(stderr, "mm search-bench: give exactly one of --db FILE or --synthetic\n\n%s",
+                 kUsage);
+    return 2;
+  }
+  // brute and brute-simd are the baselines of the speed-up columns: always run, first.
+  std::vector<std::string> methods = {"brute", "brute-simd"};
+  std::vector<std::string> asked = out.methods;
+  if (asked.empty()) {
+    for (std::string_view name : search_method_names()) asked.emplace_back(name);
+  }
+  for (const std::string& name : asked) {
+    const auto known = search_method_names();
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::fprintf(stderr, "mm search-bench: unknown method '%s' (known:", name.c_str());
+      for (std::string_view k : known) std::fprintf(stderr, " %.*s", static_cast<int>(k.size()), k.data());
+      std::fprintf(stderr, ")\n");
+      return 2;
+    }
+    if (std::find(methods.begin(), methods.end(), name) == methods.end()) methods.push_back(name);
+  }
+  out.methods = methods;
+  return -1;
+}
+
+// Latency and quality of one method over all queries.
+struct MethodReport {
+  std::string name;
+  double build_ms = 0;
+  size_t memory_bytes = 0;
+  double median_us = 0;
+  double p99_us = 0;
+  double mean_us = 0;
+  double exact_match_rate = 0;
+  double cost_ratio = 0;
+  double speedup_brute = 0;
+  double speedup_brute_simd = 0;
+  std::vector<SearchResult> results;
+};
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(p * (values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
+  return values[k];
+}
+
+// Microseconds on the wall clock or on this thread's CPU clock.
+double now_us(bool cpu_clock) {
+  if (cpu_clock) {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) * 1e6 + static_cast<double>(t.tv_nsec) * 1e-3;
+  }
+  return std::chrono::duration<double, std::micro>(Clock::now().time_since_epoch()).count();
+}
+
+bool same_cost(float a, float b) {
+  if (a == b) return true;
+  return std::fabs(a - b) <= 1e-5f * std::max(std::fabs(a), std::fabs(b));
+}
+
+// Progress on a terminal: one line, rewritten at most every 100 ms.
+class Progress {
+ public:
+  explicit Progress(bool enabled) : enabled_(enabled && isatty(fileno(stderr))) {}
+  void show(const std::string& what, int done, int total) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (done != 0 && done != total && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    std::fprintf(stderr, "\r\033[K  %s %d/%d", what.c_str(), done, total);
+    std::fflush(stderr);
+  }
+  void clear() {
+    if (enabled_) std::fprintf(stderr, "\r\033[K");
+  }
+
+ private:
+  bool enabled_;
+  Clock::time_point last_{};
+};
+
+std::string human_bytes(size_t bytes) {
+  char text[32];
+  if (bytes >= (size_t{1} << 20)) {
+    std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
+  } else {
+    std::snprintf(text, sizeof text, "%.1f KiB", static_cast<double>(bytes) / (1 << 10));
+  }
+  return text;
+}
+
+int run_search_bench(const std::vector<std::string>& args) {
+  Arguments arguments;
+  if (const int code = parse_arguments(args, arguments); code >= 0) return code;
+
+  // The data: a database file or synthetic rows.
+  Database database;
+  SyntheticSearchData synthetic;
+  SearchInput input;
+  std::string source;
+  if (arguments.synthetic) {
+    SyntheticSearchSpec spec;
+    spec.clip_count = 600;
+    synthetic = make_synthetic_search_data(spec);
+    input = synthetic.input();
+    source = "synthetic (600 clips)";
+  } else {
+    auto loaded = load_database(arguments.db_path);
+    if (!loaded) {
+      std::fprintf(stderr, "mm search-bench: %s\n", loaded.message().c_str());
+      return 1;
+    }
+    database = std::move(loaded.value());
+    input = search_input(database);
+    source = arguments.db_path;
+  }
+  if (Status valid = input.validate(); !valid) {
+    std::fprintf(stderr, "mm search-bench: %s\n", valid.message().c_str());
+    return 1;
+  }
+  const int candidates = static_cast<int>(std::count(input.searchable.begin(), input.searchable.end(), 1));
+  const NoisyQueries queries =
+      make_noisy_queries(input, arguments.queries, arguments.noise, arguments.seed);
+  if (queries.count() == 0) {
+    std::fprintf(stderr, "mm search-bench: the database has no searchable frame\n");
+    return 1;
+  }
+  std::vector<SearchConstraints> constraints(static_cast<size_t>(queries.count()));
+  for (int i = 0; i < queries.count(); ++i) {
+    SearchConstraints& c = constraints[static_cast<size_t>(i)];
+    if (arguments.playing) {
+      c.current_frame = queries.source_frames[static_cast<size_t>(i)];
+      c.window_frames = arguments.window;
+      c.transition_cost = arguments.transition_cost;
+    }
+    c.include_tags = arguments.include_tags;
+    c.exclude_tags = arguments.exclude_tags;
+  }
+
+  std::printf("search-bench: %s\n  %d frames, %d candidates, %d dims; %d queries, noise %g, %s; "
+              "scan kernel %s; %s clock, fastest of %d run%s per query\n",
+              source.c_str(), input.frame_count(), candidates, input.dims, queries.count(),
+              static_cast<double>(arguments.noise),
+              arguments.playing ? "playing the source frame" : "nothing playing",
+              search_kernels::scan_blocks_isa(), arguments.cpu_clock ? "thread CPU" : "wall",
+              arguments.repeat, arguments.repeat == 1 ? "" : "s");
+
+  Progress progress(!arguments.quiet);
+  std::vector<MethodReport> reports;
+  for (const std::string& name : arguments.methods) {
+    MethodReport report;
+    report.name = name;
+    progress.show(name + ": building", 0, 1);
+    const auto build_start = Clock::now();
+    auto made = make_searcher(name, input, arguments.options);
+    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    if (!made) {
+      progress.clear();
+      std::fprintf(stderr, "mm search-bench: %s\n", made.message().c_str());
+      return 1;
+    }
+    const Searcher& searcher = *made.value();
+    report.memory_bytes = searcher.memory_bytes();
+    // Warm-up: caches and branch predictors see the structure before the timed run.
+    const int warmup = std::min(queries.count(), 64);
+    for (int i = 0; i < warmup; ++i) {
+      volatile float sink = searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]).cost;
+      (void)sink;
+    }
+    std::vector<double> times(static_cast<size_t>(queries.count()),
+                              std::numeric_limits<double>::infinity());
+    report.results.resize(static_cast<size_t>(queries.count()));
+    const int total = queries.count() * arguments.repeat;
+    for (int round = 0; round < arguments.repeat; ++round) {
+      for (int i = 0; i < queries.count(); ++i) {
+        const double start = now_us(arguments.cpu_clock);
+        report.results[static_cast<size_t>(i)] =
+            searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]);
+        const double elapsed = now_us(arguments.cpu_clock) - start;
+        times[static_cast<size_t>(i)] = std::min(times[static_cast<size_t>(i)], elapsed);
+        if ((i & 63) == 0) progress.show(name + ": queries", round * queries.count() + i, total);
+      }
+    }
+    progress.clear();
+    report.median_us = percentile(times, 0.5);
+    report.p99_us = percentile(times, 0.99);
+    double sum = 0;
+    for (double t : times) sum += t;
+    report.mean_us = sum / static_cast<double>(times.size());
+    reports.push_back(std::move(report));
+  }
+
+  // Quality against brute (reports[0]) and speed-ups over the baselines (reports[0], [1]).
+  const MethodReport& brute = reports[0];
+  const MethodReport& brute_simd = reports[1];
+  for (MethodReport& r : reports) {
+    int exact = 0;
+    double ratio_sum = 0;
+    int ratio_count = 0;
+    for (size_t i = 0; i < r.results.size(); ++i) {
+      const float expected = brute.results[i].cost;
+      const float got = r.results[i].cost;
+      exact += same_cost(got, expected);
+      if (std::isfinite(expected) && std::isfinite(got) && expected > 0) {
+        ratio_sum += static_cast<double>(got) / expected;
+        ++ratio_count;
+      } else if (same_cost(got, expected)) {
+        ratio_sum += 1.0;
+        ++ratio_count;
+      }
+    }
+    r.exact_match_rate = static_cast<double>(exact) / static_cast<double>(r.results.size());
+    r.cost_ratio = ratio_count ? ratio_sum / ratio_count : 1.0;
+    r.speedup_brute = brute.median_us / r.median_us;
+    r.speedup_brute_simd = brute_simd.median_us / r.median_us;
+  }
+
+  std::printf("\n%-11s %10s %11s %10s %10s %8s %10s %9s %11s\n", "method", "build ms", "memory",
+              "median us", "p99 us", "exact", "cost ratio", "x brute", "x brute-simd");
+  for (const MethodReport& r : reports) {
+    std::printf("%-11s %10.1f %11s %10.2f %10.2f %8.4f %10.5f %9.1f %11.2f\n", r.name.c_str(),
+                r.build_ms, human_bytes(r.memory_bytes).c_str(), r.median_us, r.p99_us,
+                r.exact_match_rate, r.cost_ratio, r.speedup_brute, r.speedup_brute_simd);
+  }
+
+  nlohmann::json json;
+  if (arguments.batch) {
+    // Many characters per call: the same queries in one batch, on one and on two threads.
+    std::printf("\nbatched (%d queries per call), microseconds per query:\n", queries.count());
+    std::printf("%-11s %10s %10s %8s\n", "method", "1 thread", "2 threads", "speed-up");
+    std::vector<SearchResult> results(static_cast<size_t>(queries.count()));
+    for (const std::string& name : arguments.methods) {
+      auto made = make_searcher(name, input, arguments.options);
+      if (!made) return 1;
+      double per_query[2] = {0, 0};
+      for (int threads = 1; threads <= 2; ++threads) {
+        SearchBatchRunner runner(threads);
+        runner.run(*made.value(), queries.features, constraints, results);  // warm-up
+        const auto start = Clock::now();
+        runner.run(*made.value(), queries.features, constraints, results);
+        per_query[threads - 1] =
+            std::chrono::duration<double, std::micro>(Clock::now() - start).count() /
+            queries.count();
+      }
+      std::printf("%-11s %10.2f %10.2f %8.2f\n", name.c_str(), per_query[0], per_query[1],
+                  per_query[0] / per_query[1]);
+      json[name]["batch_us_per_query_1_thread"] = per_query[0];
+      json[name]["batch_us_per_query_2_threads"] = per_query[1];
+    }
+  }
+
+  if (!arguments.json_path.empty()) {
+    json["run"] = {{"database", source},
+                   {"frames", input.frame_count()},
+                   {"candidates", candidates},
+                   {"dims", input.dims},
+                   {"queries", queries.count()},
+                   {"noise", arguments.noise},
+                   {"seed", arguments.seed},
+                   {"playing", arguments.playing},
+                   {"repeat", arguments.repeat},
+                   {"clock", arguments.cpu_clock ? "thread_cpu" : "wall"},
+                   {"scan_kernel", search_kernels::scan_blocks_isa()}};
+    for (const MethodReport& r : reports) {
+      nlohmann::json& m = json[r.name];
+      m["build_ms"] = r.build_ms;
+      m["memory_bytes"] = r.memory_bytes;
+      m["median_us"] = r.median_us;
+      m["p99_us"] = r.p99_us;
+      m["mean_us"] = r.mean_us;
+      m["exact_match_rate"] = r.exact_match_rate;
+      m["cost_ratio"] = r.cost_ratio;
+      m["speedup_vs_brute"] = r.speedup_brute;
+      m["speedup_vs_brute_simd"] = r.speedup_brute_simd;
+    }
+    std::ofstream file(arguments.json_path);
+    file << json.dump(2) << "\n";
+    if (!file) {
+      std::fprintf(stderr, "mm search-bench: could not write %s\n", arguments.json_path.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
+
+const bool registered = register_command(
+    {"search-bench", "benchmark the search structures on a database (headless)", &run_search_bench});
+
+}  // namespace
+}  // namespace mm::cli
