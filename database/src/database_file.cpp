@@ -160,6 +160,7 @@ class SectionReader {
     return Status::success();
   }
   Status floats(float* out, size_t count, std::string_view what) {
+    if (count == 0) return Status::success();  // `out` may be null (an empty vector's data)
     if (remaining() / sizeof(float) < count) return truncated(what, count * sizeof(float));
     std::memcpy(out, bytes_.data() + pos_, count * sizeof(float));
     pos_ += count * sizeof(float);
@@ -534,7 +535,21 @@ Status read_skeleton(std::span<const std::byte> file, const DatabaseFileInfo& in
   return Status::success();
 }
 
-// Everything but the checksum: the variable sections record by record, the arrays by memcpy.
+// The largest arrays, which a second thread copies on large files while it also hashes: about
+// as many bytes as copy_arrays_b() once the hash is counted.
+void copy_arrays_a(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
+  copy_array(file, info, DatabaseSection::LocalRotations, db.local_rotations);
+  copy_array(file, info, DatabaseSection::Features, db.features);
+}
+
+void copy_arrays_b(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
+  copy_array(file, info, DatabaseSection::LocalPositions, db.local_positions);
+  copy_array(file, info, DatabaseSection::LocalVelocities, db.local_velocities);
+  copy_array(file, info, DatabaseSection::LocalAngularVelocities, db.local_angular_velocities);
+}
+
+// Everything but the checksum and copy_arrays_a(): the variable sections record by record, the
+// other arrays by memcpy.
 Status read_contents(std::span<const std::byte> file, const DatabaseFileInfo& info,
                      std::string_view name, Database& db) {
   if (Status s = read_schema(file, info, name, db.schema); !s) return s;
@@ -547,12 +562,8 @@ Status read_contents(std::span<const std::byte> file, const DatabaseFileInfo& in
   db.roles = info.roles;
   db.frame_time = info.frame_time;
   db.frame_count = static_cast<int>(info.frame_count);
-  copy_array(file, info, DatabaseSection::LocalPositions, db.local_positions);
-  copy_array(file, info, DatabaseSection::LocalRotations, db.local_rotations);
-  copy_array(file, info, DatabaseSection::LocalVelocities, db.local_velocities);
-  copy_array(file, info, DatabaseSection::LocalAngularVelocities, db.local_angular_velocities);
+  copy_arrays_b(file, info, db);
   copy_array(file, info, DatabaseSection::Contacts, db.contacts);
-  copy_array(file, info, DatabaseSection::Features, db.features);
   copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
   copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
   copy_array(file, info, DatabaseSection::Searchable, db.searchable);
@@ -745,36 +756,49 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
                  hex(computed) + "): the file was changed or damaged after it was written"};
   };
 
-  // The checksum and the copying both stream the whole file; on a large file they run on the
-  // two cores at once. Parsing before the checksum is verified is safe because every read is
-  // bounds-checked, and a checksum failure is reported in preference to anything found.
+  // Fresh memory for the arrays costs a page fault per 4 KiB, more than the copying itself, so
+  // on a large file a second thread hashes and fills about half of the arrays while this one
+  // parses and fills the rest. Only a file whose header parsed is split: every offset and
+  // length used below was checked against the file, so reading before the checksum is verified
+  // is safe, and a checksum failure is reported in preference to anything found.
+  Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
   uint64_t computed = 0;
-  std::thread hasher;
-  if (bytes.size() >= kParallelHashBytes) {
+  Database db;
+  bool worker_failed = false;
+  std::thread worker;
+  if (header && bytes.size() >= kParallelHashBytes) {
     try {
-      hasher = std::thread([&computed, covered] { computed = database_checksum(covered); });
+      worker = std::thread([&computed, &worker_failed, &db, covered, bytes, &info = header.value()] {
+        computed = database_checksum(covered);
+        try {
+          copy_arrays_a(bytes, info, db);
+        } catch (...) {
+          worker_failed = true;  // out of memory
+        }
+      });
     } catch (...) {
-      // No thread to be had: hash on this one below.
+      // No thread to be had: everything runs on this one below.
     }
   }
-  if (!hasher.joinable()) {
+  const bool parallel = worker.joinable();
+  if (!parallel) {
     computed = database_checksum(covered);
     if (computed != stored) return checksum_error(computed);
+    if (!header) return header.error();
   }
 
-  Database db;
   Status contents;
   try {
-    Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
-    contents = header ? read_contents(bytes, header.value(), name, db) : Status(header.error());
+    contents = read_contents(bytes, header.value(), name, db);
+    if (!parallel) copy_arrays_a(bytes, header.value(), db);
   } catch (const std::exception& e) {
-    // Only allocation can throw here; sizes were checked against the file, so this means the
-    // machine is out of memory.
+    // Only allocation can throw here, and every size was checked against the file first.
     contents = Error{name + ": cannot load: " + e.what()};
   }
-  if (hasher.joinable()) {
-    hasher.join();
+  if (parallel) {
+    worker.join();
     if (computed != stored) return checksum_error(computed);
+    if (worker_failed) return Error{name + ": cannot load: out of memory"};
   }
   if (!contents) return Error{contents.message()};
   if (Status s = db.validate(); !s) return Error{name + ": " + s.message()};
