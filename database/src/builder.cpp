@@ -10,6 +10,10 @@
 #include <set>
 #include <thread>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/gltf.hpp"
@@ -41,22 +45,40 @@ bool is_gltf_file(const fs::path& path) {
   return ext == ".gltf" || ext == ".glb";
 }
 
-// One preprocessed clip with its raw features and tags, waiting to be concatenated.
-struct BuiltClip {
-  ProcessedClip motion;
-  std::vector<float> raw_features;  // frame_count * dims, not normalized
-  std::vector<uint8_t> searchable;  // frame_count
-  std::vector<std::string> tags;    // sorted
+// Grows an empty vector to n value-initialized elements. On Linux the block is first marked for
+// transparent huge pages: the database arrays are hundreds of MB, and faulting them in 4 KB
+// pages costs more than filling them (measured 2-3x slower on this project's machines).
+template <class T>
+void resize_large(std::vector<T>& v, size_t n) {
+  v.reserve(n);
+#ifdef __linux__
+  constexpr uintptr_t kHuge = uintptr_t{1} << 21;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + n) & ~(kHuge - 1);
+  if (end > begin) {
+    // Only advice: failure (e.g. THP disabled) just means ordinary pages.
+    (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  }
+#endif
+  v.resize(n);
+}
+
+// What phase 1 made of one input (a file or an in-memory clip): its clips at the database
+// rate, and the joint roles of their (shared) skeleton.
+struct InputResult {
+  bool processed = false;  // false when skipped after an earlier input failed, or refused
+  Status status;
+  std::vector<Clip> clips;
+  JointRoleIndices roles;  // in the source skeleton
+  uint64_t bytes = 0;
 };
 
-// What a worker made of one input (a file or an in-memory clip).
-struct InputResult {
-  bool processed = false;  // false when skipped after an earlier input failed
-  Status status;
-  std::vector<BuiltClip> clips;
-  Skeleton source_skeleton;  // the first clip's source skeleton (for the topology check)
-  JointRoleIndices source_roles;
-  uint64_t bytes = 0;
+// One unit of phase 2: a clip (or its mirror) and where its frames go in the database.
+struct ClipJob {
+  size_t input = 0;       // index into the inputs
+  size_t clip = 0;        // index into the input's clips
+  bool mirrored = false;  // process the mirrored copy
+  size_t range = 0;       // index of its ClipRange in the database
 };
 
 // Buffers one worker reuses for every clip it processes.
@@ -73,39 +95,9 @@ struct BuildContext {
   int dims = 0;
 };
 
-Status process_one(const Clip& clip, bool mirrored, const std::string& original_name,
-                   const JointRoleIndices& roles, const Skeleton& db_skeleton,
-                   std::span<const int> channel_bones, const BuildContext& context,
-                   WorkerScratch& scratch, InputResult& result) {
-  BuiltClip built;
-  if (Status s = preprocess_clip(clip, roles, context.preprocess, built.motion, scratch.preprocess);
-      !s) {
-    return s;
-  }
-  built.motion.mirrored = mirrored;
-  const int frames = built.motion.frame_count;
-  built.raw_features.resize(static_cast<size_t>(frames) * context.dims);
-  built.searchable.resize(frames);
-  ClipMotionView view;
-  view.parents = db_skeleton.parents();
-  view.local_positions = built.motion.local_positions;
-  view.local_rotations = built.motion.local_rotations;
-  view.local_velocities = built.motion.local_velocities;
-  view.local_angular_velocities = built.motion.local_angular_velocities;
-  view.frame_count = frames;
-  view.frame_time = built.motion.frame_time;
-  extract_clip_features(context.options.schema, channel_bones, view, built.raw_features,
-                        built.searchable, scratch.features);
-  built.tags = clip_tags(original_name, mirrored, context.tag_rules);
-  result.clips.push_back(std::move(built));
-  return Status::success();
-}
-
-// Resamples, preprocesses and extracts the features of one imported clip (and its mirror).
-Status process_clip(Clip clip, const std::string& input_name, const BuildContext& context,
-                    WorkerScratch& scratch, InputResult& result) {
-  const BuildOptions& options = context.options;
-  const std::string where = input_name + ": clip '" + clip.name + "': ";
+// Validates an imported clip, brings it to the database rate and finds its joint roles.
+Status prepare_clip(Clip& clip, const std::string& input_name, const BuildOptions& options,
+                    InputResult& result) {
   if (Status s = clip.validate(); !s) return Error{input_name + ": " + s.message()};
   if (needs_resampling(clip, options.rate)) {
     clip = resample_clip(clip, options.rate);
@@ -113,39 +105,12 @@ Status process_clip(Clip clip, const std::string& input_name, const BuildContext
     clip.frame_time = 1.0f / options.rate;
   }
   Result<JointRoleIndices> roles = find_joint_roles(clip.skeleton, options.roles);
-  if (!roles) return Error{where + roles.message()};
-  Result<Skeleton> db_skeleton = add_simulation_root(clip.skeleton);
-  if (!db_skeleton) return Error{where + db_skeleton.message()};
-  auto shifted = [](int j) { return j < 0 ? -1 : j + 1; };
-  JointRoleIndices db_roles;
-  db_roles.hips = shifted(roles->hips);
-  db_roles.left_foot = shifted(roles->left_foot);
-  db_roles.right_foot = shifted(roles->right_foot);
-  db_roles.left_toe = shifted(roles->left_toe);
-  db_roles.right_toe = shifted(roles->right_toe);
-  db_roles.head = shifted(roles->head);
-  Result<std::vector<int>> bones = resolve_feature_bones(options.schema, *db_skeleton, db_roles);
-  if (!bones) return Error{where + bones.message()};
-  if (result.clips.empty()) {
-    result.source_skeleton = clip.skeleton;
-    result.source_roles = *roles;
+  if (!roles) return Error{input_name + ": clip '" + clip.name + "': " + roles.message()};
+  if (clip.skeleton.find(kSimulationJointName) >= 0) {
+    return Error{input_name + ": clip '" + clip.name + "': has a joint named '" +
+                 kSimulationJointName + "', the name the builder gives the simulation root"};
   }
-
-  if (Status s = process_one(clip, false, clip.name, *roles, *db_skeleton, *bones, context, scratch,
-                             result);
-      !s) {
-    return Error{input_name + ": " + s.message()};
-  }
-  if (options.mirror) {
-    Result<std::vector<int>> map = mirror_joint_map(clip.skeleton, options.mirror_pairs);
-    if (!map) return Error{where + map.message()};
-    const Clip mirrored = mirror_clip(clip, *map);
-    if (Status s = process_one(mirrored, true, clip.name, *roles, *db_skeleton, *bones, context,
-                               scratch, result);
-        !s) {
-      return Error{input_name + ": " + s.message()};
-    }
-  }
+  result.roles = *roles;
   return Status::success();
 }
 
@@ -198,7 +163,8 @@ int run_workers(size_t items, int threads, const Work& work) {
     for (size_t i = next.fetch_add(1); i < items; i = next.fetch_add(1)) work(worker, i);
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) {
+  const int wanted = static_cast<int>(std::min<size_t>(static_cast<size_t>(threads), items));
+  for (int t = 1; t < wanted; ++t) {
     try {
       pool.emplace_back(loop, t);
     } catch (const std::exception&) {
@@ -210,8 +176,14 @@ int run_workers(size_t items, int threads, const Work& work) {
   return static_cast<int>(pool.size()) + 1;
 }
 
-// The shared part of both entry points: `load(i, context, result, scratch)` imports and
-// processes input i into `result`.
+// The shared part of both entry points: `load(i, result)` imports input i into result.clips.
+//
+// Phase 1 (parallel over inputs): import, validate, resample, find roles.
+// Phase 2 (in input order): refuse failures and foreign skeletons, lay out the clip ranges,
+//   tags and arrays of the database.
+// Phase 3 (parallel over clips): preprocess and extract raw features straight into the
+//   database's arrays at each clip's frames.
+// Phase 4: normalization statistics (one pass in frame order), normalization, validation.
 template <class Load>
 Result<Database> build(size_t input_count, const std::vector<std::string>& input_names,
                        const BuildOptions& options, BuildReport* report, const Load& load) {
@@ -239,23 +211,37 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   context.preprocess.root = options.root;
   context.preprocess.contacts = options.contacts;
 
-  // Phase 1, parallel: import and process every input.
-  std::vector<InputResult> results(input_count);
   int threads = options.threads > 0
                     ? options.threads
                     : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  threads = static_cast<int>(std::min<size_t>(static_cast<size_t>(threads), input_count));
-  std::vector<WorkerScratch> scratch(threads);
+  std::vector<WorkerScratch> scratch(static_cast<size_t>(threads));
+  // Progress counts every input twice: once imported (phase 1), once processed (phase 3).
+  const size_t progress_total = 2 * input_count;
+  std::mutex progress_mutex;
+  size_t progress_done = 0;
+  auto step = [&] {
+    if (!options.progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    options.progress(++progress_done, progress_total);
+  };
+
+  // ---- Phase 1, parallel over inputs.
+  std::vector<InputResult> results(input_count);
   // Without skip_bad the first failing input (in input order) is the answer: inputs after a
   // known failure are skipped, inputs before it still run so the reported one is always the same.
   std::atomic<size_t> first_failure{input_count};
-  std::mutex progress_mutex;
-  size_t done = 0;
-  rep.threads = run_workers(input_count, threads, [&](int worker, size_t i) {
+  rep.threads = run_workers(input_count, threads, [&](int, size_t i) {
     InputResult& result = results[i];
     if (!options.skip_bad && i > first_failure.load()) return;
     try {
-      result.status = load(i, context, result, scratch[worker]);
+      result.status = load(i, result);
+      for (size_t c = 0; c < result.clips.size() && result.status; ++c) {
+        result.status = prepare_clip(result.clips[c], input_names[i], options, result);
+        if (result.status && c > 0 &&
+            !result.clips[c].skeleton.same_topology(result.clips[0].skeleton)) {
+          result.status = Error{input_names[i] + ": its clips do not share one skeleton"};
+        }
+      }
     } catch (const std::exception& e) {
       result.status = Error{input_names[i] + ": " + e.what()};
     }
@@ -266,15 +252,12 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
       while (i < expected && !first_failure.compare_exchange_weak(expected, i)) {
       }
     }
-    if (options.progress) {
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      options.progress(++done, input_count);
-    }
+    step();
   });
   rep.load_seconds = seconds_since(start);
-  const Clock::time_point assemble_start = Clock::now();
+  Clock::time_point phase_start = Clock::now();
 
-  // Phase 2, in input order: refuse what failed or does not match the first skeleton.
+  // ---- Phase 2, in input order: refuse what failed or does not match the first skeleton.
   const InputResult* reference = nullptr;
   size_t reference_index = 0;
   for (size_t i = 0; i < input_count; ++i) {
@@ -282,10 +265,11 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
     if (!result.processed) continue;
     rep.bytes_read += result.bytes;
     Status status = result.status;
-    if (status && reference && !reference->source_skeleton.same_topology(result.source_skeleton)) {
+    if (status && reference &&
+        !reference->clips[0].skeleton.same_topology(result.clips[0].skeleton)) {
       status = Error{input_names[i] + ": its skeleton differs from that of " +
                      input_names[reference_index] + ": " +
-                     topology_difference(reference->source_skeleton, result.source_skeleton) +
+                     topology_difference(reference->clips[0].skeleton, result.clips[0].skeleton) +
                      "; every clip of a database needs the same joints and parents"};
     }
     if (!status) {
@@ -305,25 +289,52 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
                  " were refused (the first: " + rep.refused.front().message + ")"};
   }
 
+  const Skeleton& source_skeleton = reference->clips[0].skeleton;
+  const JointRoleIndices roles = reference->roles;
   Database db;
   db.frame_time = 1.0f / options.rate;
   db.schema = options.schema;
-  Result<Skeleton> skeleton = add_simulation_root(reference->source_skeleton);
-  if (!skeleton) return Error{skeleton.message()};
+  Result<Skeleton> skeleton = add_simulation_root(source_skeleton);
+  if (!skeleton) return Error{input_names[reference_index] + ": " + skeleton.message()};
   db.skeleton = std::move(skeleton).value();
   auto shifted = [](int j) { return j < 0 ? -1 : j + 1; };
-  const JointRoleIndices& r = reference->source_roles;
-  db.roles = {shifted(r.hips),     shifted(r.left_foot), shifted(r.right_foot),
-              shifted(r.left_toe), shifted(r.right_toe), shifted(r.head)};
+  db.roles = {shifted(roles.hips),     shifted(roles.left_foot), shifted(roles.right_foot),
+              shifted(roles.left_toe), shifted(roles.right_toe), shifted(roles.head)};
+  Result<std::vector<int>> bones = resolve_feature_bones(db.schema, db.skeleton, db.roles);
+  if (!bones) return Error{"build: " + bones.message()};
+  std::vector<int> mirror_map;
+  if (options.mirror) {
+    Result<std::vector<int>> map = mirror_joint_map(source_skeleton, options.mirror_pairs);
+    if (!map) return Error{"build: " + map.message()};
+    mirror_map = std::move(map).value();
+  }
 
-  // Tags: every distinct tag, sorted, one bit each.
+  // Clip ranges (a mirrored copy right after its original) and their tags.
+  std::vector<ClipJob> jobs;
+  std::vector<std::vector<std::string>> clip_tag_lists;
   std::set<std::string> tag_set;
   size_t total_frames = 0;
-  for (const InputResult& result : results) {
-    if (!result.processed) continue;
-    for (const BuiltClip& clip : result.clips) {
-      tag_set.insert(clip.tags.begin(), clip.tags.end());
-      total_frames += static_cast<size_t>(clip.motion.frame_count);
+  for (size_t i = 0; i < input_count; ++i) {
+    if (!results[i].processed) continue;
+    for (size_t c = 0; c < results[i].clips.size(); ++c) {
+      const Clip& clip = results[i].clips[c];
+      for (const bool mirrored : {false, true}) {
+        if (mirrored && !options.mirror) continue;
+        ClipRange range;
+        range.name = mirrored ? clip.name + "_mirror" : clip.name;
+        range.start = static_cast<int>(total_frames);
+        range.end = range.start + clip.frame_count;
+        range.mirrored = mirrored;
+        total_frames += static_cast<size_t>(clip.frame_count);
+        if (total_frames > kMaxDatabaseFrames) {
+          return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
+                       " frames, the most a database holds"};
+        }
+        jobs.push_back({i, c, mirrored, db.clips.size()});
+        db.clips.push_back(std::move(range));
+        clip_tag_lists.push_back(clip_tags(clip.name, mirrored, context.tag_rules));
+        tag_set.insert(clip_tag_lists.back().begin(), clip_tag_lists.back().end());
+      }
     }
   }
   if (tag_set.size() > kMaxTags) {
@@ -332,64 +343,134 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
     return Error{"build: " + std::to_string(tag_set.size()) + " distinct tags, at most " +
                  std::to_string(kMaxTags) + " fit a database (" + some + ")"};
   }
-  if (total_frames > static_cast<size_t>(kMaxDatabaseFrames)) {
-    return Error{"build: " + std::to_string(total_frames) +
-                 " frames is more than a database holds"};
-  }
   db.tag_names.assign(tag_set.begin(), tag_set.end());
+  for (size_t r = 0; r < db.clips.size(); ++r) {
+    for (const std::string& tag : clip_tag_lists[r]) {
+      const auto bit =
+          std::lower_bound(db.tag_names.begin(), db.tag_names.end(), tag) - db.tag_names.begin();
+      db.clips[r].tags |= uint64_t{1} << bit;
+    }
+  }
 
   const int joints = db.joint_count();
-  const size_t values = total_frames * static_cast<size_t>(joints);
   const size_t dims = static_cast<size_t>(context.dims);
+  const size_t values = total_frames * static_cast<size_t>(joints);
   db.frame_count = static_cast<int>(total_frames);
-  db.local_positions.reserve(values);
-  db.local_rotations.reserve(values);
-  db.local_velocities.reserve(values);
-  db.local_angular_velocities.reserve(values);
-  db.contacts.reserve(total_frames * 2);
-  db.features.reserve(total_frames * dims);
-  db.searchable.reserve(total_frames);
-  db.frame_clip.reserve(total_frames);
-  for (InputResult& result : results) {
-    if (!result.processed) continue;
-    for (BuiltClip& clip : result.clips) {
-      ClipRange range;
-      range.name = clip.motion.name;
-      range.start = static_cast<int>(db.local_positions.size() / joints);
-      range.end = range.start + clip.motion.frame_count;
-      range.mirrored = clip.motion.mirrored;
-      for (const std::string& tag : clip.tags) {
-        const size_t bit = static_cast<size_t>(
-            std::lower_bound(db.tag_names.begin(), db.tag_names.end(), tag) - db.tag_names.begin());
-        range.tags |= uint64_t{1} << bit;
-      }
-      auto append = [](auto& to, auto& from) {
-        to.insert(to.end(), from.begin(), from.end());
-        std::decay_t<decltype(from)>().swap(from);  // release the clip's copy at once
-      };
-      append(db.local_positions, clip.motion.local_positions);
-      append(db.local_rotations, clip.motion.local_rotations);
-      append(db.local_velocities, clip.motion.local_velocities);
-      append(db.local_angular_velocities, clip.motion.local_angular_velocities);
-      append(db.contacts, clip.motion.contacts);
-      append(db.features, clip.raw_features);
-      if (std::find(clip.searchable.begin(), clip.searchable.end(), uint8_t{1}) ==
-          clip.searchable.end()) {
-        rep.warnings.push_back("clip '" + range.name + "' (" + std::to_string(range.frame_count()) +
-                               " frames) is shorter than the feature times need: none of its "
-                               "frames can be matched (it can still be played into)");
-      }
-      append(db.searchable, clip.searchable);
-      db.frame_clip.insert(db.frame_clip.end(), static_cast<size_t>(range.frame_count()),
-                           static_cast<int>(db.clips.size()));
-      db.clips.push_back(std::move(range));
+  // Fresh memory costs more to fault in than to fill, so the arrays are allocated in parallel,
+  // largest first.
+  run_workers(8, threads, [&](int, size_t array) {
+    switch (array) {
+      case 0:
+        resize_large(db.local_rotations, values);
+        break;
+      case 1:
+        resize_large(db.local_positions, values);
+        break;
+      case 2:
+        resize_large(db.local_velocities, values);
+        break;
+      case 3:
+        resize_large(db.local_angular_velocities, values);
+        break;
+      case 4:
+        resize_large(db.features, total_frames * dims);
+        break;
+      case 5:
+        resize_large(db.frame_clip, total_frames);
+        break;
+      case 6:
+        resize_large(db.contacts, total_frames * 2);
+        break;
+      default:
+        resize_large(db.searchable, total_frames);
+        break;
     }
-    result.clips.clear();
+  });
+  for (size_t r = 0; r < db.clips.size(); ++r) {
+    std::fill(db.frame_clip.begin() + db.clips[r].start, db.frame_clip.begin() + db.clips[r].end,
+              static_cast<int>(r));
   }
 
+  rep.layout_seconds = seconds_since(phase_start);
+  phase_start = Clock::now();
+
+  // ---- Phase 3, parallel over clips: straight into the database's arrays.
+  std::vector<Status> job_status(jobs.size());
+  std::vector<std::atomic<int>> jobs_left(input_count);
+  for (const ClipJob& job : jobs) jobs_left[job.input].fetch_add(1);
+  run_workers(jobs.size(), threads, [&](int worker, size_t k) {
+    const ClipJob& job = jobs[k];
+    const ClipRange& range = db.clips[job.range];
+    try {
+      const Clip& source = results[job.input].clips[job.clip];
+      Clip mirrored;
+      if (job.mirrored) mirrored = mirror_clip(source, mirror_map);
+      const Clip& clip = job.mirrored ? mirrored : source;
+      const size_t first = static_cast<size_t>(range.start) * joints;
+      const size_t count = static_cast<size_t>(range.frame_count()) * joints;
+      const std::span<glm::vec3> positions = std::span(db.local_positions).subspan(first, count);
+      const std::span<glm::quat> rotations = std::span(db.local_rotations).subspan(first, count);
+      const std::span<glm::vec3> velocities = std::span(db.local_velocities).subspan(first, count);
+      const std::span<glm::vec3> angular =
+          std::span(db.local_angular_velocities).subspan(first, count);
+      const ClipMotionOutput out{positions, rotations, velocities, angular,
+                                 std::span(db.contacts)
+                                     .subspan(static_cast<size_t>(range.start) * 2,
+                                              static_cast<size_t>(range.frame_count()) * 2)};
+      Status status = preprocess_clip(clip, results[job.input].roles, context.preprocess, out,
+                                      scratch[worker].preprocess);
+      if (status) {
+        ClipMotionView view;
+        view.parents = db.skeleton.parents();
+        view.local_positions = positions;
+        view.local_rotations = rotations;
+        view.local_velocities = velocities;
+        view.local_angular_velocities = angular;
+        view.frame_count = range.frame_count();
+        view.frame_time = db.frame_time;
+        extract_clip_features(db.schema, *bones, view,
+                              std::span(db.features)
+                                  .subspan(static_cast<size_t>(range.start) * dims,
+                                           static_cast<size_t>(range.frame_count()) * dims),
+                              std::span(db.searchable).subspan(range.start, range.frame_count()),
+                              scratch[worker].features);
+      } else {
+        status = Error{input_names[job.input] + ": " + status.message()};
+      }
+      job_status[k] = std::move(status);
+    } catch (const std::exception& e) {
+      job_status[k] = Error{input_names[job.input] + ": clip '" + range.name + "': " + e.what()};
+    }
+    if (jobs_left[job.input].fetch_sub(1) == 1) step();
+  });
+  for (const Status& s : job_status) {
+    if (!s) return Error{s.message()};
+  }
+  results.clear();  // the imported clips are no longer needed
+
+  rep.process_seconds = seconds_since(phase_start);
+  phase_start = Clock::now();
+
+  // ---- Phase 4: normalization over the whole database, then a final check.
+  for (const ClipRange& range : db.clips) {
+    if (std::find(db.searchable.begin() + range.start, db.searchable.begin() + range.end,
+                  uint8_t{1}) == db.searchable.begin() + range.end) {
+      rep.warnings.push_back("clip '" + range.name + "' (" + std::to_string(range.frame_count()) +
+                             " frames) is shorter than the feature times need: none of its "
+                             "frames can be matched (it can still be played into)");
+    }
+  }
   FeatureNormalization normalization =
       compute_feature_normalization(db.schema, db.features, db.searchable);
-  normalize_features(db.features, normalization.offset, normalization.scale);
+  // Normalizing is element-wise, so splitting the rows between threads changes nothing.
+  const size_t chunk_rows = 4096;
+  const size_t chunks = (total_frames + chunk_rows - 1) / chunk_rows;
+  run_workers(chunks, threads, [&](int, size_t chunk) {
+    const size_t first = chunk * chunk_rows;
+    const size_t rows = std::min(chunk_rows, total_frames - first);
+    normalize_features(std::span(db.features).subspan(first * dims, rows * dims),
+                       normalization.offset, normalization.scale);
+  });
   db.feature_offset = std::move(normalization.offset);
   db.feature_scale = std::move(normalization.scale);
   rep.warnings.insert(rep.warnings.end(), normalization.warnings.begin(),
@@ -407,7 +488,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   rep.duration_s = static_cast<double>(db.frame_count) / static_cast<double>(options.rate);
   rep.searchable_frames =
       static_cast<int>(std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1}));
-  rep.assemble_seconds = seconds_since(assemble_start);
+  rep.finish_seconds = seconds_since(phase_start);
   rep.total_seconds = seconds_since(start);
   return db;
 }
@@ -455,19 +536,12 @@ Result<Database> build_database(std::span<const fs::path> inputs, const BuildOpt
   std::vector<std::string> names;
   names.reserve(files->size());
   for (const fs::path& f : *files) names.push_back(f.string());
-  return build(files->size(), names, options, report,
-               [&](size_t i, const BuildContext& context, InputResult& result,
-                   WorkerScratch& scratch) -> Status {
-                 Result<std::vector<Clip>> clips = import_file((*files)[i], options, result.bytes);
-                 if (!clips) return Error{clips.message()};
-                 for (Clip& clip : *clips) {
-                   if (Status s = process_clip(std::move(clip), names[i], context, scratch, result);
-                       !s) {
-                     return s;
-                   }
-                 }
-                 return Status::success();
-               });
+  return build(files->size(), names, options, report, [&](size_t i, InputResult& result) {
+    Result<std::vector<Clip>> clips = import_file((*files)[i], options, result.bytes);
+    if (!clips) return Status(Error{clips.message()});
+    result.clips = std::move(clips).value();
+    return Status::success();
+  });
 } catch (const std::exception& e) {
   // Out of memory or a thread failure outside the workers: report it, never let it escape.
   return Error{std::string("build: ") + e.what()};
@@ -477,11 +551,10 @@ Result<Database> build_database_from_clips(std::span<const Clip> clips, const Bu
                                            BuildReport* report) try {
   std::vector<std::string> names;
   for (const Clip& c : clips) names.push_back(c.name);
-  return build(clips.size(), names, options, report,
-               [&](size_t i, const BuildContext& context, InputResult& result,
-                   WorkerScratch& scratch) -> Status {
-                 return process_clip(clips[i], names[i], context, scratch, result);
-               });
+  return build(clips.size(), names, options, report, [&](size_t i, InputResult& result) {
+    result.clips.assign(1, clips[i]);
+    return Status::success();
+  });
 } catch (const std::exception& e) {
   return Error{std::string("build: ") + e.what()};
 }

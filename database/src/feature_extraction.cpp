@@ -104,6 +104,11 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
   glm::vec3* gv = scratch.global_velocities.data();
   glm::vec3* gw = scratch.global_angular_velocities.data();
 
+  scratch.needed.assign(joints, 0);
+  for (const int bone : channel_bones) {
+    for (int j = bone; j >= 0 && !scratch.needed[j]; j = clip.parents[j]) scratch.needed[j] = 1;
+  }
+
   const FeatureFrameMargins margins = feature_frame_margins(schema, clip.frame_time);
   const float rate = 1.0f / clip.frame_time;
   const glm::vec3 forward(0.0f, 0.0f, 1.0f);
@@ -111,9 +116,11 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
   for (int f = 0; f < frames; ++f) {
     searchable[f] = (f >= margins.before && f + margins.after <= frames - 1) ? 1 : 0;
 
-    // Forward kinematics of positions, rotations and their derivatives down the hierarchy.
+    // Forward kinematics of positions, rotations and their derivatives down the hierarchy,
+    // for the channel bones and their ancestors only.
     const size_t base = static_cast<size_t>(f) * joints;
     for (int j = 0; j < joints; ++j) {
+      if (!scratch.needed[j]) continue;
       const glm::vec3& lp = clip.local_positions[base + j];
       const glm::quat& lq = clip.local_rotations[base + j];
       const glm::vec3& lv = clip.local_velocities[base + j];

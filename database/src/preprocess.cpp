@@ -36,9 +36,18 @@ void smooth_gaussian_linear(std::span<const glm::vec3> in, float sigma_frames,
   for (int k = 0; k <= radius; ++k) {
     weights[k] = std::exp(-0.5f * static_cast<float>(k * k) / (sigma_frames * sigma_frames));
   }
+  float full_sum = weights[0];
+  for (int k = 1; k <= radius; ++k) full_sum += 2.0f * weights[k];
   for (int f = 0; f < n; ++f) {
     const int lo = std::max(0, f - radius);
     const int hi = std::min(n - 1, f + radius);
+    if (lo == f - radius && hi == f + radius) {
+      // A whole, symmetric window: the linear term vanishes and this is a Gaussian filter.
+      glm::vec3 sum = weights[0] * in[f];
+      for (int k = 1; k <= radius; ++k) sum += weights[k] * (in[f - k] + in[f + k]);
+      out[f] = sum / full_sum;
+      continue;
+    }
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
     glm::dvec3 t0(0.0), t1(0.0);
     for (int i = lo; i <= hi; ++i) {
@@ -54,6 +63,25 @@ void smooth_gaussian_linear(std::span<const glm::vec3> in, float sigma_frames,
     out[f] = std::abs(s1) < 1e-9 || det <= 1e-12 ? glm::vec3(t0 / s0)
                                                  : glm::vec3((s2 * t0 - s1 * t1) / det);
   }
+}
+
+// The rotation vector of a unit quaternion like quat_to_scaled_angle_axis, faster for the
+// small rotations between neighbouring frames: for |angle| < ~29 degrees a series for atan
+// (error below 1e-9 relative) replaces atan2; larger rotations take the exact path.
+glm::vec3 small_rotation_vector(const glm::quat& rotation) {
+  const glm::quat q = rotation.w < 0.0f ? -rotation : rotation;
+  const glm::vec3 v(q.x, q.y, q.z);
+  const float s2 = glm::dot(v, v);
+  if (s2 < 0.0625f * q.w * q.w) {
+    // 2 atan(s / w) / s = (2 / w) (1 - x/3 + x^2/5 - ...), x = s^2 / w^2 <= 1/16.
+    const float x = s2 / (q.w * q.w);
+    const float series =
+        1.0f + x * (-1.0f / 3 +
+                    x * (1.0f / 5 +
+                         x * (-1.0f / 7 + x * (1.0f / 9 + x * (-1.0f / 11 + x * (1.0f / 13))))));
+    return v * (2.0f * series / q.w);
+  }
+  return quat_to_scaled_angle_axis(q);
 }
 
 // Replaces each run of contact values by the majority of its neighbourhood (width frames,
@@ -177,13 +205,35 @@ void compute_local_velocities(std::span<const glm::vec3> positions,
     for (size_t j = 0; j < joints; ++j) {
       velocities[out + j] = (positions[ib + j] - positions[ia + j]) * inv_dt;
       angular_velocities[out + j] =
-          quat_to_scaled_angle_axis(rotations[ib + j] * glm::conjugate(rotations[ia + j])) * inv_dt;
+          small_rotation_vector(rotations[ib + j] * glm::conjugate(rotations[ia + j])) * inv_dt;
     }
   }
 }
 
 Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
                        const PreprocessOptions& options, ProcessedClip& out,
+                       PreprocessScratch& scratch) {
+  const size_t frames = clip.frame_count > 0 ? static_cast<size_t>(clip.frame_count) : 0;
+  const size_t values = frames * static_cast<size_t>(clip.joint_count() + 1);
+  out.name = clip.name;
+  out.source_path = clip.source_path;
+  out.frame_count = clip.frame_count;
+  out.joint_count = clip.joint_count() + 1;
+  out.frame_time = clip.frame_time;
+  out.local_positions.resize(values);
+  out.local_rotations.resize(values);
+  out.local_velocities.resize(values);
+  out.local_angular_velocities.resize(values);
+  out.contacts.resize(frames * 2);
+  return preprocess_clip(
+      clip, roles, options,
+      ClipMotionOutput{out.local_positions, out.local_rotations, out.local_velocities,
+                       out.local_angular_velocities, out.contacts},
+      scratch);
+}
+
+Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
+                       const PreprocessOptions& options, const ClipMotionOutput& out,
                        PreprocessScratch& scratch) {
   const int joints = clip.joint_count();
   const int frames = clip.frame_count;
@@ -203,13 +253,33 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
     return Error{where + "the hips forward axis must be a finite, non-zero vector"};
   }
 
-  // Global transforms of every frame (FK), needed for the root, the contacts and the roots'
-  // new locals.
+  const int out_joints = joints + 1;
+  const size_t values = static_cast<size_t>(frames) * out_joints;
+  if (out.local_positions.size() != values || out.local_rotations.size() != values ||
+      out.local_velocities.size() != values || out.local_angular_velocities.size() != values ||
+      out.contacts.size() != static_cast<size_t>(frames) * 2) {
+    return Error{where + "the output arrays do not hold frames * (joints + 1) values"};
+  }
+
+  // Global transforms (FK) of the joints the root and the contacts need, the source roots and
+  // their ancestors; the other joints keep their locals and need no global.
   const std::vector<int>& parents = clip.skeleton.parents();
+  scratch.needed.assign(joints, 0);
+  for (const int role :
+       {roles.hips, roles.left_foot, roles.right_foot, roles.left_toe, roles.right_toe}) {
+    for (int j = role; j >= 0 && !scratch.needed[j]; j = parents[j]) scratch.needed[j] = 1;
+  }
+  for (int j = 0; j < joints; ++j) {
+    if (parents[j] < 0) scratch.needed[j] = 1;
+  }
   scratch.globals.resize(static_cast<size_t>(frames) * joints);
   for (int f = 0; f < frames; ++f) {
-    forward_kinematics(parents, clip.pose(f),
-                       std::span(scratch.globals).subspan(static_cast<size_t>(f) * joints, joints));
+    const std::span<const Transform> pose = clip.pose(f);
+    Transform* g = scratch.globals.data() + static_cast<size_t>(f) * joints;
+    for (int j = 0; j < joints; ++j) {
+      if (!scratch.needed[j]) continue;
+      g[j] = parents[j] < 0 ? pose[j] : compose(g[parents[j]], pose[j]);
+    }
   }
   auto global = [&](int f, int j) -> const Transform& {
     return scratch.globals[static_cast<size_t>(f) * joints + j];
@@ -239,19 +309,6 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
     }
   }
 
-  const int out_joints = joints + 1;
-  const size_t values = static_cast<size_t>(frames) * out_joints;
-  out.name = clip.name;
-  out.source_path = clip.source_path;
-  out.frame_count = frames;
-  out.joint_count = out_joints;
-  out.frame_time = dt;
-  out.local_positions.resize(values);
-  out.local_rotations.resize(values);
-  out.local_velocities.resize(values);
-  out.local_angular_velocities.resize(values);
-  out.contacts.resize(static_cast<size_t>(frames) * 2);
-
   // Joint 0 positions (smoothed or not) go straight into the output.
   smooth_gaussian_linear(scratch.positions, options.root.position_smoothing / dt, scratch.smoothed,
                          scratch.weights);
@@ -278,9 +335,15 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
     const Transform to_simulation = inverse(simulation);
     const std::span<const Transform> pose = clip.pose(f);
     for (int j = 0; j < joints; ++j) {
-      Transform t = parents[j] < 0 ? compose(to_simulation, global(f, j)) : pose[j];
-      out.local_positions[base + 1 + j] = t.translation;
-      out.local_rotations[base + 1 + j] = glm::normalize(t.rotation);
+      if (parents[j] < 0) {
+        // Re-rooted: a product of rotations, renormalized against rounding drift.
+        const Transform t = compose(to_simulation, global(f, j));
+        out.local_positions[base + 1 + j] = t.translation;
+        out.local_rotations[base + 1 + j] = glm::normalize(t.rotation);
+      } else {
+        out.local_positions[base + 1 + j] = pose[j].translation;
+        out.local_rotations[base + 1 + j] = pose[j].rotation;
+      }
     }
   }
 

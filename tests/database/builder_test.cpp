@@ -442,9 +442,10 @@ TEST(BuilderOptions, RateManifestAndProgress) {
   BuildReport report;
   Result<Database> db = build_database(inputs, options, &report);
   ASSERT_TRUE(db) << db.message();
-  EXPECT_EQ(calls, 2u);
-  EXPECT_EQ(last_done, 2u);
-  EXPECT_EQ(last_total, 2u);
+  // Each input counts twice: imported, then processed.
+  EXPECT_EQ(calls, 4u);
+  EXPECT_EQ(last_done, 4u);
+  EXPECT_EQ(last_total, 4u);
   EXPECT_FLOAT_EQ(db->frame_time, 1.0f / 60.0f);
   const Built& b = built();
   // At 60 Hz a clip of n frames at 30 Hz becomes 2n - 1 frames; 1 s of features is 60 frames.

@@ -43,7 +43,8 @@ int usage_error(const std::string& message) {
   return 2;
 }
 
-// Draws a progress bar on a terminal, or prints a plain line every 10 % otherwise.
+// Draws a progress bar on a terminal, or prints a plain line every 10 % otherwise. The builder
+// counts each file twice (read, then processed).
 class Progress {
  public:
   explicit Progress(bool enabled) : enabled_(enabled), terminal_(isatty(fileno(stderr)) != 0) {}
@@ -52,15 +53,15 @@ class Progress {
     if (terminal_) {
       const int width = 40;
       const int filled = static_cast<int>(width * done / total);
-      std::fprintf(stderr, "\r[%s%s] %zu/%zu files", std::string(filled, '#').c_str(),
-                   std::string(width - filled, '.').c_str(), done, total);
+      std::fprintf(stderr, "\r[%s%s] %3d %%", std::string(filled, '#').c_str(),
+                   std::string(width - filled, '.').c_str(), static_cast<int>(100 * done / total));
       if (done == total) std::fprintf(stderr, "\n");
       std::fflush(stderr);
     } else {
       const size_t decile = done * 10 / total;
       if (decile > last_decile_ || done == total) {
         last_decile_ = decile;
-        std::fprintf(stderr, "mm build: %zu/%zu files\n", done, total);
+        std::fprintf(stderr, "mm build: %3d %%\n", static_cast<int>(100 * done / total));
       }
     }
   }
@@ -156,10 +157,10 @@ int run_build(const std::vector<std::string>& args) {
                 human_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
     print_database_summary(stdout, *db, ec ? 0 : static_cast<uint64_t>(size));
     std::printf(
-        "time:        %.2f s (import and preprocessing %.2f s on %d threads, assembly "
-        "%.2f s, writing %.2f s)\n",
-        seconds, report.load_seconds, report.threads, report.assemble_seconds,
-        seconds - report.total_seconds);
+        "time:        %.2f s on %d threads (reading %.2f s, layout %.2f s, processing %.2f s, "
+        "normalizing %.2f s, writing %.2f s)\n",
+        seconds, report.threads, report.load_seconds, report.layout_seconds, report.process_seconds,
+        report.finish_seconds, seconds - report.total_seconds);
   }
   return 0;
 }

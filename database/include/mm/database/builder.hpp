@@ -1,15 +1,16 @@
 #pragma once
 // The database builder: files (or in-memory clips) in, one Database out.
 //
-// Per input, in parallel (workers pull inputs from a shared counter, each with its own reusable
-// buffers): import (BVH or glTF), validate, resample to the database rate, find the joint
-// roles, preprocess (simulation root, velocities, contacts; see preprocess.hpp), extract the raw
-// features of the clip (feature_extraction.hpp), optionally the same for its mirrored copy, and
-// tag it (tags.hpp). Then, in input order: check that every clip has the first clip's topology,
-// concatenate the clips into the flat arrays, normalize the features over the searchable frames
-// of the whole database, and validate the result. Every per-clip step is independent of the
-// others and the statistics are summed in a fixed order, so the output is byte-for-byte the
-// same whatever the number of threads.
+// Four phases. 1, parallel over inputs (workers pull input indices from a shared counter):
+// import (BVH or glTF), validate, resample to the database rate, find the joint roles. 2, in
+// input order: refuse failed inputs and skeletons other than the first input's, lay out the
+// clip ranges (a mirrored copy right after its original), their tags and the database arrays.
+// 3, parallel over clips, each worker with its own reusable buffers: preprocess (simulation
+// root, velocities, contacts; see preprocess.hpp) and extract the raw features
+// (feature_extraction.hpp) straight into the database arrays at the clip's frames. 4:
+// normalize the features over the searchable frames of the whole database and validate the
+// result. Every per-clip step is independent of the others and the statistics are summed in
+// frame order, so the output is byte-for-byte the same whatever the number of threads.
 //
 // Inputs are files or folders. Folders are scanned recursively for .bvh, .gltf and .glb files
 // (extensions compared case-insensitively), sorted by path; files given by name are taken in
@@ -58,8 +59,9 @@ struct BuildOptions {
   bool skip_bad = false;
   // Worker threads; 0 uses every hardware thread. Never more than there are inputs.
   int threads = 0;
-  // Called after each input is done (done, total), from the worker threads but never two at a
-  // time. May be empty.
+  // Called with (done, total) as the build advances, from the worker threads but never two at
+  // a time; total = 2 x inputs: each input counts once when imported and once when processed.
+  // May be empty.
   std::function<void(size_t done, size_t total)> progress;
   // Settings of the BVH importer (its scale turns file units into metres).
   BvhOptions bvh;
@@ -80,8 +82,10 @@ struct BuildReport {
   double duration_s = 0.0;            // frames / rate
   uint64_t bytes_read = 0;            // bytes of the files that were read
   int threads = 0;                    // worker threads used
-  double load_seconds = 0.0;          // wall time of import + preprocessing + raw features
-  double assemble_seconds = 0.0;      // wall time of concatenation, normalization, validation
+  double load_seconds = 0.0;          // wall time of phase 1: import, validation, resampling
+  double layout_seconds = 0.0;        // phase 2: checks, clip ranges, tags, array allocation
+  double process_seconds = 0.0;       // phase 3: preprocessing and raw features
+  double finish_seconds = 0.0;        // phase 4: normalization and the final validation
   double total_seconds = 0.0;         // wall time of the whole build
   std::vector<std::string> warnings;  // e.g. feature channels that do not vary
   std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)

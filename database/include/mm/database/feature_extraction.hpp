@@ -63,6 +63,7 @@ struct FeatureScratch {
   std::vector<glm::quat> global_rotations;
   std::vector<glm::vec3> global_velocities;
   std::vector<glm::vec3> global_angular_velocities;
+  std::vector<uint8_t> needed;  // per joint: a channel bone or one of their ancestors
 };
 
 // Whole frames a frame needs before and after it (so that every time of every trajectory

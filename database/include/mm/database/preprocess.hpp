@@ -145,9 +145,21 @@ struct ProcessedClip {
   std::vector<uint8_t> contacts;                    // [frame * 2 + 0] left, + 1 right
 };
 
+// Where preprocess_clip writes one clip's database arrays (e.g. straight into a Database's
+// arrays at the clip's first frame). The four joint arrays hold frame_count * (source joints
+// + 1) values, frame-major; contacts hold frame_count * 2.
+struct ClipMotionOutput {
+  std::span<glm::vec3> local_positions;
+  std::span<glm::quat> local_rotations;
+  std::span<glm::vec3> local_velocities;
+  std::span<glm::vec3> local_angular_velocities;
+  std::span<uint8_t> contacts;
+};
+
 // Buffers preprocess_clip reuses between clips so that its per-frame loops do not allocate.
 struct PreprocessScratch {
-  std::vector<Transform> globals;  // frames * source joints
+  std::vector<Transform> globals;  // frames * source joints (only the joints needed are set)
+  std::vector<uint8_t> needed;     // per source joint: its global transform is computed
   std::vector<glm::vec3> directions;
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> smoothed;
@@ -170,6 +182,12 @@ struct PreprocessScratch {
 // - Contacts as described by ContactOptions.
 Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
                        const PreprocessOptions& options, ProcessedClip& out,
+                       PreprocessScratch& scratch);
+
+// The same, writing into caller-owned arrays of exactly the sizes ClipMotionOutput describes
+// (a size mismatch is an error).
+Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
+                       const PreprocessOptions& options, const ClipMotionOutput& out,
                        PreprocessScratch& scratch);
 
 // Finite-difference velocities and angular velocities of frame-major local positions and
