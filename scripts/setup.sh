@@ -30,7 +30,9 @@ case "$config" in
   release)
     cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DMM_WERROR=ON >/dev/null ;;
   asan)
+    # Optimized but with asserts on (no NDEBUG), so the sanitizer pass also checks them.
     cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON -DMM_WERROR=ON \
+      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
       -DMM_BUILD_BENCH=OFF >/dev/null ;;
   fuzz)
     CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_BUILD_FUZZ=ON \
