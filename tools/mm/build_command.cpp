@@ -32,6 +32,11 @@ options:
   --skip-bad          build from the good files and list the refused ones, instead of failing
   --threads N         worker threads (default 0: all hardware threads)
   --scale S           BVH units to metres (default 0.01: centimetres)
+  --role ROLE=JOINT   the joint playing a role (hips, left_foot, right_foot, left_toe,
+                      right_toe, head), instead of the name-based default; repeatable
+  --mirror-pair L=R   two joints that swap when mirroring, besides the detected _L/_R,
+                      Left/Right, .L/.R, l_/r_ pairs; repeatable
+  --forward-axis X,Y,Z  the hips' bone-local forward axis (default 0,0,1, the Bandai hips')
   --quiet             no progress and no summary
   -h, --help          this text
 
@@ -113,6 +118,55 @@ int run_build(const std::vector<std::string>& args) {
       const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
       if (!s || *s <= 0.0) return usage_error("--scale needs a positive number");
       options.bvh.scale = static_cast<float>(*s);
+    } else if (a == "--role") {
+      const std::string* v = value();
+      const size_t eq = v ? v->find('=') : std::string::npos;
+      if (eq == std::string::npos || eq == 0 || eq + 1 == v->size()) {
+        return usage_error("--role needs ROLE=JOINT, e.g. --role left_foot=LeftAnkle");
+      }
+      const std::string role = v->substr(0, eq);
+      std::vector<std::string> joint = {v->substr(eq + 1)};
+      if (role == "hips") {
+        options.roles.hips = joint;
+      } else if (role == "left_foot") {
+        options.roles.left_foot = joint;
+      } else if (role == "right_foot") {
+        options.roles.right_foot = joint;
+      } else if (role == "left_toe") {
+        options.roles.left_toe = joint;
+      } else if (role == "right_toe") {
+        options.roles.right_toe = joint;
+      } else if (role == "head") {
+        options.roles.head = joint;
+      } else {
+        return usage_error("unknown role '" + role +
+                           "' (roles: hips, left_foot, right_foot, left_toe, right_toe, head)");
+      }
+    } else if (a == "--mirror-pair") {
+      const std::string* v = value();
+      const size_t eq = v ? v->find('=') : std::string::npos;
+      if (eq == std::string::npos || eq == 0 || eq + 1 == v->size()) {
+        return usage_error("--mirror-pair needs LEFT=RIGHT joint names");
+      }
+      options.mirror_pairs.push_back({v->substr(0, eq), v->substr(eq + 1)});
+    } else if (a == "--forward-axis") {
+      const std::string* v = value();
+      glm::vec3 axis(0.0f);
+      bool good = v != nullptr;
+      size_t start = 0;
+      for (int k = 0; k < 3 && good; ++k) {
+        const size_t comma = k < 2 ? v->find(',', start) : v->size();
+        good = comma != std::string::npos;
+        if (!good) break;
+        const std::optional<double> x = parse_number(v->substr(start, comma - start));
+        good = x.has_value();
+        if (good) axis[k] = static_cast<float>(*x);
+        start = comma + 1;
+      }
+      if (!good || glm::length(axis) < 1e-6f) {
+        return usage_error("--forward-axis needs three numbers X,Y,Z, not all zero");
+      }
+      options.root.hips_forward_axis = axis;
     } else if (a == "--quiet") {
       quiet = true;
     } else if (!a.empty() && a[0] == '-') {
@@ -130,7 +184,10 @@ int run_build(const std::vector<std::string>& args) {
   BuildReport report;
   Result<Database> db = build_database(inputs, options, &report);
   if (!db) {
-    std::fprintf(stderr, "mm build: %s\n", db.message().c_str());
+    // The builder's own messages start with "build: ", which the prefix here already says.
+    std::string message = db.message();
+    if (message.rfind("build: ", 0) == 0) message.erase(0, 7);
+    std::fprintf(stderr, "mm build: %s\n", message.c_str());
     return 1;
   }
   if (Status s = save_database(*db, output); !s) {
