@@ -21,6 +21,11 @@ namespace {
 // input; real skeletons have tens of joints, and the 100,000-deep stress case stays far below.
 constexpr int kMaxJoints = 1'000'000;
 constexpr int kMaxChannelsPerJoint = 6;
+// Joints without channels cost hierarchy bytes once but a transform in every frame, so a small
+// hostile file could expand quadratically. Real files stay far below this many transforms per
+// byte of text (the clips here: 0.04); past it, the file is refused before allocating.
+constexpr size_t kMaxTransformsPerByte = 16;
+constexpr size_t kTransformAllowance = 1 << 16;
 constexpr float kHalfDegreesToRadians = 3.14159265358979323846f / 360.0f;
 
 // 10^-k rounded to double. Exact powers are not needed: see parse_plain_decimal.
@@ -161,7 +166,7 @@ struct OpenJoint {
 class BvhParser {
  public:
   BvhParser(std::string_view text, std::string_view path, const BvhOptions& options)
-      : p_(text.data()), end_(text.data() + text.size()), path_(path),
+      : p_(text.data()), end_(text.data() + text.size()), text_size_(text.size()), path_(path),
         scale_(options.scale) {}
 
   Result<Clip> run() {
@@ -465,7 +470,16 @@ class BvhParser {
     const size_t max_frames_in_text = remaining / (2 * static_cast<size_t>(value_count)) + 1;
     const size_t reserve_frames =
         std::min(static_cast<size_t>(declared_frames_), max_frames_in_text);
-    local_.resize(reserve_frames * static_cast<size_t>(joint_count));
+    const size_t reserve_transforms = reserve_frames * static_cast<size_t>(joint_count);
+    if (reserve_transforms > kMaxTransformsPerByte * text_size_ + kTransformAllowance) {
+      return fail(motion_line_,
+                  "expected at most " + std::to_string(kMaxTransformsPerByte) +
+                      " joint transforms per byte of the file, found " +
+                      std::to_string(joint_count) + " joints but only " +
+                      std::to_string(value_count) + " channels per frame for up to " +
+                      std::to_string(reserve_frames) + " frames (too many joints without channels)");
+    }
+    local_.resize(reserve_transforms);
     std::vector<float> values(static_cast<size_t>(value_count));
 
     const char* p = p_;
@@ -484,7 +498,7 @@ class BvhParser {
                               " frames as declared by 'Frames:' on line " +
                               std::to_string(frames_line_) +
                               ", found more: this line would be frame " +
-                              std::to_string(frames + 1));
+                              std::to_string(int64_t{frames} + 1));
       }
       // The line's '\n' is the sentinel that bounds every loop of parse_frame_line. The last
       // line may have none: it is parsed from a copy that has one.
@@ -615,6 +629,7 @@ class BvhParser {
 
   const char* p_;
   const char* end_;
+  size_t text_size_;
   std::string_view path_;
   float scale_;
   int64_t line_ = 1;  // 64-bit: a multi-gigabyte file of newlines must not overflow a counter
@@ -639,12 +654,19 @@ class BvhParser {
 
 Result<Clip> parse_bvh(std::string_view text, std::string_view path_for_messages,
                        const BvhOptions& options) {
-  BvhParser parser(text, path_for_messages, options);
-  return parser.run();
+  // Nothing may escape to the caller: an allocation failure becomes an error like any other.
+  try {
+    BvhParser parser(text, path_for_messages, options);
+    return parser.run();
+  } catch (const std::exception& exception) {
+    return Error{std::string(path_for_messages) + ": cannot import (" + exception.what() + ")"};
+  }
 }
 
-Result<Clip> load_bvh(const std::filesystem::path& path, const BvhOptions& options) {
-  const std::string name = path.string();
+namespace {
+
+Result<Clip> read_and_parse(const std::filesystem::path& path, const std::string& name,
+                            const BvhOptions& options) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"), &std::fclose);
   if (!file) {
     return Error{name + ": cannot open the file for reading (" + std::strerror(errno) + ")"};
@@ -674,6 +696,17 @@ Result<Clip> load_bvh(const std::filesystem::path& path, const BvhOptions& optio
     }
   }
   return parse_bvh(std::string_view(buffer.get(), used), name, options);
+}
+
+}  // namespace
+
+Result<Clip> load_bvh(const std::filesystem::path& path, const BvhOptions& options) {
+  const std::string name = path.string();
+  try {
+    return read_and_parse(path, name, options);
+  } catch (const std::exception& exception) {
+    return Error{name + ": cannot import (" + exception.what() + ")"};
+  }
 }
 
 }  // namespace mm

@@ -678,6 +678,26 @@ TEST(BvhStress, HugeDeclaredFrameCountWithLittleDataIsRefused) {
                  {"expected 2147483647 frames", "found 2"});
 }
 
+TEST(BvhStress, ManyJointsWithoutChannelsCannotExpandASmallFile) {
+  // 2000 joints, one channel: each 2-byte frame line would become 2000 transforms (80 kB).
+  std::string text = "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 1 Xposition\n";
+  for (int i = 0; i < 2000; ++i) {
+    text += "JOINT j" + std::to_string(i) + "\n{\nOFFSET 0 0 0\nCHANNELS 0\n}\n";
+  }
+  text += "}\n";
+  const int motion_line = last_line_number(text);
+  text += "MOTION\nFrames: 5000\nFrame Time: 0.1\n";
+  for (int i = 0; i < 5000; ++i) text += "1\n";
+  expect_refused(text, motion_line, {"expected at most 16 joint transforms per byte",
+                                     "2001 joints", "without channels"}, "wide.bvh");
+  // The same skeleton with a few frames is a legitimate file.
+  const std::string few = text.substr(0, text.find("Frames:")) + "Frames: 3\nFrame Time: 0.1\n1\n2\n3\n";
+  Result<Clip> clip = parse_bvh(few, "wide.bvh");
+  ASSERT_TRUE(clip.ok()) << clip.message();
+  EXPECT_EQ(clip->joint_count(), 2001);
+  EXPECT_NEAR(clip->pose(2)[0].translation.x, 0.03f, 1e-7f);
+}
+
 TEST(BvhStress, LongGarbageTokenIsCutShortInTheMessage) {
   const std::string garbage(100000, 'x');
   Result<Clip> clip = parse_bvh(fixture_with_line(19, garbage), kFixturePath);
