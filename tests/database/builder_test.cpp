@@ -12,6 +12,7 @@
 #include "mm/database/bvh.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
+#include "mm/database/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
@@ -501,6 +502,30 @@ TEST(BuilderOptions, ClipsTooShortToMatchAreReported) {
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("dataset-1_dash_normal_001"), std::string::npos);
   EXPECT_EQ(report.searchable_frames, db->clips[1].frame_count() - 30);
+}
+
+TEST(BuilderOptions, GltfInputBuildsLikeTheBvhItCameFrom) {
+  // The walk written as .glb (metres, 30 Hz) and read back through the glTF importer gives
+  // the same database as the BVH itself.
+  const fs::path dir = test::scratch_dir();
+  Result<Clip> walk = load_bvh(test::clip_path(kClips[0]));
+  ASSERT_TRUE(walk) << walk.message();
+  ASSERT_TRUE(save_gltf(*walk, dir / "walk.glb"));
+  const fs::path from_gltf[] = {dir / "walk.glb"};
+  const fs::path from_bvh[] = {test::clip_path(kClips[0])};
+  Result<Database> a = build_database(from_gltf, BuildOptions{});
+  ASSERT_TRUE(a) << a.message();
+  Result<Database> b = build_database(from_bvh, BuildOptions{});
+  ASSERT_TRUE(b) << b.message();
+  ASSERT_EQ(a->frame_count, b->frame_count);
+  ASSERT_EQ(a->joint_count(), b->joint_count());
+  EXPECT_EQ(a->skeleton.names(), b->skeleton.names());
+  ASSERT_EQ(a->features.size(), b->features.size());
+  std::vector<float> raw_a = a->features, raw_b = b->features;
+  denormalize_features(raw_a, a->feature_offset, a->feature_scale);
+  denormalize_features(raw_b, b->feature_offset, b->feature_scale);
+  for (size_t i = 0; i < raw_a.size(); ++i) ASSERT_NEAR(raw_a[i], raw_b[i], 1e-3f) << i;
+  EXPECT_EQ(a->contacts, b->contacts);
 }
 
 // ---- End to end --------------------------------------------------------------------------------
