@@ -9,8 +9,10 @@
 //   value) building the same transforms, i.e. what a straightforward importer does;
 // - from_chars scan: only splitting the text at whitespace and running std::from_chars on
 //   every token, no structure or transforms: roughly the ceiling for a from_chars parser.
-// Then prints parse_bvh's speed as a ratio against each of them. The data folder is $MM_DATA,
-// else MM_SHARED_DIR/mocap/bandai-normal.
+// Then prints parse_bvh's speed as a ratio against each of them. Rates use CPU time (the target
+// is per core, and the machine may be shared); with --benchmark_repetitions=N the summary takes
+// each benchmark's best repetition. The data folder is $MM_DATA, else
+// MM_SHARED_DIR/mocap/bandai-normal.
 
 #include <benchmark/benchmark.h>
 
@@ -84,7 +86,7 @@ void BM_ParseBvh(benchmark::State& state) {
   state.SetBytesProcessed(state.iterations() * total_bytes());
   state.counters["files"] = static_cast<double>(files().size());
 }
-BENCHMARK(BM_ParseBvh)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ParseBvh)->Unit(benchmark::kMillisecond);
 
 void BM_LoadBvh(benchmark::State& state) {
   for (auto _ : state) {
@@ -99,7 +101,7 @@ void BM_LoadBvh(benchmark::State& state) {
   }
   state.SetBytesProcessed(state.iterations() * total_bytes());
 }
-BENCHMARK(BM_LoadBvh)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_LoadBvh)->Unit(benchmark::kMillisecond);
 
 // The baseline: the obvious iostream importer. Returns the number of transforms built.
 size_t baseline_iostream_parse(const std::string& text, std::vector<mm::Transform>& local) {
@@ -174,7 +176,7 @@ void BM_BaselineIostream(benchmark::State& state) {
   }
   state.SetBytesProcessed(state.iterations() * total_bytes());
 }
-BENCHMARK(BM_BaselineIostream)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_BaselineIostream)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // Whitespace split plus from_chars on every token: no structure, no transforms.
 void BM_FromCharsScan(benchmark::State& state) {
@@ -195,16 +197,19 @@ void BM_FromCharsScan(benchmark::State& state) {
   }
   state.SetBytesProcessed(state.iterations() * total_bytes());
 }
-BENCHMARK(BM_FromCharsScan)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FromCharsScan)->Unit(benchmark::kMillisecond);
 
-// Keeps each benchmark's bytes per second so main() can print ratios after the run.
+// Keeps each benchmark's best bytes per second (over repetitions, ignoring the mean/median/cv
+// rows) so main() can print ratios after the run.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& run : runs) {
-      if (run.error_occurred) continue;
+      if (run.error_occurred || run.run_type == Run::RT_Aggregate) continue;
       auto it = run.counters.find("bytes_per_second");
-      if (it != run.counters.end()) bytes_per_second[run.benchmark_name()] = it->second.value;
+      if (it == run.counters.end()) continue;
+      double& best = bytes_per_second[run.run_name.function_name];
+      best = std::max(best, it->second.value);
     }
     ConsoleReporter::ReportRuns(runs);
   }
@@ -222,14 +227,12 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const auto& rates = reporter.bytes_per_second;
   const auto find = [&](const char* name) {
-    for (const auto& [key, value] : rates) {
-      if (key.rfind(name, 0) == 0) return value;
-    }
-    return 0.0;
+    auto it = rates.find(name);
+    return it == rates.end() ? 0.0 : it->second;
   };
   const double parse = find("BM_ParseBvh");
   if (parse > 0.0) {
-    std::printf("\nparse_bvh: %.0f MB/s (target 600 MB/s on one core)\n", parse / 1e6);
+    std::printf("\nparse_bvh: %.0f MB/s per core, CPU time (target 600 MB/s)\n", parse / 1e6);
     const char* baselines[] = {"BM_LoadBvh", "BM_BaselineIostream", "BM_FromCharsScan"};
     for (const char* name : baselines) {
       const double other = find(name);

@@ -484,6 +484,10 @@ class BvhParser {
 
     const char* p = p_;
     const char* const end = end_;
+    // Every line that starts before the text's last '\n' ends in one: that '\n' is the sentinel
+    // that bounds every loop of parse_frame_line. A last line without one is parsed from a copy.
+    const char* lines_end = end;
+    while (lines_end > p && lines_end[-1] != '\n') --lines_end;
     int64_t line = line_;
     int frames = 0;
     for (;;) {
@@ -500,18 +504,13 @@ class BvhParser {
                               ", found more: this line would be frame " +
                               std::to_string(int64_t{frames} + 1));
       }
-      // The line's '\n' is the sentinel that bounds every loop of parse_frame_line. The last
-      // line may have none: it is parsed from a copy that has one.
-      const void* newline = std::memchr(p, '\n', static_cast<size_t>(end - p));
-      if (newline != nullptr) {
+      if (p < lines_end) {
         if (auto error = parse_frame_line(p, line, frames, values.data(), false)) return error;
-        p = static_cast<const char*>(newline);
       } else {
         std::string last_line(p, end);
         last_line += '\n';
-        if (auto error = parse_frame_line(last_line.data(), line, frames, values.data(), true)) {
-          return error;
-        }
+        const char* copy = last_line.data();
+        if (auto error = parse_frame_line(copy, line, frames, values.data(), true)) return error;
         p = end;
       }
       if (auto error = store_frame(values.data(), frames, line)) return error;
@@ -530,8 +529,9 @@ class BvhParser {
     return nullptr;
   }
 
-  // Reads exactly channel_total_ numbers from the line starting at p, which ends in '\n'.
-  MaybeError parse_frame_line(const char* p, int64_t line, int frame, float* values,
+  // Reads exactly channel_total_ numbers from the line starting at p, which ends in '\n', and
+  // leaves p on that '\n'.
+  MaybeError parse_frame_line(const char*& p, int64_t line, int frame, float* values,
                               bool last_line) const {
     const int value_count = channel_total_;
     for (int i = 0; i < value_count; ++i) {
