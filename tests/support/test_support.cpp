@@ -2,16 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-
 namespace mm::test {
 
 std::filesystem::path mocap_dir() { return std::filesystem::path(MM_SHARED_DIR) / "mocap"; }
 
-std::filesystem::path data_dir() {
-  if (const char* env = std::getenv("MM_DATA"); env && *env) return env;
-  return mocap_dir() / "bandai-normal";
-}
+// Tests assert facts about the Bandai files (counts, names), so they always read that folder;
+// MM_DATA only redirects the run command.
+std::filesystem::path data_dir() { return mocap_dir() / "bandai-normal"; }
 
 std::filesystem::path scratch_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();

@@ -6,7 +6,7 @@
 
 namespace mm::test {
 
-// The folder of real BVH clips: $MM_DATA if set, else ../shared/mocap/bandai-normal.
+// The folder of real BVH clips the tests assert facts about: ../shared/mocap/bandai-normal.
 std::filesystem::path data_dir();
 // ../shared/mocap (the archive and licence live here).
 std::filesystem::path mocap_dir();
