@@ -33,7 +33,7 @@ printf '\n=== 2/4 Database summary ===\n'
 printf '\n=== 3/4 Search benchmark (every method, 2000 queries, noise 0.1) ===\n'
 "$mm" search-bench --db out/database.mmdb --queries 2000 --noise 0.1 --json out/search-bench.json
 
-printf '\n=== 4/4 Exporting clip 0 to glTF ===\n'
-"$mm" export out/database.mmdb --clip 0 -o out/clip0.glb
+printf '\n=== 4/4 Exporting one walk clip to glTF ===\n'
+"$mm" export out/database.mmdb --clip dataset-2_walk_normal_001 -o out/walk.glb
 
-printf '\nDone: out/database.mmdb, out/search-bench.json, out/clip0.glb (opens in Blender).\n'
+printf '\nDone: out/database.mmdb, out/search-bench.json, out/walk.glb (opens in Blender).\n'
