@@ -418,12 +418,32 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
   return file.subspan(static_cast<size_t>(sec.offset), static_cast<size_t>(sec.length));
 }
 
+// Asks the kernel to back [data, data + bytes) with 2 MiB pages where it can. Filling a fresh
+// array costs a page fault per 4 KiB page, more than copying the bytes; 2 MiB pages cut the
+// faults 512-fold and measured twice as fast here. Only a hint: failure changes nothing.
+void advise_huge_pages(void* data, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr uintptr_t kHugePage = uintptr_t{2} << 20;
+  if (bytes < 4 * kHugePage) return;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHugePage - 1) & ~(kHugePage - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHugePage - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
+
 // Copies a fixed-size section whose length parse_header() already matched to the counts.
 template <class T>
 void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
                 std::vector<T>& out) {
   const std::span<const std::byte> bytes = section_bytes(file, info, s);
-  out.resize(bytes.size() / sizeof(T));
+  const size_t count = bytes.size() / sizeof(T);
+  out.clear();
+  out.reserve(count);  // allocates without touching the memory, so the advice applies
+  advise_huge_pages(out.data(), count * sizeof(T));
+  out.resize(count);
   if (bytes.empty()) return;
   if constexpr (std::is_trivially_copyable_v<T>) {
     std::memcpy(out.data(), bytes.data(), bytes.size());
@@ -535,16 +555,17 @@ Status read_skeleton(std::span<const std::byte> file, const DatabaseFileInfo& in
   return Status::success();
 }
 
-// The largest arrays, which a second thread copies on large files while it also hashes: about
-// as many bytes as copy_arrays_b() once the hash is counted.
+// The large arrays in two groups for the two threads: the hashing thread takes rotations,
+// velocities and features (115 MB of 219 MB at 167k frames x 23 joints), the parsing thread
+// positions and angular velocities (92 MB), which balances them once the hash is counted.
 void copy_arrays_a(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
   copy_array(file, info, DatabaseSection::LocalRotations, db.local_rotations);
+  copy_array(file, info, DatabaseSection::LocalVelocities, db.local_velocities);
   copy_array(file, info, DatabaseSection::Features, db.features);
 }
 
 void copy_arrays_b(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
   copy_array(file, info, DatabaseSection::LocalPositions, db.local_positions);
-  copy_array(file, info, DatabaseSection::LocalVelocities, db.local_velocities);
   copy_array(file, info, DatabaseSection::LocalAngularVelocities, db.local_angular_velocities);
 }
 
