@@ -124,6 +124,48 @@ struct ExactRanker {
   static void offer(void* context, int row, float scanned_distance, search_kernels::ScanBest& best);
 };
 
+// The most groups k-means forms, and the most groups a RowGroups may hold (tag classes).
+inline constexpr int kMaxKmeansGroups = 64;
+inline constexpr int kMaxGroups = 256;
+
+// A group's lower bound for one query: the squared distance to its box.
+struct GroupDistance {
+  float distance;
+  int group;
+};
+
+// Groups of candidate rows (k-means, about group_rows each; a dense cluster is split again), with
+// their bounding boxes in the original space and the OR and AND of their rows' tags. Tree
+// methods build one structure per group and visit groups nearest first.
+struct RowGroups {
+  int query_dims = 0;    // columns of a query
+  int padded_dims = 0;   // columns rounded up to a multiple of 8
+  std::vector<float> boxes;  // per group: padded lows, then padded highs
+  std::vector<uint64_t> tags_or;
+  std::vector<uint64_t> tags_and;
+
+  int count() const { return static_cast<int>(tags_or.size()); }
+  size_t memory_bytes() const;
+  // Writes the groups that may pass the tag filter to `out` (room for kMaxGroups), nearest box
+  // first, and returns how many.
+  int order(const float* query, const SearchConstraints& constraints, GroupDistance* out) const;
+  // True when a group at box distance `distance` cannot hold a row better than `best`: the box
+  // distance is a float sum in the original space, and a relative margin covers its rounding.
+  static bool beyond(float distance, float best) { return distance > best * 1.00001f; }
+};
+
+// Groups the candidate rows; `rows_out` receives each group's candidate rows. group_rows <= 0
+// makes one group of all rows.
+RowGroups make_row_groups(const CandidateSet& set, int group_rows,
+                          std::vector<std::vector<int>>& rows_out);
+
+// Boxes and tag summaries of given groups of candidate rows (at most kMaxGroups).
+RowGroups row_groups_of(const CandidateSet& set, const std::vector<std::vector<int>>& rows);
+
+// The candidate rows by the exact tag mask of their clip ("tag classes"), in order of first
+// appearance; empty when there are more than kMaxGroups classes.
+std::vector<std::vector<int>> tag_classes(const CandidateSet& set);
+
 // Factories of the methods (input already validated, options checked by each).
 Result<std::unique_ptr<Searcher>> make_brute(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_brute_simd(const SearchInput& input);

@@ -1,17 +1,25 @@
 // The FLANN-based methods: `kdtree` (flann::KDTreeSingleIndex, exact) and `approx`
 // (flann::KDTreeIndex, randomized trees with a leaf-check budget).
 //
-// Both index the searchable rows only (the mask is fixed when the database is built),
-// optionally in principal-axes coordinates, and apply the per-query rules inside a custom
-// FLANN result set: a row that fails the tag filter or lies in the window is never recorded,
-// and the bound starts at the continuation's distance minus the transition cost. Rows found in
-// the rotated space are decided by their unrotated distance (ExactRanker). The single tree
-// prunes a branch only when its lower bound reaches the threshold, so it stays exact under
-// every constraint.
+// Both index the searchable rows only (the mask is fixed when the database is built), split into
+// k-means groups (RowGroups) with one FLANN index per group, each over the group's principal-axes
+// coordinates. A query visits the groups nearest first by the distance to their bounding box and
+// stops at the first group whose box is farther than the best cost found. Inside a group the
+// per-query rules are applied by a custom FLANN result set: a row that fails the tag filter or
+// lies in the window is never recorded, and the threshold starts at the best so far (at first
+// the continuation's distance minus the transition cost). Rows found in a rotated space are
+// decided by their unrotated distance (ExactRanker). The single trees prune a branch only when
+// its lower bound reaches the threshold, so `kdtree` is exact under every constraint.
 //
-// FLANN allocates inside findNeighbors(): KDTreeSingleIndex a vector of dims floats per query,
-// KDTreeIndex a branch heap (a reserve of one entry per row) and a visited bitset of one bit per
-// row. Those are FLANN's internals; nothing else on these paths allocates.
+// Why groups: FLANN bounds a branch by the cutting planes on its path plus the distance to the
+// root box. With one tree over everything, the root box spans the whole database, and for a
+// noisy query near the dense cluster of standing gestures the bound misses the query's offset in
+// every dimension the path did not cut, so the search visits most of the cluster. A group's root
+// box is tight around the group (in its own axes), so that offset is counted from the start.
+//
+// FLANN allocates inside findNeighbors(): KDTreeSingleIndex a vector of dims floats per call,
+// KDTreeIndex a branch heap (a reserve of one entry per row of the group) and a visited bitset of
+// one bit per row. Those are FLANN's internals; nothing else on these paths allocates.
 
 #include <flann/flann.hpp>
 
@@ -36,7 +44,7 @@ class ConstrainedBestResultSet final : public flann::ResultSet<float> {
   }
 
   // FLANN's randomized trees keep searching past the check budget while this is false: a
-  // result exists once a bound (the continuation) or a passing row is known.
+  // result exists once a bound (the continuation, an earlier group) or a passing row is known.
   bool full() const override {
     return best_.row >= 0 || best_.distance < std::numeric_limits<float>::infinity();
   }
@@ -52,7 +60,7 @@ class ConstrainedBestResultSet final : public flann::ResultSet<float> {
   }
   float worstDist() const override { return best_.distance; }
 
-  int best_row() const { return best_.row; }
+  const search_kernels::ScanBest& best() const { return best_; }
 
  private:
   const search_kernels::RowFilter& filter_;
@@ -74,34 +82,148 @@ struct ApproxTraits {
   static constexpr bool kCopiesRows = false;
 };
 
+// One group: its rows (rotated or not), their candidate rows, frames and tags, and the index.
+template <class Index>
+struct FlannGroup {
+  FeatureRotation rotation;      // empty when the index is over the raw columns
+  std::vector<float> points;     // the group's rows in the index's space (FLANN points into it)
+  std::vector<int> set_rows;     // index row -> candidate row
+  std::vector<int> frames;       // index row -> frame
+  std::vector<uint64_t> tags;    // index row -> clip tags
+  float max_row_norm = 0.0f;
+  std::unique_ptr<Index> index;
+};
+
+// Groups of rows with one index each, their boxes, and the search over them.
+template <class Index>
+struct FlannForest {
+  RowGroups groups;
+  std::vector<FlannGroup<Index>> trees;  // one per group
+  size_t rows = 0;                       // rows over all groups
+
+  bool empty() const { return trees.empty(); }
+
+  // Builds one index per group of candidate rows.
+  Status build(const CandidateSet& set, std::vector<std::vector<int>> rows_of_groups, bool rotate,
+               const flann::IndexParams& params, std::string_view method) {
+    const int dims = set.dims;
+    groups = row_groups_of(set, rows_of_groups);
+    trees.resize(rows_of_groups.size());
+    for (size_t g = 0; g < rows_of_groups.size(); ++g) {
+      FlannGroup<Index>& group = trees[g];
+      group.set_rows = std::move(rows_of_groups[g]);
+      const int count = static_cast<int>(group.set_rows.size());
+      rows += group.set_rows.size();
+      group.points.resize(static_cast<size_t>(count) * dims);
+      for (int i = 0; i < count; ++i) {
+        const int r = group.set_rows[static_cast<size_t>(i)];
+        std::copy_n(set.row(r), dims, group.points.data() + static_cast<size_t>(i) * dims);
+        group.frames.push_back(set.row_frame[static_cast<size_t>(r)]);
+        group.tags.push_back(set.row_tags[static_cast<size_t>(r)]);
+      }
+      if (rotate && count > 0) {
+        group.rotation = principal_axes(group.points.data(), count, dims, 4096);
+        float rotated[kMaxSearchDims];
+        for (int i = 0; i < count; ++i) {
+          float* point = group.points.data() + static_cast<size_t>(i) * dims;
+          group.rotation.apply(point, rotated);
+          std::copy_n(rotated, dims, point);
+          group.max_row_norm = std::max(group.max_row_norm, row_norm(rotated, dims));
+        }
+      }
+      if (count == 0) continue;
+      try {
+        flann::Matrix<float> matrix(group.points.data(), static_cast<size_t>(count),
+                                    static_cast<size_t>(dims));
+        group.index = std::make_unique<Index>(matrix, params);
+        group.index->buildIndex();
+      } catch (const std::exception& e) {
+        return Error{std::string(method) + ": FLANN failed to build an index: " + e.what()};
+      }
+    }
+    return Status::success();
+  }
+
+  size_t memory_bytes(int dims, bool copies_rows) const {
+    size_t bytes = groups.memory_bytes();
+    for (const FlannGroup<Index>& group : trees) {
+      const size_t count = group.set_rows.size();
+      bytes += group.rotation.memory_bytes() + group.points.capacity() * sizeof(float) +
+               group.set_rows.capacity() * sizeof(int) + group.frames.capacity() * sizeof(int) +
+               group.tags.capacity() * sizeof(uint64_t);
+      if (group.index) {
+        // usedMemory() counts FLANN's node pool and index array; add its per-row pointer table
+        // and, for the reordering single tree, its copy of the rows.
+        bytes += static_cast<size_t>(group.index->usedMemory()) + count * sizeof(float*);
+        if (copies_rows) bytes += count * static_cast<size_t>(dims) * sizeof(float);
+      }
+    }
+    return bytes;
+  }
+
+  // Visits the groups nearest first while their box can still hold a better row; `best_distance`
+  // and `best_row` (a candidate row) carry the best so far in and out.
+  void search(const CandidateSet& set, const float* query, const QueryPlan& plan,
+              const SearchConstraints& constraints, const flann::SearchParams& search_params,
+              float& best_distance, int& best_row) const {
+    GroupDistance order[kMaxGroups];
+    const int count = groups.order(query, constraints, order);
+    for (int i = 0; i < count && !RowGroups::beyond(order[i].distance, best_distance); ++i) {
+      const FlannGroup<Index>& group = trees[static_cast<size_t>(order[i].group)];
+      if (!group.index) continue;
+      search_kernels::RowFilter filter = plan.filter;
+      filter.row_tags = group.tags.data();
+      filter.row_frame = group.frames.data();
+      filter.row_count = static_cast<int>(group.frames.size());
+      const float* point = query;
+      float rotated[kMaxSearchDims];
+      ExactRanker ranker;
+      float threshold = best_distance;
+      if (!group.rotation.empty()) {
+        group.rotation.apply(query, rotated);
+        point = rotated;
+        ranker.start(set, group.rotation, query, best_distance, row_norm(rotated, set.dims),
+                     group.max_row_norm);
+        ranker.scanned_to_set = group.set_rows.data();
+        filter.offer = &ExactRanker::offer;
+        filter.offer_context = &ranker;
+        threshold = ranker.threshold();
+      }
+      ConstrainedBestResultSet result(filter, threshold);
+      group.index->findNeighbors(result, point, search_params);
+      if (result.best().row >= 0) {
+        best_distance = group.rotation.empty() ? result.best().distance : ranker.best_distance;
+        best_row = group.set_rows[static_cast<size_t>(result.best().row)];
+      }
+    }
+  }
+};
+
 template <class Traits>
 class FlannSearcher final : public Searcher {
  public:
-  // `params` builds the index; `search_params` is used for every query.
-  static Result<std::unique_ptr<Searcher>> make(const SearchInput& input, bool rotate,
+  using Forest = FlannForest<typename Traits::Index>;
+
+  // `params` builds every index; `search_params` is used for every query. With more than one
+  // tag class, a second forest holds one index per class, for queries whose tag filter leaves
+  // few rows: filtering inside the main index would reject most of what it visits.
+  static Result<std::unique_ptr<Searcher>> make(const SearchInput& input,
+                                                const SearchOptions& options, int group_rows,
                                                 const flann::IndexParams& params,
                                                 const flann::SearchParams& search_params) {
     auto searcher = std::unique_ptr<FlannSearcher>(new FlannSearcher(input, search_params));
-    CandidateSet& set = searcher->set_;
-    const int rows = set.row_count();
-    if (rows == 0) return std::unique_ptr<Searcher>(std::move(searcher));
-    if (rotate) {
-      searcher->rotation_ = principal_axes(set.rows.data(), rows, set.dims, 4096);
-      searcher->points_.resize(set.rows.size());
-      float rotated[kMaxSearchDims];
-      for (int r = 0; r < rows; ++r) {
-        searcher->rotation_.apply(set.row(r), rotated);
-        std::copy_n(rotated, set.dims, searcher->points_.data() + static_cast<size_t>(r) * set.dims);
-        searcher->max_row_norm_ = std::max(searcher->max_row_norm_, row_norm(rotated, set.dims));
-      }
-    }
-    try {
-      float* data = rotate ? searcher->points_.data() : set.rows.data();
-      flann::Matrix<float> matrix(data, static_cast<size_t>(rows), static_cast<size_t>(set.dims));
-      searcher->index_ = std::make_unique<typename Traits::Index>(matrix, params);
-      searcher->index_->buildIndex();
-    } catch (const std::exception& e) {
-      return Error{std::string(Traits::kName) + ": FLANN failed to build the index: " + e.what()};
+    const CandidateSet& set = searcher->set_;
+    if (set.row_count() == 0) return std::unique_ptr<Searcher>(std::move(searcher));
+    std::vector<std::vector<int>> rows;
+    make_row_groups(set, group_rows, rows);
+    Status built = searcher->main_.build(set, std::move(rows), options.principal_axes, params,
+                                         Traits::kName);
+    if (!built) return Error{built.message()};
+    std::vector<std::vector<int>> classes = tag_classes(set);
+    if (options.tag_class_indices && classes.size() > 1) {
+      built = searcher->classes_.build(set, std::move(classes), options.principal_axes, params,
+                                       Traits::kName);
+      if (!built) return Error{built.message()};
     }
     return std::unique_ptr<Searcher>(std::move(searcher));
   }
@@ -110,53 +232,46 @@ class FlannSearcher final : public Searcher {
   int dims() const override { return set_.dims; }
   bool exact() const override { return Traits::kExact; }
   size_t memory_bytes() const override {
-    size_t bytes = set_.memory_bytes() + points_.capacity() * sizeof(float) +
-                   rotation_.memory_bytes();
-    if (index_) {
-      const size_t rows = static_cast<size_t>(set_.row_count());
-      // usedMemory() counts FLANN's node pool and index array; add its per-row pointer table
-      // and, for the reordering single tree, its copy of the rows.
-      bytes += static_cast<size_t>(index_->usedMemory()) + rows * sizeof(float*);
-      if (Traits::kCopiesRows) bytes += rows * static_cast<size_t>(set_.dims) * sizeof(float);
-    }
-    return bytes;
+    return set_.memory_bytes() + main_.memory_bytes(set_.dims, Traits::kCopiesRows) +
+           classes_.memory_bytes(set_.dims, Traits::kCopiesRows);
   }
 
   SearchResult search(std::span<const float> query,
                       const SearchConstraints& constraints) const override {
     assert(static_cast<int>(query.size()) == set_.dims);
-    QueryPlan plan = plan_query(set_, query.data(), constraints);
-    if (!(plan.bound > 0.0f) || !index_) {
-      return finish_query(set_, plan, query.data(), -1, constraints);
-    }
-    float threshold = plan.bound;
-    const float* point = query.data();
-    float rotated[kMaxSearchDims];
-    ExactRanker ranker;
-    if (!rotation_.empty()) {
-      rotation_.apply(query.data(), rotated);
-      point = rotated;
-      ranker.start(set_, rotation_, query.data(), plan.bound, row_norm(rotated, set_.dims),
-                   max_row_norm_);
-      plan.filter.offer = &ExactRanker::offer;
-      plan.filter.offer_context = &ranker;
-      threshold = ranker.threshold();
-    }
-    ConstrainedBestResultSet result(plan.filter, threshold);
-    index_->findNeighbors(result, point, search_params_);
-    return finish_query(set_, plan, query.data(), result.best_row(), constraints);
+    const QueryPlan plan = plan_query(set_, query.data(), constraints);
+    if (!(plan.bound > 0.0f)) return finish_query(set_, plan, query.data(), -1, constraints);
+    float best_distance = plan.bound;
+    int best_row = -1;
+    const Forest& forest = uses_classes(constraints) ? classes_ : main_;
+    forest.search(set_, query.data(), plan, constraints, search_params_, best_distance, best_row);
+    return finish_query(set_, plan, query.data(), best_row, constraints);
   }
 
  private:
   FlannSearcher(const SearchInput& input, const flann::SearchParams& search_params)
       : set_(make_candidate_set(input)), search_params_(search_params) {}
 
+  // True when the tag filter leaves less than a quarter of the rows: then the per-class indices
+  // of the passing classes are searched instead of the main ones.
+  bool uses_classes(const SearchConstraints& constraints) const {
+    if (classes_.empty() || (constraints.include_tags == 0 && constraints.exclude_tags == 0)) {
+      return false;
+    }
+    size_t passing = 0;
+    for (int c = 0; c < classes_.groups.count(); ++c) {
+      const uint64_t tags = classes_.groups.tags_or[static_cast<size_t>(c)];  // one mask per class
+      if (tags_pass(tags, constraints.include_tags, constraints.exclude_tags)) {
+        passing += classes_.trees[static_cast<size_t>(c)].set_rows.size();
+      }
+    }
+    return 4 * passing < classes_.rows;
+  }
+
   CandidateSet set_;
   flann::SearchParams search_params_;
-  FeatureRotation rotation_;  // empty axes when the index is over the raw rows
-  std::vector<float> points_;  // rotated rows (FLANN keeps pointers into them)
-  float max_row_norm_ = 0.0f;
-  std::unique_ptr<typename Traits::Index> index_;
+  Forest main_;     // all rows: one index, or one per k-means group
+  Forest classes_;  // one index per tag class (empty with a single class)
 };
 
 }  // namespace
@@ -166,10 +281,13 @@ Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
   if (options.kdtree_leaf_size < 1) {
     return Error{"kdtree: leaf size must be >= 1, got " + std::to_string(options.kdtree_leaf_size)};
   }
+  if (options.kdtree_group_rows < 0) {
+    return Error{"kdtree: rows per group must be >= 0 (0: one group), got " +
+                 std::to_string(options.kdtree_group_rows)};
+  }
   // KDTreeSingleIndex ignores the check count, and eps 0 keeps it exact.
   return FlannSearcher<ExactTraits>::make(
-      input, options.principal_axes,
-      flann::KDTreeSingleIndexParams(options.kdtree_leaf_size, /*reorder=*/true),
+      input, options, options.kdtree_group_rows, flann::KDTreeSingleIndexParams(options.kdtree_leaf_size, /*reorder=*/true),
       flann::SearchParams());
 }
 
@@ -182,7 +300,11 @@ Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
     return Error{"approx: the check budget must be >= 1 (unlimited checks are not allowed), got " +
                  std::to_string(options.approx_checks)};
   }
-  return FlannSearcher<ApproxTraits>::make(input, options.principal_axes,
+  if (options.approx_group_rows < 0) {
+    return Error{"approx: rows per group must be >= 0 (0: one group), got " +
+                 std::to_string(options.approx_group_rows)};
+  }
+  return FlannSearcher<ApproxTraits>::make(input, options, options.approx_group_rows,
                                            flann::KDTreeIndexParams(options.approx_trees),
                                            flann::SearchParams(options.approx_checks));
 }

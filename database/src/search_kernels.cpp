@@ -119,6 +119,66 @@ void scan_blocks_portable(const float* blocks, int first_block, int last_block, 
   }
 }
 
+namespace {
+
+// Squared distances of the rows of `Count` consecutive blocks (1, 2 or 4) to the query, each
+// block summed in two chains (even and odd columns) so that 2 * Count independent FMA chains
+// hide the FMA latency.
+template <int Count>
+__attribute__((target("avx2,fma"), always_inline)) inline void block_distances_avx2(
+    const float* first_block, size_t stride, int dims, const float* query, __m256* out) {
+  __m256 even[Count];
+  __m256 odd[Count];
+  for (int k = 0; k < Count; ++k) {
+    even[k] = _mm256_setzero_ps();
+    odd[k] = _mm256_setzero_ps();
+  }
+  int d = 0;
+  for (; d + 1 < dims; d += 2) {
+    const __m256 q0 = _mm256_broadcast_ss(query + d);
+    const __m256 q1 = _mm256_broadcast_ss(query + d + 1);
+    for (int k = 0; k < Count; ++k) {
+      const float* column = first_block + k * stride + d * kBlockRows;
+      const __m256 diff0 = _mm256_sub_ps(q0, _mm256_loadu_ps(column));
+      const __m256 diff1 = _mm256_sub_ps(q1, _mm256_loadu_ps(column + kBlockRows));
+      even[k] = _mm256_fmadd_ps(diff0, diff0, even[k]);
+      odd[k] = _mm256_fmadd_ps(diff1, diff1, odd[k]);
+    }
+  }
+  if (d < dims) {
+    const __m256 q0 = _mm256_broadcast_ss(query + d);
+    for (int k = 0; k < Count; ++k) {
+      const __m256 diff0 =
+          _mm256_sub_ps(q0, _mm256_loadu_ps(first_block + k * stride + d * kBlockRows));
+      even[k] = _mm256_fmadd_ps(diff0, diff0, even[k]);
+    }
+  }
+  for (int k = 0; k < Count; ++k) out[k] = _mm256_add_ps(even[k], odd[k]);
+}
+
+// Checks `Count` blocks of distances against the bound; the rare path keeps the best row.
+template <int Count>
+__attribute__((target("avx2,fma"), always_inline)) inline void scan_group_avx2(
+    const float* blocks, int b, size_t stride, int dims, const float* query,
+    const RowFilter& filter, ScanBest& best, __m256& bound) {
+  __m256 distances[Count];
+  block_distances_avx2<Count>(blocks + b * stride, stride, dims, query, distances);
+  __m256 below = _mm256_cmp_ps(distances[0], bound, _CMP_LT_OQ);
+  for (int k = 1; k < Count; ++k) {
+    below = _mm256_or_ps(below, _mm256_cmp_ps(distances[k], bound, _CMP_LT_OQ));
+  }
+  if (_mm256_movemask_ps(below) == 0) return;
+  alignas(32) float lanes[kBlockRows];
+  for (int k = 0; k < Count; ++k) {
+    if (!filter.block_may_pass(b + k)) continue;
+    _mm256_store_ps(lanes, distances[k]);
+    consider_lanes(lanes, (b + k) * kBlockRows, filter, best);
+  }
+  bound = _mm256_set1_ps(best.distance);
+}
+
+}  // namespace
+
 __attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, int first_block,
                                                           int last_block, int dims,
                                                           const float* query,
@@ -126,72 +186,23 @@ __attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, i
                                                           ScanBest& best) {
   const size_t stride = static_cast<size_t>(dims) * kBlockRows;
   __m256 bound = _mm256_set1_ps(best.distance);
-  alignas(32) float distances[4][kBlockRows];
   int b = first_block;
-  // Four blocks at a time: four independent FMA chains keep both FMA pipes busy.
+  // Four blocks at a time, then two, then one: eight, four or two FMA chains in flight.
   for (; b + 4 <= last_block; b += 4) {
     if (!filter.block_may_pass(b) && !filter.block_may_pass(b + 1) &&
         !filter.block_may_pass(b + 2) && !filter.block_may_pass(b + 3)) {
       continue;
     }
-    const float* block0 = blocks + b * stride;
-    const float* block1 = block0 + stride;
-    const float* block2 = block1 + stride;
-    const float* block3 = block2 + stride;
-    __m256 acc0 = _mm256_setzero_ps();
-    __m256 acc1 = _mm256_setzero_ps();
-    __m256 acc2 = _mm256_setzero_ps();
-    __m256 acc3 = _mm256_setzero_ps();
-    for (int d = 0; d < dims; ++d) {
-      const __m256 q = _mm256_broadcast_ss(query + d);
-      const __m256 diff0 = _mm256_sub_ps(q, _mm256_loadu_ps(block0 + d * kBlockRows));
-      const __m256 diff1 = _mm256_sub_ps(q, _mm256_loadu_ps(block1 + d * kBlockRows));
-      const __m256 diff2 = _mm256_sub_ps(q, _mm256_loadu_ps(block2 + d * kBlockRows));
-      const __m256 diff3 = _mm256_sub_ps(q, _mm256_loadu_ps(block3 + d * kBlockRows));
-      acc0 = _mm256_fmadd_ps(diff0, diff0, acc0);
-      acc1 = _mm256_fmadd_ps(diff1, diff1, acc1);
-      acc2 = _mm256_fmadd_ps(diff2, diff2, acc2);
-      acc3 = _mm256_fmadd_ps(diff3, diff3, acc3);
-    }
-    const __m256 below = _mm256_or_ps(
-        _mm256_or_ps(_mm256_cmp_ps(acc0, bound, _CMP_LT_OQ), _mm256_cmp_ps(acc1, bound, _CMP_LT_OQ)),
-        _mm256_or_ps(_mm256_cmp_ps(acc2, bound, _CMP_LT_OQ), _mm256_cmp_ps(acc3, bound, _CMP_LT_OQ)));
-    if (_mm256_movemask_ps(below) == 0) continue;
-    _mm256_store_ps(distances[0], acc0);
-    _mm256_store_ps(distances[1], acc1);
-    _mm256_store_ps(distances[2], acc2);
-    _mm256_store_ps(distances[3], acc3);
-    for (int k = 0; k < 4; ++k) {
-      if (filter.block_may_pass(b + k)) {
-        consider_lanes(distances[k], (b + k) * kBlockRows, filter, best);
-      }
-    }
-    bound = _mm256_set1_ps(best.distance);
+    scan_group_avx2<4>(blocks, b, stride, dims, query, filter, best, bound);
   }
-  for (; b < last_block; ++b) {
-    if (!filter.block_may_pass(b)) continue;
-    const float* block = blocks + b * stride;
-    __m256 acc0 = _mm256_setzero_ps();
-    __m256 acc1 = _mm256_setzero_ps();
-    int d = 0;
-    for (; d + 1 < dims; d += 2) {
-      const __m256 diff0 =
-          _mm256_sub_ps(_mm256_broadcast_ss(query + d), _mm256_loadu_ps(block + d * kBlockRows));
-      const __m256 diff1 = _mm256_sub_ps(_mm256_broadcast_ss(query + d + 1),
-                                         _mm256_loadu_ps(block + (d + 1) * kBlockRows));
-      acc0 = _mm256_fmadd_ps(diff0, diff0, acc0);
-      acc1 = _mm256_fmadd_ps(diff1, diff1, acc1);
+  if (b + 2 <= last_block) {
+    if (filter.block_may_pass(b) || filter.block_may_pass(b + 1)) {
+      scan_group_avx2<2>(blocks, b, stride, dims, query, filter, best, bound);
     }
-    if (d < dims) {
-      const __m256 diff0 =
-          _mm256_sub_ps(_mm256_broadcast_ss(query + d), _mm256_loadu_ps(block + d * kBlockRows));
-      acc0 = _mm256_fmadd_ps(diff0, diff0, acc0);
-    }
-    const __m256 acc = _mm256_add_ps(acc0, acc1);
-    if (_mm256_movemask_ps(_mm256_cmp_ps(acc, bound, _CMP_LT_OQ)) == 0) continue;
-    _mm256_store_ps(distances[0], acc);
-    consider_lanes(distances[0], b * kBlockRows, filter, best);
-    bound = _mm256_set1_ps(best.distance);
+    b += 2;
+  }
+  if (b < last_block && filter.block_may_pass(b)) {
+    scan_group_avx2<1>(blocks, b, stride, dims, query, filter, best, bound);
   }
 }
 

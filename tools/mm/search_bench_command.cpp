@@ -49,16 +49,19 @@ options:
                          cost apply); by default nothing plays (plain nearest neighbour)
   --window N             window of skipped frames when --playing (default 20)
   --transition-cost C    transition cost when --playing (default 0.5)
-  --include-tags MASK    tag filter: required tag bits (number, default 0)
-  --exclude-tags MASK    tag filter: forbidden tag bits (number, default 0)
-  --leaf-size N          kdtree leaf size in rows (default 32)
-  --boxtree-leaf-size N  boxtree leaf size in rows, a multiple of 8 (default 32)
+  --include TAGS         tag filter: comma-separated tags every candidate's clip must carry
+  --exclude TAGS         tag filter: comma-separated tags no candidate's clip may carry
+  --leaf-size N          kdtree leaf size in rows (default 16)
+  --boxtree-leaf-size N  boxtree leaf size in rows, a multiple of 8 (default 64)
+  --kdtree-group-rows N  rows per k-means group, each with its own tree in its own axes
+  --boxtree-group-rows N (defaults: kdtree 0, boxtree 4096, approx 0; 0 for a single tree)
+  --approx-group-rows N
   --raw-axes             build the trees over the raw columns instead of the principal axes
   --repeat R             time every query R times and keep its fastest run (default 1), which
                          removes interference from other processes on a shared machine
   --clock wall|cpu       wall time (default) or the thread's CPU time (ignores preemption)
-  --approx-trees N       approx: randomized trees (default 4)
-  --approx-checks N      approx: leaf checks per query (default 64)
+  --approx-trees N       approx: randomized trees (default 1)
+  --approx-checks N      approx: leaf checks per query (default 128)
   --batch                also time batched queries on 1 and 2 threads
   --quiet                no progress on the terminal
 )";
@@ -74,8 +77,8 @@ struct Arguments {
   bool playing = false;
   int window = 20;
   float transition_cost = 0.5f;
-  uint64_t include_tags = 0;
-  uint64_t exclude_tags = 0;
+  std::vector<std::string> include;
+  std::vector<std::string> exclude;
   SearchOptions options;
   bool batch = false;
   bool quiet = false;
@@ -142,18 +145,25 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     } else if (a == "--transition-cost") {
       if (!number(i, a, 0, 1e9, v)) return 2;
       out.transition_cost = static_cast<float>(v);
-    } else if (a == "--include-tags") {
-      if (!number(i, a, 0, 1.8e19, v)) return 2;
-      out.include_tags = static_cast<uint64_t>(v);
-    } else if (a == "--exclude-tags") {
-      if (!number(i, a, 0, 1.8e19, v)) return 2;
-      out.exclude_tags = static_cast<uint64_t>(v);
+    } else if (a == "--include" && i + 1 < args.size()) {
+      out.include = split_list(args[++i]);
+    } else if (a == "--exclude" && i + 1 < args.size()) {
+      out.exclude = split_list(args[++i]);
     } else if (a == "--leaf-size") {
       if (!number(i, a, 1, 1e6, v)) return 2;
       out.options.kdtree_leaf_size = static_cast<int>(v);
     } else if (a == "--boxtree-leaf-size") {
       if (!number(i, a, 8, 1e6, v)) return 2;
       out.options.boxtree_leaf_size = static_cast<int>(v);
+    } else if (a == "--kdtree-group-rows") {
+      if (!number(i, a, 0, 1e9, v)) return 2;
+      out.options.kdtree_group_rows = static_cast<int>(v);
+    } else if (a == "--boxtree-group-rows") {
+      if (!number(i, a, 0, 1e9, v)) return 2;
+      out.options.boxtree_group_rows = static_cast<int>(v);
+    } else if (a == "--approx-group-rows") {
+      if (!number(i, a, 0, 1e9, v)) return 2;
+      out.options.approx_group_rows = static_cast<int>(v);
     } else if (a == "--raw-axes") {
       out.options.principal_axes = false;
     } else if (a == "--repeat") {
@@ -304,6 +314,20 @@ int run_search_bench(const std::vector<std::string>& args) {
     std::fprintf(stderr, "mm search-bench: %s\n", valid.message().c_str());
     return 1;
   }
+  // Tag names to masks (the database's tag table); synthetic data has no names.
+  uint64_t include_tags = 0;
+  uint64_t exclude_tags = 0;
+  for (const auto* names : {&arguments.include, &arguments.exclude}) {
+    for (const std::string& name : *names) {
+      const std::string one[] = {name};
+      const uint64_t bit = database.tag_mask(one);
+      if (bit == 0) {
+        std::fprintf(stderr, "mm search-bench: the database has no tag '%s'\n", name.c_str());
+        return 2;
+      }
+      (names == &arguments.include ? include_tags : exclude_tags) |= bit;
+    }
+  }
   const int candidates = static_cast<int>(std::count(input.searchable.begin(), input.searchable.end(), 1));
   const NoisyQueries queries =
       make_noisy_queries(input, arguments.queries, arguments.noise, arguments.seed);
@@ -319,8 +343,8 @@ int run_search_bench(const std::vector<std::string>& args) {
       c.window_frames = arguments.window;
       c.transition_cost = arguments.transition_cost;
     }
-    c.include_tags = arguments.include_tags;
-    c.exclude_tags = arguments.exclude_tags;
+    c.include_tags = include_tags;
+    c.exclude_tags = exclude_tags;
   }
 
   std::printf("search-bench: %s\n  %d frames, %d candidates, %d dims; %d queries, noise %g, %s; "

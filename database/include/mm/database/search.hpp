@@ -75,16 +75,26 @@ struct SearchResult {
 // Tunables of the search structures; every method reads the fields it needs.
 struct SearchOptions {
   // Rows per leaf of the FLANN exact KD-tree (`kdtree`).
-  int kdtree_leaf_size = 32;
+  int kdtree_leaf_size = 16;
   // Rows per leaf of the box tree (`boxtree`): a positive multiple of 8 (one SIMD block).
-  int boxtree_leaf_size = 32;
+  int boxtree_leaf_size = 64;
+  // The tree methods can first group the rows by k-means, about this many rows per group (at
+  // most 64 groups; a dense cluster is split again), and build one tree per group in the group's
+  // own principal axes; a query visits groups nearest first and skips those whose bounding box
+  // is farther than the best cost found. 0 builds a single tree over all rows.
+  int kdtree_group_rows = 0;
+  int boxtree_group_rows = 4096;
+  int approx_group_rows = 0;
+  // `kdtree` and `approx` also build one index per tag class (rows whose clips carry exactly
+  // the same tags), searched when a query's tag filter leaves less than a quarter of the rows.
+  bool tag_class_indices = true;
   // Build the trees (`kdtree`, `boxtree`, `approx`) over the principal axes of the rows
   // instead of the raw columns. Results stay exact: rows are decided by their unrotated distance.
   bool principal_axes = true;
   // Randomized trees of the approximate method (`approx`).
-  int approx_trees = 4;
+  int approx_trees = 1;
   // Leaf checks per query of the approximate method (its budget; never unlimited).
-  int approx_checks = 64;
+  int approx_checks = 128;
 };
 
 // One search structure over one database. Instances are immutable after creation: search()

@@ -1,0 +1,254 @@
+// Row groups shared by the tree methods: k-means groups of the candidate rows, each with its
+// bounding box in the original space, so that a query visits groups nearest first and skips a
+// group once the distance to its box reaches the best cost found.
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "search_detail.hpp"
+
+namespace mm::search_detail {
+
+namespace {
+
+using search_kernels::kBlockRows;
+
+// Splits `rows` (candidate rows of `set`) into at most `group_count` groups by k-means
+// (k-means++ seeding from a fixed seed, Lloyd iterations on an evenly spaced sample, then every
+// row to its nearest centre); returns the non-empty groups.
+std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::vector<int>& rows,
+                                           int group_count) {
+  const int count = static_cast<int>(rows.size());
+  const int dims = set.dims;
+  const auto row_size = static_cast<size_t>(dims);
+  std::vector<std::vector<int>> groups;
+  if (group_count <= 1 || count <= group_count) {
+    groups.push_back(rows);
+    return groups;
+  }
+  const int step = std::max(1, count / 16384);
+  std::vector<int> sample;
+  for (int i = 0; i < count; i += step) sample.push_back(rows[static_cast<size_t>(i)]);
+  // k-means++ seeding: each next centre is a sample row drawn with probability proportional to
+  // its squared distance to the nearest centre so far.
+  std::mt19937_64 rng(0x5eed);
+  std::vector<float> centres;
+  std::vector<float> nearest(sample.size(), std::numeric_limits<float>::infinity());
+  const int first = sample[rng() % sample.size()];
+  centres.insert(centres.end(), set.row(first), set.row(first) + dims);
+  for (int k = 1; k < group_count; ++k) {
+    const float* last = centres.data() + static_cast<size_t>(k - 1) * row_size;
+    double total = 0.0;
+    for (size_t i = 0; i < sample.size(); ++i) {
+      nearest[i] = std::min(nearest[i], search_kernels::squared_distance(set.row(sample[i]), last, dims));
+      total += nearest[i];
+    }
+    if (!(total > 0.0)) break;  // every sample row is a centre already
+    double pick = std::uniform_real_distribution<double>(0.0, total)(rng);
+    size_t chosen = sample.size() - 1;
+    for (size_t i = 0; i < sample.size(); ++i) {
+      pick -= nearest[i];
+      if (pick <= 0.0) {
+        chosen = i;
+        break;
+      }
+    }
+    centres.insert(centres.end(), set.row(sample[chosen]), set.row(sample[chosen]) + dims);
+  }
+  const int k_count = static_cast<int>(centres.size() / row_size);
+  // Nearest centre of a row, with the blocked scan over the centres.
+  std::vector<float> packed;
+  std::vector<uint64_t> no_tags(static_cast<size_t>(k_count), 0);
+  std::vector<int> centre_ids(static_cast<size_t>(k_count));
+  std::iota(centre_ids.begin(), centre_ids.end(), 0);
+  const search_kernels::ScanBlocksFn scan = search_kernels::scan_blocks();
+  auto pack = [&] {
+    packed.assign(search_kernels::blocked_float_count(k_count, dims), 0.0f);
+    search_kernels::pack_blocks(centres.data(), k_count, dims, packed.data());
+  };
+  search_kernels::RowFilter all;
+  all.row_tags = no_tags.data();
+  all.row_frame = centre_ids.data();
+  all.row_count = k_count;
+  const int centre_blocks = (k_count + kBlockRows - 1) / kBlockRows;
+  auto nearest_centre = [&](int row) {
+    search_kernels::ScanBest best;
+    scan(packed.data(), 0, centre_blocks, dims, set.row(row), all, best);
+    return std::max(best.row, 0);
+  };
+  std::vector<double> sums;
+  std::vector<int> counts;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    pack();
+    sums.assign(centres.size(), 0.0);
+    counts.assign(static_cast<size_t>(k_count), 0);
+    for (int r : sample) {
+      const int c = nearest_centre(r);
+      ++counts[static_cast<size_t>(c)];
+      for (size_t d = 0; d < row_size; ++d) sums[static_cast<size_t>(c) * row_size + d] += set.row(r)[d];
+    }
+    for (int c = 0; c < k_count; ++c) {
+      if (counts[static_cast<size_t>(c)] == 0) continue;  // keeps its old place
+      for (size_t d = 0; d < row_size; ++d) {
+        centres[static_cast<size_t>(c) * row_size + d] = static_cast<float>(
+            sums[static_cast<size_t>(c) * row_size + d] / counts[static_cast<size_t>(c)]);
+      }
+    }
+  }
+  pack();
+  std::vector<std::vector<int>> by_centre(static_cast<size_t>(k_count));
+  for (int r : rows) by_centre[static_cast<size_t>(nearest_centre(r))].push_back(r);
+  for (auto& group : by_centre) {
+    if (!group.empty()) groups.push_back(std::move(group));
+  }
+  return groups;
+}
+
+// Groups of about `group_rows` candidate rows: k-means over all rows, then again inside every
+// group still more than twice that size (a dense cluster, such as the standing gestures, takes
+// one centre of the first pass but is split by the next), up to kMaxKmeansGroups in all.
+std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_rows) {
+  std::vector<int> all(static_cast<size_t>(set.row_count()));
+  std::iota(all.begin(), all.end(), 0);
+  if (group_rows <= 0) return {all};
+  const auto groups_for = [&](size_t rows) {
+    return static_cast<int>(std::clamp<size_t>((rows + group_rows / 2) / group_rows, 1, kMaxKmeansGroups));
+  };
+  std::vector<std::vector<int>> done;
+  std::vector<std::vector<int>> pending = kmeans_split(set, all, groups_for(all.size()));
+  for (int pass = 0; pass < 4 && !pending.empty(); ++pass) {
+    std::vector<std::vector<int>> next;
+    for (auto& group : pending) {
+      const size_t room =
+          kMaxKmeansGroups - std::min<size_t>(kMaxKmeansGroups, done.size() + next.size() + 1);
+      if (group.size() <= 2 * static_cast<size_t>(group_rows) || room == 0) {
+        done.push_back(std::move(group));
+        continue;
+      }
+      const int parts = std::min<int>(groups_for(group.size()), static_cast<int>(room) + 1);
+      std::vector<std::vector<int>> parts_found = kmeans_split(set, group, parts);
+      if (parts_found.size() <= 1) {
+        done.push_back(std::move(group));
+        continue;
+      }
+      for (auto& part : parts_found) next.push_back(std::move(part));
+    }
+    pending = std::move(next);
+  }
+  for (auto& group : pending) done.push_back(std::move(group));
+  return done;
+}
+
+}  // namespace
+
+size_t RowGroups::memory_bytes() const {
+  return boxes.capacity() * sizeof(float) + (tags_or.capacity() + tags_and.capacity()) * sizeof(uint64_t);
+}
+
+RowGroups make_row_groups(const CandidateSet& set, int group_rows,
+                          std::vector<std::vector<int>>& rows_out) {
+  rows_out = kmeans_groups(set, group_rows);
+  return row_groups_of(set, rows_out);
+}
+
+RowGroups row_groups_of(const CandidateSet& set, const std::vector<std::vector<int>>& rows) {
+  RowGroups groups;
+  const int dims = set.dims;
+  groups.query_dims = dims;
+  groups.padded_dims = (dims + 7) / 8 * 8;
+  const size_t count = rows.size();
+  const size_t box_stride = 2 * static_cast<size_t>(groups.padded_dims);
+  groups.boxes.assign(count * box_stride, 0.0f);
+  groups.tags_or.assign(count, 0);
+  groups.tags_and.assign(count, ~uint64_t{0});
+  for (size_t g = 0; g < count; ++g) {
+    float* lo = groups.boxes.data() + g * box_stride;
+    float* hi = lo + groups.padded_dims;
+    std::fill(lo, lo + dims, std::numeric_limits<float>::infinity());
+    std::fill(hi, hi + dims, -std::numeric_limits<float>::infinity());
+    for (int r : rows[g]) {
+      const float* row = set.row(r);
+      for (int d = 0; d < dims; ++d) {
+        lo[d] = std::min(lo[d], row[d]);
+        hi[d] = std::max(hi[d], row[d]);
+      }
+      groups.tags_or[g] |= set.row_tags[static_cast<size_t>(r)];
+      groups.tags_and[g] &= set.row_tags[static_cast<size_t>(r)];
+    }
+  }
+  return groups;
+}
+
+std::vector<std::vector<int>> tag_classes(const CandidateSet& set) {
+  std::vector<uint64_t> masks;
+  std::vector<std::vector<int>> classes;
+  size_t last = 0;  // rows come clip by clip: the previous row's class is the usual answer
+  for (int r = 0; r < set.row_count(); ++r) {
+    const uint64_t tags = set.row_tags[static_cast<size_t>(r)];
+    if (masks.empty() || masks[last] != tags) {
+      last = static_cast<size_t>(std::find(masks.begin(), masks.end(), tags) - masks.begin());
+      if (last == masks.size()) {
+        if (masks.size() == static_cast<size_t>(kMaxGroups)) return {};
+        masks.push_back(tags);
+        classes.emplace_back();
+      }
+    }
+    classes[last].push_back(r);
+  }
+  return classes;
+}
+
+int RowGroups::order(const float* query, const SearchConstraints& constraints,
+                     GroupDistance* out) const {
+  typedef float Float8 __attribute__((vector_size(32)));
+  alignas(32) float padded[kMaxSearchDims + 8] = {};
+  const int dims = padded_dims;  // the query's padding columns stay 0, like the boxes'
+  const bool tag_filter = constraints.include_tags != 0 || constraints.exclude_tags != 0;
+  const size_t box_stride = 2 * static_cast<size_t>(padded_dims);
+  int count = 0;
+  bool copied = false;
+  for (size_t g = 0; g < tags_or.size(); ++g) {
+    if (tag_filter && ((tags_or[g] & constraints.include_tags) != constraints.include_tags ||
+                       (tags_and[g] & constraints.exclude_tags) != 0)) {
+      continue;
+    }
+    if (!copied) {
+      std::memcpy(padded, query, static_cast<size_t>(query_dims) * sizeof(float));
+      copied = true;
+    }
+    const float* lo = boxes.data() + g * box_stride;
+    const float* hi = lo + padded_dims;
+    Float8 acc = {};
+    const Float8 zero = {};
+    for (int d = 0; d < dims; d += 8) {
+      Float8 q;
+      Float8 l;
+      Float8 h;
+      std::memcpy(&q, padded + d, sizeof q);
+      std::memcpy(&l, lo + d, sizeof l);
+      std::memcpy(&h, hi + d, sizeof h);
+      const Float8 below = l - q;
+      const Float8 above = q - h;
+      Float8 gap = below > above ? below : above;
+      gap = gap > zero ? gap : zero;
+      acc += gap * gap;
+    }
+    float lanes[8];
+    std::memcpy(lanes, &acc, sizeof lanes);
+    const GroupDistance entry{((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
+                                  ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7])),
+                              static_cast<int>(g)};
+    // Insertion sort: a few dozen groups at most.
+    int i = count++;
+    while (i > 0 && out[i - 1].distance > entry.distance) {
+      out[i] = out[i - 1];
+      --i;
+    }
+    out[i] = entry;
+  }
+  return count;
+}
+
+}  // namespace mm::search_detail
