@@ -3,6 +3,7 @@
 // group once the distance to its box reaches the best cost found.
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <numeric>
 #include <random>
@@ -106,9 +107,35 @@ std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::v
   return groups;
 }
 
+// Sum of the per-column variances of `rows` (candidate rows of `set`).
+double total_variance(const CandidateSet& set, const std::vector<int>& rows) {
+  const auto dims = static_cast<size_t>(set.dims);
+  if (rows.empty()) return 0.0;
+  std::vector<double> sum(dims, 0.0);
+  std::vector<double> sum_squares(dims, 0.0);
+  for (int r : rows) {
+    const float* row = set.row(r);
+    for (size_t d = 0; d < dims; ++d) {
+      sum[d] += row[d];
+      sum_squares[d] += static_cast<double>(row[d]) * row[d];
+    }
+  }
+  double variance = 0.0;
+  const auto n = static_cast<double>(rows.size());
+  for (size_t d = 0; d < dims; ++d) variance += std::max(0.0, sum_squares[d] / n - (sum[d] / n) * (sum[d] / n));
+  return variance;
+}
+
+// A group is dense when its spread is below this fraction of the whole database's.
+constexpr double kDenseVarianceFraction = 0.01;
+
 // Groups of about `group_rows` candidate rows: k-means over all rows, then again inside every
 // group still more than twice that size (a dense cluster, such as the standing gestures, takes
 // one centre of the first pass but is split by the next), up to kMaxKmeansGroups in all.
+// Then only the dense groups (total variance under 1 % of the database's) stay apart, each to
+// get its own tree in its own axes; all the others are merged back into one group: at the scale
+// of the database one tree in principal axes prunes as well as several, and a query then
+// descends one tree instead of several. Without a dense group, this is one group of all rows.
 std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_rows) {
   std::vector<int> all(static_cast<size_t>(set.row_count()));
   std::iota(all.begin(), all.end(), 0);
@@ -138,7 +165,21 @@ std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_r
     pending = std::move(next);
   }
   for (auto& group : pending) done.push_back(std::move(group));
-  return done;
+  const double dense_below = kDenseVarianceFraction * total_variance(set, all);
+  std::vector<std::vector<int>> kept;
+  std::vector<int> merged;
+  for (auto& group : done) {
+    if (total_variance(set, group) < dense_below) {
+      kept.push_back(std::move(group));
+    } else {
+      merged.insert(merged.end(), group.begin(), group.end());
+    }
+  }
+  if (!merged.empty()) {
+    std::sort(merged.begin(), merged.end());  // back in database order
+    kept.insert(kept.begin(), std::move(merged));
+  }
+  return kept;
 }
 
 }  // namespace

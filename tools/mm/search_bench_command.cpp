@@ -53,8 +53,8 @@ options:
   --exclude TAGS         tag filter: comma-separated tags no candidate's clip may carry
   --leaf-size N          kdtree leaf size in rows (default 16)
   --boxtree-leaf-size N  boxtree leaf size in rows, a multiple of 8 (default 64)
-  --kdtree-group-rows N  rows per k-means group, each with its own tree in its own axes
-  --boxtree-group-rows N (defaults: kdtree 0, boxtree 4096, approx 0; 0 for a single tree)
+  --kdtree-group-rows N  rows per k-means group (default 4096, approx 0; dense groups get their
+  --boxtree-group-rows N own tree in their own axes, the rest share one; 0 for a single tree)
   --approx-group-rows N
   --raw-axes             build the trees over the raw columns instead of the principal axes
   --repeat R             time every query R times and keep its fastest run (default 1), which

@@ -78,11 +78,13 @@ struct SearchOptions {
   int kdtree_leaf_size = 16;
   // Rows per leaf of the box tree (`boxtree`): a positive multiple of 8 (one SIMD block).
   int boxtree_leaf_size = 64;
-  // The tree methods can first group the rows by k-means, about this many rows per group (at
-  // most 64 groups; a dense cluster is split again), and build one tree per group in the group's
-  // own principal axes; a query visits groups nearest first and skips those whose bounding box
-  // is farther than the best cost found. 0 builds a single tree over all rows.
-  int kdtree_group_rows = 0;
+  // The tree methods first group the rows by k-means, about this many rows per group, and keep
+  // apart the dense groups (total variance under 1 % of the database's, such as the standing
+  // gestures), merging all others into one: one tree per group, each in the group's own
+  // principal axes. A query visits groups nearest first and skips those whose bounding box is
+  // farther than the best cost found. Without a dense cluster this is a single tree; 0 always
+  // builds a single tree (the default of `approx`, whose check budget would be spent per group).
+  int kdtree_group_rows = 4096;
   int boxtree_group_rows = 4096;
   int approx_group_rows = 0;
   // `kdtree` and `approx` also build one index per tag class (rows whose clips carry exactly
