@@ -420,20 +420,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
       Status status = preprocess_clip(clip, results[job.input].roles, context.preprocess, out,
                                       scratch[worker].preprocess);
       if (status) {
-        ClipMotionView view;
-        view.parents = db.skeleton.parents();
-        view.local_positions = positions;
-        view.local_rotations = rotations;
-        view.local_velocities = velocities;
-        view.local_angular_velocities = angular;
-        view.frame_count = range.frame_count();
-        view.frame_time = db.frame_time;
-        extract_clip_features(db.schema, *bones, view,
-                              std::span(db.features)
-                                  .subspan(static_cast<size_t>(range.start) * dims,
-                                           static_cast<size_t>(range.frame_count()) * dims),
-                              std::span(db.searchable).subspan(range.start, range.frame_count()),
-                              scratch[worker].features);
+        extract_range_features(db, range, *bones, scratch[worker].features);
       } else {
         status = Error{input_names[job.input] + ": " + status.message()};
       }

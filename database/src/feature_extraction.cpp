@@ -273,6 +273,26 @@ void denormalize_features(std::span<float> rows, std::span<const float> offset,
   }
 }
 
+void extract_range_features(Database& db, const ClipRange& range,
+                            std::span<const int> channel_bones, FeatureScratch& scratch) {
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const size_t dims = static_cast<size_t>(db.schema.dims());
+  const size_t first = static_cast<size_t>(range.start) * joints;
+  const size_t count = static_cast<size_t>(range.frame_count()) * joints;
+  ClipMotionView view;
+  view.parents = db.skeleton.parents();
+  view.local_positions = std::span(db.local_positions).subspan(first, count);
+  view.local_rotations = std::span(db.local_rotations).subspan(first, count);
+  view.local_velocities = std::span(db.local_velocities).subspan(first, count);
+  view.local_angular_velocities = std::span(db.local_angular_velocities).subspan(first, count);
+  view.frame_count = range.frame_count();
+  view.frame_time = db.frame_time;
+  extract_clip_features(
+      db.schema, channel_bones, view,
+      std::span(db.features).subspan(range.start * dims, range.frame_count() * dims),
+      std::span(db.searchable).subspan(range.start, range.frame_count()), scratch);
+}
+
 Status compute_database_features(Database& db, std::vector<std::string>* warnings) {
   if (Status s = db.schema.validate(); !s) return s;
   const int joints = db.joint_count();
@@ -299,22 +319,7 @@ Status compute_database_features(Database& db, std::vector<std::string>* warning
       return Error{"database: clip '" + range.name + "' has an invalid frame range [" +
                    std::to_string(range.start) + ", " + std::to_string(range.end) + ")"};
     }
-    const size_t first = static_cast<size_t>(range.start) * joints;
-    const size_t count = static_cast<size_t>(range.frame_count()) * joints;
-    ClipMotionView view;
-    view.parents = db.skeleton.parents();
-    view.local_positions = std::span(db.local_positions).subspan(first, count);
-    view.local_rotations = std::span(db.local_rotations).subspan(first, count);
-    view.local_velocities = std::span(db.local_velocities).subspan(first, count);
-    view.local_angular_velocities = std::span(db.local_angular_velocities).subspan(first, count);
-    view.frame_count = range.frame_count();
-    view.frame_time = db.frame_time;
-    extract_clip_features(db.schema, *bones, view,
-                          std::span(db.features)
-                              .subspan(static_cast<size_t>(range.start) * dims,
-                                       static_cast<size_t>(range.frame_count()) * dims),
-                          std::span(db.searchable).subspan(range.start, range.frame_count()),
-                          scratch);
+    extract_range_features(db, range, *bones, scratch);
   }
   FeatureNormalization normalization =
       compute_feature_normalization(db.schema, db.features, db.searchable);

@@ -83,6 +83,11 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
                            const ClipMotionView& clip, std::span<float> raw,
                            std::span<uint8_t> searchable, FeatureScratch& scratch);
 
+// Extracts one clip range of a database in place: reads its motion arrays, writes its raw
+// (un-normalized) rows of db.features and its db.searchable flags. Arrays must be sized.
+void extract_range_features(Database& db, const ClipRange& range,
+                            std::span<const int> channel_bones, FeatureScratch& scratch);
+
 // Per-column offsets and scales that normalize a feature matrix, and warnings for channels
 // that could not be scaled.
 struct FeatureNormalization {
