@@ -1,0 +1,150 @@
+// The `mm` command line as scripts use it: exit codes, messages, and files that round-trip.
+// Runs the real binary (MM_TOOL_PATH) in a shell and reads its output.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+#include "mm/database/bvh.hpp"
+#include "mm/database/database_file.hpp"
+#include "mm/database/gltf.hpp"
+#include "test_support.hpp"
+
+namespace mm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandRun run_mm(const std::string& arguments) {
+  // Built with append: GCC 12 gives a false -Wrestrict on chains of operator+ with literals.
+  std::string command = "'";
+  command.append(MM_TOOL_PATH).append("' ").append(arguments).append(" 2>&1");
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string quoted(const fs::path& p) {
+  std::string q = "'";
+  return q.append(p.string()).append("'");
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+// A copy of a few real clips in a scratch folder, plus whatever the test adds.
+fs::path folder_with_real_clips(const fs::path& dir) {
+  const fs::path in = dir / "in";
+  fs::create_directories(in);
+  for (const char* stem : {"dataset-2_walk_normal_001", "dataset-2_walk-turn-left_normal_001",
+                           "dataset-2_run_normal_001"}) {
+    fs::copy_file(test::clip_path(stem), in / (std::string(stem) + ".bvh"));
+  }
+  return in;
+}
+
+TEST(Cli, HelpListsEveryCommandAndEachCommandHasHelp) {
+  const CommandRun help = run_mm("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* command : {"build", "info", "export", "search-bench"}) {
+    EXPECT_NE(help.output.find(command), std::string::npos) << command;
+    const CommandRun sub = run_mm(std::string(command) + " --help");
+    EXPECT_EQ(sub.exit_code, 0) << command;
+    EXPECT_NE(sub.output.find(std::string("usage: mm ") + command), std::string::npos)
+        << sub.output;
+  }
+  EXPECT_EQ(run_mm("no-such-command").exit_code, 2);
+  EXPECT_EQ(run_mm("build --no-such-option").exit_code, 2);
+}
+
+TEST(Cli, BuildWritesALoadableDatabaseAndPrintsItsSummary) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  const fs::path out = dir / "db.mmdb";
+  const CommandRun build = run_mm("build " + quoted(in) + " -o " + quoted(out));
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  for (const char* field : {"clips:", "frames:", "joints:", "tags:", "features:", "file size:"}) {
+    EXPECT_NE(build.output.find(field), std::string::npos) << field << "\n" << build.output;
+  }
+  Result<Database> db = load_database(out);
+  ASSERT_TRUE(db.ok()) << db.message();
+  EXPECT_EQ(db->clips.size(), 3u);
+  // The frames of the three sources, counted by the importer independently of the builder.
+  int frames = 0;
+  for (const auto& entry : fs::directory_iterator(in)) frames += load_bvh(entry.path())->frame_count;
+  EXPECT_EQ(db->frame_count, frames);
+
+  const CommandRun info = run_mm("info " + quoted(out));
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("left_foot_position"), std::string::npos) << info.output;
+}
+
+TEST(Cli, BuildRefusesABadFileNamingItAndSkipBadBuildsFromTheRest) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  // The file ends inside line 4, in the middle of an OFFSET.
+  write_text(in / "broken.bvh", "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0");
+  const fs::path out = dir / "db.mmdb";
+
+  const CommandRun strict = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --quiet");
+  EXPECT_EQ(strict.exit_code, 1);
+  EXPECT_NE(strict.output.find("broken.bvh:4: expected"), std::string::npos) << strict.output;
+  EXPECT_FALSE(fs::exists(out));
+
+  const CommandRun skip = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --skip-bad");
+  EXPECT_EQ(skip.exit_code, 0) << skip.output;
+  EXPECT_NE(skip.output.find("refused 1"), std::string::npos) << skip.output;
+  EXPECT_NE(skip.output.find("broken.bvh"), std::string::npos) << skip.output;
+  Result<Database> db = load_database(out);
+  ASSERT_TRUE(db.ok()) << db.message();
+  EXPECT_EQ(db->clips.size(), 3u);
+}
+
+TEST(Cli, InfoRefusesATruncatedDatabase) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  const fs::path out = dir / "db.mmdb";
+  ASSERT_EQ(run_mm("build " + quoted(in) + " -o " + quoted(out) + " --quiet").exit_code, 0);
+  fs::resize_file(out, fs::file_size(out) / 2);
+  const CommandRun info = run_mm("info " + quoted(out));
+  EXPECT_EQ(info.exit_code, 1);
+  EXPECT_NE(info.output.find("truncated"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("db.mmdb"), std::string::npos) << info.output;
+}
+
+TEST(Cli, ExportWritesAGlbThatImportsWithTheClipsFramesAndJoints) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path source = test::clip_path("dataset-2_walk_normal_001");
+  const fs::path out = dir / "walk.glb";
+  const CommandRun run = run_mm("export " + quoted(source) + " -o " + quoted(out));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  Result<Clip> original = load_bvh(source);
+  Result<GltfAsset> asset = load_gltf(out);
+  ASSERT_TRUE(original.ok() && asset.ok()) << asset.message();
+  ASSERT_EQ(asset->clips.size(), 1u);
+  EXPECT_EQ(asset->clips[0].frame_count, original->frame_count);
+  EXPECT_TRUE(asset->skeleton.same_topology(original->skeleton));
+
+  EXPECT_EQ(run_mm("export " + quoted(source)).exit_code, 2);  // no -o
+  EXPECT_EQ(run_mm("export " + quoted(dir / "missing.bvh") + " -o " + quoted(out)).exit_code, 1);
+}
+
+}  // namespace
+}  // namespace mm
