@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <new>
 #include <limits>
 #include <random>
 #include <string>
@@ -14,6 +17,59 @@
 #include "mm/database/search.hpp"
 #include "mm/database/search_kernels.hpp"
 #include "mm/database/search_synthetic.hpp"
+
+// Every allocation of this test program is counted, so that a test can check that a searcher's
+// hot path allocates nothing.
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+// Every replaceable form goes through malloc and free, so the sanitizers see matching pairs.
+// Not inlined: GCC would otherwise pair an inlined free() with the new-expression and warn.
+namespace {
+void* counted_malloc(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(size != 0 ? size : 1);
+}
+void* counted_aligned(std::size_t size, std::align_val_t align) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  const auto alignment = static_cast<std::size_t>(align);
+  return std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment);
+}
+}  // namespace
+
+[[gnu::noinline]] void* operator new(std::size_t size) {
+  if (void* p = counted_malloc(size)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void* operator new[](std::size_t size) {
+  if (void* p = counted_malloc(size)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  return counted_malloc(size);
+}
+[[gnu::noinline]] void* operator new[](std::size_t size, const std::nothrow_t&) noexcept {
+  return counted_malloc(size);
+}
+[[gnu::noinline]] void* operator new(std::size_t size, std::align_val_t align) {
+  if (void* p = counted_aligned(size, align)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void* operator new[](std::size_t size, std::align_val_t align) {
+  if (void* p = counted_aligned(size, align)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
 namespace mm {
 namespace {
@@ -512,6 +568,35 @@ TEST(SearchBatch, BatchedResultsEqualSingleSearches) {
   for (size_t i = 0; i < queries.size(); ++i) {
     EXPECT_EQ(results[i].cost, kdtree->search(queries[i].features, shared).cost);
   }
+}
+
+// The hot paths of the methods not built on FLANN allocate nothing (FLANN allocates inside its
+// findNeighbors(), as search_flann.cpp documents), and neither does a batched run.
+TEST(SearchAllocations, HotPathsDoNotAllocate) {
+  const SyntheticSearchData data = small_synthetic();
+  const std::vector<Query> queries = constrained_queries(data, 1, 9);
+  for (const char* name : {"brute", "brute-simd", "aabb", "boxtree"}) {
+    auto searcher = make(name, data.input());
+    ASSERT_NE(searcher, nullptr);
+    const long before = g_allocations.load();
+    float sum = 0.0f;
+    for (const Query& q : queries) sum += searcher->search(q.features, q.constraints).cost;
+    EXPECT_EQ(g_allocations.load() - before, 0) << name;
+    EXPECT_TRUE(std::isfinite(sum) || std::isinf(sum));
+  }
+  auto boxtree = make("boxtree", data.input());
+  std::vector<float> flat;
+  std::vector<SearchConstraints> constraints;
+  for (const Query& q : queries) {
+    flat.insert(flat.end(), q.features.begin(), q.features.end());
+    constraints.push_back(q.constraints);
+  }
+  std::vector<SearchResult> results(queries.size());
+  SearchBatchRunner runner(2);
+  runner.run(*boxtree, flat, constraints, results);  // the worker has started and waited once
+  const long before = g_allocations.load();
+  runner.run(*boxtree, flat, constraints, results);
+  EXPECT_EQ(g_allocations.load() - before, 0);
 }
 
 TEST(SyntheticData, HasClipsTailsAndAStandingCluster) {

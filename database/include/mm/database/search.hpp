@@ -84,9 +84,9 @@ struct SearchOptions {
   // principal axes. A query visits groups nearest first and skips those whose bounding box is
   // farther than the best cost found. Without a dense cluster this is a single tree; 0 always
   // builds a single tree (the default of `approx`, whose check budget would be spent per group).
-  int kdtree_group_rows = 4096;
-  int boxtree_group_rows = 4096;
-  int approx_group_rows = 0;
+  int kdtree_group_rows = 4096;   // rows per group of `kdtree`
+  int boxtree_group_rows = 4096;  // rows per group of `boxtree`
+  int approx_group_rows = 0;      // rows per group of `approx`
   // `kdtree` and `approx` also build one index per tag class (rows whose clips carry exactly
   // the same tags), searched when a query's tag filter leaves less than a quarter of the rows.
   bool tag_class_indices = true;
@@ -119,7 +119,16 @@ class Searcher {
 };
 
 // The method names make_searcher() accepts, the reference first:
-// brute, brute-simd, aabb, kdtree, boxtree, approx.
+// - brute: every frame checked against the rules as written (early exit per row): the reference.
+// - brute-simd: every candidate row, in blocks of 8 rows scanned with AVX2 (or portable vector
+//   code): the fair brute-force baseline.
+// - aabb: bounding boxes over blocks of 16 and 64 consecutive rows with early exits per
+//   dimension (the structure of Daniel Holden's Motion-Matching demo).
+// - kdtree: FLANN's exact single KD-tree (KDTreeSingleIndex) in principal axes, one per dense
+//   k-means group, plus one per tag class for selective tag filters.
+// - boxtree: k-d trees with a tight bounding box per node and SIMD-scanned leaves, in principal
+//   axes, one per dense group: the exact search for every case, including the hard ones.
+// - approx: FLANN's randomized KD-tree (KDTreeIndex) with a leaf-check budget; not exact.
 std::span<const std::string_view> search_method_names();
 
 // Builds the named search structure over `input`; fails on an unknown name, invalid input or
