@@ -117,6 +117,28 @@ TEST(Cli, BuildRefusesABadFileNamingItAndSkipBadBuildsFromTheRest) {
   EXPECT_EQ(db->clips.size(), 3u);
 }
 
+TEST(Cli, ContactThresholdsAreConfigurable) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  auto contact_frames = [](const fs::path& file) {
+    Result<Database> db = load_database(file);
+    EXPECT_TRUE(db.ok()) << db.message();
+    int n = 0;
+    for (uint8_t c : db->contacts) n += c;
+    return n;
+  };
+  ASSERT_EQ(run_mm("build " + quoted(in) + " -o " + quoted(dir / "a.mmdb") + " --quiet").exit_code,
+            0);
+  // No joint is ever below the ground, so zero heights leave no contact at all.
+  ASSERT_EQ(run_mm("build " + quoted(in) + " -o " + quoted(dir / "b.mmdb") +
+                   " --quiet --contact-height 0 --contact-toe-height 0")
+                .exit_code,
+            0);
+  EXPECT_GT(contact_frames(dir / "a.mmdb"), 0);
+  EXPECT_EQ(contact_frames(dir / "b.mmdb"), 0);
+  EXPECT_EQ(run_mm("build " + quoted(in) + " -o x.mmdb --contact-speed -1").exit_code, 2);
+}
+
 TEST(Cli, InfoRefusesATruncatedDatabase) {
   const fs::path dir = test::scratch_dir();
   const fs::path in = folder_with_real_clips(dir);

@@ -37,6 +37,9 @@ options:
   --mirror-pair L=R   two joints that swap when mirroring, besides the detected _L/_R,
                       Left/Right, .L/.R, l_/r_ pairs; repeatable
   --forward-axis X,Y,Z  the hips' bone-local forward axis (default 0,0,1, the Bandai hips')
+  --contact-height M      a foot is in contact when its ankle is below M metres (default 0.15)
+  --contact-toe-height M  ... or its toe is below M metres (default 0.06)
+  --contact-speed V       ... and that joint moves slower than V m/s (default 0.6)
   --quiet             no progress and no summary
   -h, --help          this text
 
@@ -167,6 +170,14 @@ int run_build(const std::vector<std::string>& args) {
         return usage_error("--forward-axis needs three numbers X,Y,Z, not all zero");
       }
       options.root.hips_forward_axis = axis;
+    } else if (a == "--contact-height" || a == "--contact-toe-height" || a == "--contact-speed") {
+      const std::string* v = value();
+      const std::optional<double> x = v ? parse_number(*v) : std::nullopt;
+      if (!x || *x < 0.0) return usage_error(a + " needs a non-negative number");
+      float& field = a == "--contact-height"       ? options.contacts.foot_height
+                     : a == "--contact-toe-height" ? options.contacts.toe_height
+                                                   : options.contacts.speed;
+      field = static_cast<float>(*x);
     } else if (a == "--quiet") {
       quiet = true;
     } else if (!a.empty() && a[0] == '-') {
