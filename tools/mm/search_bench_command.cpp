@@ -51,7 +51,7 @@ options:
   --transition-cost C    transition cost when --playing (default 0.5)
   --include TAGS         tag filter: comma-separated tags every candidate's clip must carry
   --exclude TAGS         tag filter: comma-separated tags no candidate's clip may carry
-  --leaf-size N          kdtree leaf size in rows (default 16)
+  --leaf-size N          kdtree leaf size in rows (default 32)
   --boxtree-leaf-size N  boxtree leaf size in rows, a multiple of 8 (default 64)
   --kdtree-group-rows N  rows per k-means group (default 4096, approx 0; dense groups get their
   --boxtree-group-rows N own tree in their own axes, the rest share one; 0 for a single tree)

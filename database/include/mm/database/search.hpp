@@ -74,8 +74,10 @@ struct SearchResult {
 
 // Tunables of the search structures; every method reads the fields it needs.
 struct SearchOptions {
-  // Rows per leaf of the FLANN exact KD-tree (`kdtree`).
-  int kdtree_leaf_size = 16;
+  // Rows per leaf of the FLANN exact KD-tree (`kdtree`). 32 rather than 16: on all styles
+  // (noise 0.1) the larger leaves cut the median by about 13 % and the p99 by about 15 %, because
+  // fewer levels are backtracked; on the normal style the difference is within noise.
+  int kdtree_leaf_size = 32;
   // Rows per leaf of the box tree (`boxtree`): a positive multiple of 8 (one SIMD block).
   int boxtree_leaf_size = 64;
   // The tree methods first group the rows by k-means, about this many rows per group, and keep
