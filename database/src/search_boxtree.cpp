@@ -38,34 +38,6 @@ namespace {
 
 using search_kernels::kBlockRows;
 
-// Eight floats as a GCC vector: 256-bit AVX code in the AVX2 build of the traversal, two SSE
-// registers in the portable one.
-typedef float Float8 __attribute__((vector_size(32)));
-
-// Squared distance from `query` to the box [lo, hi]; all three padded to a multiple of 8 (the
-// padding columns hold zeros, which add nothing).
-__attribute__((always_inline)) inline float box_distance(const float* query, const float* lo,
-                                                         const float* hi, int padded_dims) {
-  const Float8 zero = {};
-  Float8 acc = {};
-  for (int d = 0; d < padded_dims; d += 8) {
-    Float8 q;
-    Float8 l;
-    Float8 h;
-    std::memcpy(&q, query + d, sizeof q);
-    std::memcpy(&l, lo + d, sizeof l);
-    std::memcpy(&h, hi + d, sizeof h);
-    const Float8 below = l - q;
-    const Float8 above = q - h;
-    Float8 gap = below > above ? below : above;
-    gap = gap > zero ? gap : zero;
-    acc += gap * gap;
-  }
-  float lanes[8];
-  std::memcpy(lanes, &acc, sizeof lanes);
-  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
-}
-
 struct Node {
   int first_block = 0;   // the node's rows are blocks [first_block, last_block)
   int last_block = 0;

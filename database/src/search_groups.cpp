@@ -243,7 +243,6 @@ std::vector<std::vector<int>> tag_classes(const CandidateSet& set) {
 
 int RowGroups::order(const float* query, const SearchConstraints& constraints,
                      GroupDistance* out) const {
-  typedef float Float8 __attribute__((vector_size(32)));
   alignas(32) float padded[kMaxSearchDims + 8] = {};
   const int dims = padded_dims;  // the query's padding columns stay 0, like the boxes'
   const bool tag_filter = constraints.include_tags != 0 || constraints.exclude_tags != 0;
@@ -261,26 +260,7 @@ int RowGroups::order(const float* query, const SearchConstraints& constraints,
     }
     const float* lo = boxes.data() + g * box_stride;
     const float* hi = lo + padded_dims;
-    Float8 acc = {};
-    const Float8 zero = {};
-    for (int d = 0; d < dims; d += 8) {
-      Float8 q;
-      Float8 l;
-      Float8 h;
-      std::memcpy(&q, padded + d, sizeof q);
-      std::memcpy(&l, lo + d, sizeof l);
-      std::memcpy(&h, hi + d, sizeof h);
-      const Float8 below = l - q;
-      const Float8 above = q - h;
-      Float8 gap = below > above ? below : above;
-      gap = gap > zero ? gap : zero;
-      acc += gap * gap;
-    }
-    float lanes[8];
-    std::memcpy(lanes, &acc, sizeof lanes);
-    const GroupDistance entry{((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
-                                  ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7])),
-                              static_cast<int>(g)};
+    const GroupDistance entry{box_distance(padded, lo, hi, dims), static_cast<int>(g)};
     // Insertion sort: a few dozen groups at most.
     int i = count++;
     while (i > 0 && out[i - 1].distance > entry.distance) {
