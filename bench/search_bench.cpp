@@ -9,8 +9,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -137,6 +139,43 @@ BENCHMARK(BM_Scan_Scalar)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Scan_Portable)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Scan_Avx2)->Unit(benchmark::kMicrosecond);
 
+// --- the row distance (FLANN's inner loop) against the column-order sum -----------------------
+
+// Every row's full distance to one query, row-major, as a tree's leaf visits them.
+void row_distances_with(benchmark::State& state, search_kernels::RowDistanceFn distance) {
+  const BenchData& d = data();
+  const int dims = d.input.dims;
+  const int rows = row_count();
+  int q = 0;
+  for (auto _ : state) {
+    const float* query = d.queries.query(q++ % d.queries.count()).data();
+    float best = std::numeric_limits<float>::infinity();
+    for (int r = 0; r < rows; ++r) {
+      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims));
+    }
+    benchmark::DoNotOptimize(best);
+  }
+  state.SetItemsProcessed(state.iterations() * rows);
+}
+
+void BM_RowDistance_Scalar(benchmark::State& state) {
+  row_distances_with(state, &search_kernels::squared_distance);
+}
+void BM_RowDistance_Portable(benchmark::State& state) {
+  row_distances_with(state, &search_kernels::row_distance_portable);
+}
+void BM_RowDistance_Avx2(benchmark::State& state) {
+  if (!search_kernels::avx2_supported()) {
+    state.SkipWithError("this CPU has no AVX2 + FMA");
+    return;
+  }
+  row_distances_with(state, &search_kernels::row_distance_avx2);
+}
+
+BENCHMARK(BM_RowDistance_Scalar)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RowDistance_Portable)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RowDistance_Avx2)->Unit(benchmark::kMicrosecond);
+
 // --- one query through every method -----------------------------------------------------------
 
 const Searcher& searcher(const std::string& method) {
@@ -230,6 +269,11 @@ int main(int argc, char** argv) {
   for (const char* scan : {"BM_Scan_Portable", "BM_Scan_Avx2"}) {
     if (const double x = reporter.speedup(scan, "BM_Scan_Scalar"); x > 0) {
       std::printf("  %-22s %7.2fx the scalar loop\n", scan, x);
+    }
+  }
+  for (const char* kernel : {"BM_RowDistance_Portable", "BM_RowDistance_Avx2"}) {
+    if (const double x = reporter.speedup(kernel, "BM_RowDistance_Scalar"); x > 0) {
+      std::printf("  %-22s %7.2fx the column-order loop\n", kernel, x);
     }
   }
   for (std::string_view name : search_method_names()) {

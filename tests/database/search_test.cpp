@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <new>
 #include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -408,6 +409,46 @@ TEST(SearchKernels, Avx2ScanMatchesScalarLoop) {
   }
   EXPECT_STREQ(search_kernels::scan_blocks_isa(), "avx2");
   check_scan(&search_kernels::scan_blocks_avx2);
+}
+
+// Row distances against the column-order sum, for every column count up to 40 (whole blocks of
+// 8 and every tail length), with each row placed at the very end of its own allocation so that
+// reading past `dims` floats would touch memory the sanitizer build reports.
+void check_row_distance(search_kernels::RowDistanceFn distance) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> value(-3.0f, 3.0f);
+  for (int dims = 1; dims <= 40; ++dims) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const auto a = std::make_unique<float[]>(static_cast<size_t>(dims));
+      const auto b = std::make_unique<float[]>(static_cast<size_t>(dims));
+      double exact = 0.0;
+      for (int d = 0; d < dims; ++d) {
+        a[static_cast<size_t>(d)] = value(rng);
+        b[static_cast<size_t>(d)] = value(rng);
+        const double diff = static_cast<double>(a[static_cast<size_t>(d)]) - b[static_cast<size_t>(d)];
+        exact += diff * diff;
+      }
+      const float got = distance(a.get(), b.get(), dims);
+      EXPECT_NEAR(got, exact, 1e-5 * exact + 1e-30) << "dims " << dims;
+      EXPECT_NEAR(got, search_kernels::squared_distance(a.get(), b.get(), dims), 1e-5 * exact + 1e-30);
+    }
+  }
+  const float a[3] = {1, 2, 3};
+  const float b[3] = {2, 0, 3};
+  EXPECT_FLOAT_EQ(distance(a, b, 3), 5.0f);
+}
+
+TEST(SearchKernels, PortableRowDistanceMatchesColumnSum) {
+  check_row_distance(&search_kernels::row_distance_portable);
+}
+
+TEST(SearchKernels, Avx2RowDistanceMatchesColumnSum) {
+  if (!search_kernels::avx2_supported()) {
+    EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_portable);
+    return;
+  }
+  EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_avx2);
+  check_row_distance(&search_kernels::row_distance_avx2);
 }
 
 // --- every method against brute on synthetic data --------------------------------------------

@@ -21,6 +21,16 @@ float squared_distance_bounded(const float* a, const float* b, int dims, float b
 float box_squared_distance_bounded(const float* point, const float* lo, const float* hi, int dims,
                                    float bound);
 
+// Squared distance of two rows summed 8 columns at a time, for structures that visit one row at
+// a time (the FLANN trees). The order of summation differs from squared_distance(), so the
+// result may differ from the canonical value by rounding. Reads exactly `dims` floats of each.
+using RowDistanceFn = float (*)(const float* a, const float* b, int dims);
+float row_distance_portable(const float* a, const float* b, int dims);
+// AVX2 + FMA version: call only when avx2_supported().
+float row_distance_avx2(const float* a, const float* b, int dims);
+// The fastest row distance this CPU supports, chosen once at run time.
+RowDistanceFn row_distance();
+
 // Rows per block of the blocked layout.
 inline constexpr int kBlockRows = 8;
 
