@@ -8,7 +8,6 @@
 #include <exception>
 #include <mutex>
 #include <set>
-#include <thread>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -17,6 +16,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/gltf.hpp"
+#include "workers.hpp"
 
 namespace mm {
 
@@ -154,28 +154,6 @@ std::string topology_difference(const Skeleton& a, const Skeleton& b) {
   return "the same joints";
 }
 
-// Runs `work(worker, item)` for every item on up to `threads` threads (the caller's included)
-// that pull item indices from a shared counter. Returns the number of threads used.
-template <class Work>
-int run_workers(size_t items, int threads, const Work& work) {
-  std::atomic<size_t> next{0};
-  auto loop = [&](int worker) {
-    for (size_t i = next.fetch_add(1); i < items; i = next.fetch_add(1)) work(worker, i);
-  };
-  std::vector<std::thread> pool;
-  const int wanted = static_cast<int>(std::min<size_t>(static_cast<size_t>(threads), items));
-  for (int t = 1; t < wanted; ++t) {
-    try {
-      pool.emplace_back(loop, t);
-    } catch (const std::exception&) {
-      break;  // no more threads available: the ones running (and this one) do the work
-    }
-  }
-  loop(0);
-  for (std::thread& t : pool) t.join();
-  return static_cast<int>(pool.size()) + 1;
-}
-
 // The shared part of both entry points: `load(i, result)` imports input i into result.clips.
 //
 // Phase 1 (parallel over inputs): import, validate, resample, find roles.
@@ -211,9 +189,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   context.preprocess.root = options.root;
   context.preprocess.contacts = options.contacts;
 
-  int threads = options.threads > 0
-                    ? options.threads
-                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int threads = detail::worker_threads(options.threads);
   std::vector<WorkerScratch> scratch(static_cast<size_t>(threads));
   // Progress counts every input twice: once imported (phase 1), once processed (phase 3).
   const size_t progress_total = 2 * input_count;
@@ -230,7 +206,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   // Without skip_bad the first failing input (in input order) is the answer: inputs after a
   // known failure are skipped, inputs before it still run so the reported one is always the same.
   std::atomic<size_t> first_failure{input_count};
-  rep.threads = run_workers(input_count, threads, [&](int, size_t i) {
+  rep.threads = detail::run_workers(input_count, threads, [&](int, size_t i) {
     InputResult& result = results[i];
     if (!options.skip_bad && i > first_failure.load()) return;
     try {
@@ -358,7 +334,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   db.frame_count = static_cast<int>(total_frames);
   // Fresh memory costs more to fault in than to fill, so the arrays are allocated in parallel,
   // largest first.
-  run_workers(8, threads, [&](int, size_t array) {
+  detail::run_workers(8, threads, [&](int, size_t array) {
     switch (array) {
       case 0:
         resize_large(db.local_rotations, values);
@@ -398,7 +374,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   std::vector<Status> job_status(jobs.size());
   std::vector<std::atomic<int>> jobs_left(input_count);
   for (const ClipJob& job : jobs) jobs_left[job.input].fetch_add(1);
-  run_workers(jobs.size(), threads, [&](int worker, size_t k) {
+  detail::run_workers(jobs.size(), threads, [&](int worker, size_t k) {
     const ClipJob& job = jobs[k];
     const ClipRange& range = db.clips[job.range];
     try {
@@ -452,7 +428,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   // Normalizing is element-wise, so splitting the rows between threads changes nothing.
   const size_t chunk_rows = 4096;
   const size_t chunks = (total_frames + chunk_rows - 1) / chunk_rows;
-  run_workers(chunks, threads, [&](int, size_t chunk) {
+  detail::run_workers(chunks, threads, [&](int, size_t chunk) {
     const size_t first = chunk * chunk_rows;
     const size_t rows = std::min(chunk_rows, total_frames - first);
     normalize_features(std::span(db.features).subspan(first * dims, rows * dims),

@@ -28,6 +28,7 @@
 #include <limits>
 
 #include "search_detail.hpp"
+#include "workers.hpp"
 
 namespace mm::search_detail {
 
@@ -121,25 +122,35 @@ struct FlannForest {
 
   bool empty() const { return trees.empty(); }
 
-  // Builds one index per group of candidate rows.
-  Status build(const CandidateSet& set, std::vector<std::vector<int>> rows_of_groups, bool rotate,
-               const flann::IndexParams& params, std::string_view method) {
-    const int dims = set.dims;
+  // Sets up one group per entry of `rows_of_groups` (candidate rows of `set`); the indices are
+  // built by build_group(), which may run for several groups at once.
+  void prepare(const CandidateSet& set, std::vector<std::vector<int>> rows_of_groups) {
     groups = row_groups_of(set, rows_of_groups);
     trees.resize(rows_of_groups.size());
     for (size_t g = 0; g < rows_of_groups.size(); ++g) {
-      FlannGroup<Index>& group = trees[g];
-      group.set_rows = std::move(rows_of_groups[g]);
-      const int count = static_cast<int>(group.set_rows.size());
-      rows += group.set_rows.size();
+      rows += rows_of_groups[g].size();
+      trees[g].set_rows = std::move(rows_of_groups[g]);
+    }
+  }
+
+  // Copies group g's rows (into its principal axes when `rotate`) and builds its index.
+  Status build_group(size_t g, const CandidateSet& set, bool rotate,
+                     const flann::IndexParams& params, std::string_view method) {
+    const int dims = set.dims;
+    FlannGroup<Index>& group = trees[g];
+    const int count = static_cast<int>(group.set_rows.size());
+    if (count == 0) return Status::success();
+    try {
       group.points.resize(static_cast<size_t>(count) * dims);
+      group.frames.reserve(group.set_rows.size());
+      group.tags.reserve(group.set_rows.size());
       for (int i = 0; i < count; ++i) {
         const int r = group.set_rows[static_cast<size_t>(i)];
         std::copy_n(set.row(r), dims, group.points.data() + static_cast<size_t>(i) * dims);
         group.frames.push_back(set.row_frame[static_cast<size_t>(r)]);
         group.tags.push_back(set.row_tags[static_cast<size_t>(r)]);
       }
-      if (rotate && count > 0) {
+      if (rotate) {
         group.rotation = principal_axes(group.points.data(), count, dims, 4096);
         float rotated[kMaxSearchDims];
         for (int i = 0; i < count; ++i) {
@@ -149,15 +160,12 @@ struct FlannForest {
           group.max_row_norm = std::max(group.max_row_norm, row_norm(rotated, dims));
         }
       }
-      if (count == 0) continue;
-      try {
-        flann::Matrix<float> matrix(group.points.data(), static_cast<size_t>(count),
-                                    static_cast<size_t>(dims));
-        group.index = std::make_unique<Index>(matrix, params);
-        group.index->buildIndex();
-      } catch (const std::exception& e) {
-        return Error{std::string(method) + ": FLANN failed to build an index: " + e.what()};
-      }
+      flann::Matrix<float> matrix(group.points.data(), static_cast<size_t>(count),
+                                  static_cast<size_t>(dims));
+      group.index = std::make_unique<Index>(matrix, params);
+      group.index->buildIndex();
+    } catch (const std::exception& e) {
+      return Error{std::string(method) + ": FLANN failed to build an index: " + e.what()};
     }
     return Status::success();
   }
@@ -234,14 +242,34 @@ class FlannSearcher final : public Searcher {
     if (set.row_count() == 0) return std::unique_ptr<Searcher>(std::move(searcher));
     std::vector<std::vector<int>> rows;
     make_row_groups(set, group_rows, rows);
-    Status built = searcher->main_.build(set, std::move(rows), options.principal_axes, params,
-                                         Traits::kName);
-    if (!built) return Error{built.message()};
+    searcher->main_.prepare(set, std::move(rows));
     std::vector<std::vector<int>> classes = tag_classes(set);
     if (options.tag_class_indices && classes.size() > 1) {
-      built = searcher->classes_.build(set, std::move(classes), options.principal_axes, params,
-                                       Traits::kName);
-      if (!built) return Error{built.message()};
+      searcher->classes_.prepare(set, std::move(classes));
+    }
+    // Every group of both forests is one job; the largest go first so that the threads finish
+    // together.
+    struct Job {
+      Forest* forest;
+      size_t group;
+      size_t rows;
+    };
+    std::vector<Job> jobs;
+    for (Forest* forest : {&searcher->main_, &searcher->classes_}) {
+      for (size_t g = 0; g < forest->trees.size(); ++g) {
+        jobs.push_back({forest, g, forest->trees[g].set_rows.size()});
+      }
+    }
+    std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.rows > b.rows; });
+    std::vector<Status> built(jobs.size(), Status::success());
+    detail::run_workers(jobs.size(), detail::worker_threads(options.build_threads),
+                        [&](int, size_t j) {
+                          built[j] = jobs[j].forest->build_group(jobs[j].group, set,
+                                                                 options.principal_axes, params,
+                                                                 Traits::kName);
+                        });
+    for (const Status& status : built) {
+      if (!status) return Error{status.message()};
     }
     return std::unique_ptr<Searcher>(std::move(searcher));
   }

@@ -16,6 +16,42 @@ namespace {
 
 using search_kernels::kBlockRows;
 
+// The nearest of a set of centres to a candidate row, with the blocked scan over the centres.
+class NearestCentre {
+ public:
+  explicit NearestCentre(const CandidateSet& set) : set_(set) {}
+
+  // `centres` holds whole rows of set.dims floats.
+  void set_centres(const std::vector<float>& centres) {
+    const int dims = set_.dims;
+    count_ = static_cast<int>(centres.size() / static_cast<size_t>(dims));
+    packed_.assign(search_kernels::blocked_float_count(count_, dims), 0.0f);
+    search_kernels::pack_blocks(centres.data(), count_, dims, packed_.data());
+    no_tags_.assign(static_cast<size_t>(count_), 0);
+    ids_.resize(static_cast<size_t>(count_));
+    std::iota(ids_.begin(), ids_.end(), 0);
+    filter_.row_tags = no_tags_.data();
+    filter_.row_frame = ids_.data();
+    filter_.row_count = count_;
+  }
+
+  int operator()(int row) const {
+    search_kernels::ScanBest best;
+    scan_(packed_.data(), 0, (count_ + kBlockRows - 1) / kBlockRows, set_.dims, set_.row(row),
+          filter_, best);
+    return std::max(best.row, 0);
+  }
+
+ private:
+  const CandidateSet& set_;
+  const search_kernels::ScanBlocksFn scan_ = search_kernels::scan_blocks();
+  int count_ = 0;
+  std::vector<float> packed_;
+  std::vector<uint64_t> no_tags_;
+  std::vector<int> ids_;
+  search_kernels::RowFilter filter_;
+};
+
 // Splits `rows` (candidate rows of `set`) into at most `group_count` groups by k-means
 // (k-means++ seeding from a fixed seed, Lloyd iterations on an evenly spaced sample, then every
 // row to its nearest centre); returns the non-empty groups.
@@ -59,30 +95,11 @@ std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::v
     centres.insert(centres.end(), set.row(sample[chosen]), set.row(sample[chosen]) + dims);
   }
   const int k_count = static_cast<int>(centres.size() / row_size);
-  // Nearest centre of a row, with the blocked scan over the centres.
-  std::vector<float> packed;
-  std::vector<uint64_t> no_tags(static_cast<size_t>(k_count), 0);
-  std::vector<int> centre_ids(static_cast<size_t>(k_count));
-  std::iota(centre_ids.begin(), centre_ids.end(), 0);
-  const search_kernels::ScanBlocksFn scan = search_kernels::scan_blocks();
-  auto pack = [&] {
-    packed.assign(search_kernels::blocked_float_count(k_count, dims), 0.0f);
-    search_kernels::pack_blocks(centres.data(), k_count, dims, packed.data());
-  };
-  search_kernels::RowFilter all;
-  all.row_tags = no_tags.data();
-  all.row_frame = centre_ids.data();
-  all.row_count = k_count;
-  const int centre_blocks = (k_count + kBlockRows - 1) / kBlockRows;
-  auto nearest_centre = [&](int row) {
-    search_kernels::ScanBest best;
-    scan(packed.data(), 0, centre_blocks, dims, set.row(row), all, best);
-    return std::max(best.row, 0);
-  };
+  NearestCentre nearest_centre(set);
   std::vector<double> sums;
   std::vector<int> counts;
   for (int iteration = 0; iteration < 8; ++iteration) {
-    pack();
+    nearest_centre.set_centres(centres);
     sums.assign(centres.size(), 0.0);
     counts.assign(static_cast<size_t>(k_count), 0);
     for (int r : sample) {
@@ -98,7 +115,7 @@ std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::v
       }
     }
   }
-  pack();
+  nearest_centre.set_centres(centres);
   std::vector<std::vector<int>> by_centre(static_cast<size_t>(k_count));
   for (int r : rows) by_centre[static_cast<size_t>(nearest_centre(r))].push_back(r);
   for (auto& group : by_centre) {
@@ -129,28 +146,40 @@ double total_variance(const CandidateSet& set, const std::vector<int>& rows) {
 // A group is dense when its spread is below this fraction of the whole database's.
 constexpr double kDenseVarianceFraction = 0.01;
 
-// Groups of about `group_rows` candidate rows: k-means over all rows, then again inside every
-// group still more than twice that size (a dense cluster, such as the standing gestures, takes
-// one centre of the first pass but is split by the next), up to kMaxKmeansGroups in all.
-// Then only the dense groups (total variance under 1 % of the database's) stay apart, each to
-// get its own tree in its own axes; all the others are merged back into one group: at the scale
-// of the database one tree in principal axes prunes as well as several, and a query then
-// descends one tree instead of several. Without a dense group, this is one group of all rows.
+// The most rows the grouping looks at (evenly spaced over the candidates).
+constexpr int kGroupingSampleRows = 16384;
+
+// Groups of about `group_rows` candidate rows. The grouping is decided on an evenly spaced
+// sample of at most kGroupingSampleRows rows: k-means over the sample, then again inside every
+// group still more than twice the (scaled) size (a dense cluster, such as the standing gestures,
+// takes one centre of the first pass but is split by the next), up to kMaxKmeansGroups in all.
+// Only the dense groups (total variance under 1 % of the sample's) stay apart, each to get its
+// own tree in its own axes: every row goes to its nearest final centre, and the rows of the
+// centres that are not dense are merged into one group; at the scale of the database one tree
+// in principal axes prunes as well as several, and a query then descends one tree instead of
+// several. Without a dense group (all styles) this is one group of all rows, found from the
+// sample alone.
 std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_rows) {
-  std::vector<int> all(static_cast<size_t>(set.row_count()));
+  const int count = set.row_count();
+  std::vector<int> all(static_cast<size_t>(count));
   std::iota(all.begin(), all.end(), 0);
-  if (group_rows <= 0) return {all};
+  if (group_rows <= 0 || count == 0) return {all};
+  const int step = std::max(1, count / kGroupingSampleRows);
+  std::vector<int> sample;
+  for (int r = 0; r < count; r += step) sample.push_back(r);
+  const int sample_group_rows = std::max(1, group_rows / step);
   const auto groups_for = [&](size_t rows) {
-    return static_cast<int>(std::clamp<size_t>((rows + group_rows / 2) / group_rows, 1, kMaxKmeansGroups));
+    return static_cast<int>(std::clamp<size_t>((rows + sample_group_rows / 2) / sample_group_rows,
+                                               1, kMaxKmeansGroups));
   };
   std::vector<std::vector<int>> done;
-  std::vector<std::vector<int>> pending = kmeans_split(set, all, groups_for(all.size()));
+  std::vector<std::vector<int>> pending = kmeans_split(set, sample, groups_for(sample.size()));
   for (int pass = 0; pass < 4 && !pending.empty(); ++pass) {
     std::vector<std::vector<int>> next;
     for (auto& group : pending) {
       const size_t room =
           kMaxKmeansGroups - std::min<size_t>(kMaxKmeansGroups, done.size() + next.size() + 1);
-      if (group.size() <= 2 * static_cast<size_t>(group_rows) || room == 0) {
+      if (group.size() <= 2 * static_cast<size_t>(sample_group_rows) || room == 0) {
         done.push_back(std::move(group));
         continue;
       }
@@ -165,19 +194,38 @@ std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_r
     pending = std::move(next);
   }
   for (auto& group : pending) done.push_back(std::move(group));
-  const double dense_below = kDenseVarianceFraction * total_variance(set, all);
-  std::vector<std::vector<int>> kept;
-  std::vector<int> merged;
-  for (auto& group : done) {
-    if (total_variance(set, group) < dense_below) {
-      kept.push_back(std::move(group));
-    } else {
-      merged.insert(merged.end(), group.begin(), group.end());
+  const double dense_below = kDenseVarianceFraction * total_variance(set, sample);
+  std::vector<uint8_t> dense(done.size(), 0);
+  bool any_dense = false;
+  for (size_t g = 0; g < done.size(); ++g) {
+    dense[g] = total_variance(set, done[g]) < dense_below;
+    any_dense = any_dense || dense[g];
+  }
+  if (!any_dense) return {all};
+  // Every row to its nearest final centre (the mean of its sample group).
+  const auto dims = static_cast<size_t>(set.dims);
+  std::vector<float> centres(done.size() * dims, 0.0f);
+  for (size_t g = 0; g < done.size(); ++g) {
+    std::vector<double> sum(dims, 0.0);
+    for (int r : done[g]) {
+      for (size_t d = 0; d < dims; ++d) sum[d] += set.row(r)[d];
+    }
+    for (size_t d = 0; d < dims; ++d) {
+      centres[g * dims + d] = static_cast<float>(sum[d] / static_cast<double>(done[g].size()));
     }
   }
-  if (!merged.empty()) {
-    std::sort(merged.begin(), merged.end());  // back in database order
-    kept.insert(kept.begin(), std::move(merged));
+  NearestCentre nearest_centre(set);
+  nearest_centre.set_centres(centres);
+  std::vector<std::vector<int>> by_centre(done.size());
+  std::vector<int> merged;
+  for (int r = 0; r < count; ++r) {
+    const auto c = static_cast<size_t>(nearest_centre(r));
+    (dense[c] ? by_centre[c] : merged).push_back(r);
+  }
+  std::vector<std::vector<int>> kept;
+  if (!merged.empty()) kept.push_back(std::move(merged));  // in database order
+  for (auto& group : by_centre) {
+    if (!group.empty()) kept.push_back(std::move(group));
   }
   return kept;
 }

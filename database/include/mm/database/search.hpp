@@ -99,6 +99,8 @@ struct SearchOptions {
   int approx_trees = 1;
   // Leaf checks per query of the approximate method (its budget; never unlimited).
   int approx_checks = 128;
+  // Threads that build the trees' groups in parallel (`kdtree`, `approx`); 0: every core.
+  int build_threads = 0;
 };
 
 // One search structure over one database. Instances are immutable after creation: search()
