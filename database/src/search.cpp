@@ -60,7 +60,7 @@ SearchInput search_input(const Database& database) {
 
 std::span<const std::string_view> search_method_names() {
   static constexpr std::string_view names[] = {"brute", "brute-simd", "aabb", "kdtree", "boxtree",
-                                                   "approx"};
+                                                   "approx", "kdtree-eps"};
   return names;
 }
 
@@ -73,6 +73,7 @@ Result<std::unique_ptr<Searcher>> make_searcher(std::string_view method, const S
   if (method == "kdtree") return search_detail::make_kdtree(input, options);
   if (method == "boxtree") return search_detail::make_boxtree(input, options);
   if (method == "approx") return search_detail::make_approx(input, options);
+  if (method == "kdtree-eps") return search_detail::make_kdtree_eps(input, options);
   std::string known;
   for (std::string_view name : search_method_names()) {
     known += known.empty() ? "" : ", ";

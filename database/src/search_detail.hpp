@@ -201,6 +201,8 @@ Result<std::unique_ptr<Searcher>> make_brute_simd(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_aabb(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
                                               const SearchOptions& options);
+Result<std::unique_ptr<Searcher>> make_kdtree_eps(const SearchInput& input,
+                                                  const SearchOptions& options);
 Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
                                               const SearchOptions& options);
 Result<std::unique_ptr<Searcher>> make_boxtree(const SearchInput& input,

@@ -257,6 +257,29 @@ TEST(RealApprox, WithinItsBoundsOnConstrainedQueries) {
   EXPECT_GT(exact, 500);
 }
 
+// kdtree-eps with its default eps on the same queries (noise up to 0.5, a quarter of them at
+// 0.5): within its (1 + eps) bound, and mostly exact (the benchmark measures the real rate and
+// speed per noise level).
+TEST(RealApprox, KdtreeEpsWithinItsBoundOnConstrainedQueries) {
+  const Database& db = subset_database();
+  auto brute = make_searcher("brute", search_input(db));
+  const SearchOptions options;
+  auto approx = make_searcher("kdtree-eps", search_input(db), options);
+  ASSERT_TRUE(approx) << approx.message();
+  const std::vector<Query> queries = real_queries(db, 1000, 29);
+  int exact = 0;
+  for (const Query& q : queries) {
+    const SearchResult expected = brute.value()->search(q.features, q.constraints);
+    const SearchResult got = approx.value()->search(q.features, q.constraints);
+    expect_valid(db, q, got);
+    EXPECT_EQ(got.frame >= 0, expected.frame >= 0);
+    EXPECT_GE(got.cost, expected.cost * (1.0f - 1e-5f));
+    EXPECT_LE(got.cost, expected.cost * (1.0f + options.kdtree_eps) * (1.0f + 1e-5f));
+    exact += same_cost(got.cost, expected.cost);
+  }
+  EXPECT_GT(exact, 700);
+}
+
 // The whole normal-style set (more than half standing gestures): the fast exact structures
 // against brute on unconstrained and playing queries.
 TEST(RealNormalSet, TreesMatchBruteOnTheFullDatabase) {

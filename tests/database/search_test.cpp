@@ -287,13 +287,20 @@ TEST(SearchFactory, RejectsUnknownMethodsAndBadOptions) {
   options = {};
   options.approx_checks = 0;
   EXPECT_FALSE(make_searcher("approx", db.input(), options).ok());
+  for (float eps : {-0.5f, std::numeric_limits<float>::quiet_NaN(), kInf}) {
+    options = {};
+    options.kdtree_eps = eps;
+    auto refused = make_searcher("kdtree-eps", db.input(), options);
+    ASSERT_FALSE(refused.ok()) << eps;
+    EXPECT_NE(refused.message().find("eps"), std::string::npos) << refused.message();
+  }
   for (std::string_view name : search_method_names()) {
     auto s = make_searcher(name, db.input());
     ASSERT_TRUE(s.ok()) << name;
     EXPECT_EQ(s.value()->method(), name);
     EXPECT_EQ(s.value()->dims(), 1);
     EXPECT_GT(s.value()->memory_bytes(), 0u);
-    EXPECT_EQ(s.value()->exact(), name != "approx");
+    EXPECT_EQ(s.value()->exact(), name != "approx" && name != "kdtree-eps");
   }
 }
 
@@ -578,6 +585,35 @@ TEST(SyntheticApprox, NeverBelowExactAlwaysValidMostlyExact) {
   // A loose floor: the randomized trees with a 64-check budget find most nearest neighbours
   // on this data (the benchmark measures the real rate).
   EXPECT_GT(exact, static_cast<int>(queries.size()) / 2);
+}
+
+// kdtree-eps: never better than exact, never worse than (1 + eps) times exact, and exact with
+// eps 0.
+TEST(SyntheticApprox, KdtreeEpsStaysWithinItsBound) {
+  const SyntheticSearchData data = small_synthetic();
+  auto brute = make("brute", data.input());
+  const std::vector<Query> queries = constrained_queries(data, 6, 12);
+  for (float eps : {0.0f, 0.5f, 2.0f, 8.0f}) {
+    SearchOptions options;
+    options.kdtree_eps = eps;
+    auto approx = make("kdtree-eps", data.input(), options);
+    ASSERT_NE(approx, nullptr);
+    int exact = 0;
+    for (const Query& q : queries) {
+      const SearchResult expected = brute->search(q.features, q.constraints);
+      const SearchResult got = approx->search(q.features, q.constraints);
+      expect_valid(data, q, got);
+      EXPECT_EQ(got.frame >= 0, expected.frame >= 0);
+      EXPECT_GE(got.cost, expected.cost * (1.0f - 1e-5f)) << "eps " << eps;
+      EXPECT_LE(got.cost, expected.cost * (1.0f + eps) * (1.0f + 1e-5f) + 1e-6f) << "eps " << eps;
+      exact += same_cost(got.cost, expected.cost);
+    }
+    if (eps == 0.0f) {
+      EXPECT_EQ(exact, static_cast<int>(queries.size()));
+    } else {
+      EXPECT_GT(exact, static_cast<int>(queries.size()) / 2) << "eps " << eps;
+    }
+  }
 }
 
 TEST(SearchBatch, BatchedResultsEqualSingleSearches) {

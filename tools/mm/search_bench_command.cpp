@@ -42,7 +42,7 @@ options:
   --queries N            number of queries (default 2000)
   --noise S              Gaussian noise added to each query, normalized units (default 0.1)
   --methods LIST         comma-separated methods (default: all; known: brute, brute-simd, aabb,
-                         kdtree, boxtree, approx)
+                         kdtree, boxtree, approx, kdtree-eps)
   --json FILE            also write the results as JSON
   --seed N               query seed (default 1)
   --playing              each query plays its source frame (continuation, window, transition
@@ -62,6 +62,7 @@ options:
   --clock wall|cpu       wall time (default) or the thread's CPU time (ignores preemption)
   --approx-trees N       approx: randomized trees (default 1)
   --approx-checks N      approx: leaf checks per query (default 128)
+  --eps E                kdtree-eps: distance within (1 + E) times the best (default 2)
   --batch                also time batched queries on 1 and 2 threads
   --quiet                no progress on the terminal
 )";
@@ -182,6 +183,9 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     } else if (a == "--approx-checks") {
       if (!number(i, a, 1, 1e9, v)) return 2;
       out.options.approx_checks = static_cast<int>(v);
+    } else if (a == "--eps") {
+      if (!number(i, a, 0, 1e6, v)) return 2;
+      out.options.kdtree_eps = static_cast<float>(v);
     } else if (a == "--batch") {
       out.batch = true;
     } else if (a == "--quiet") {
