@@ -10,6 +10,8 @@
 #include <string>
 #include <sys/wait.h>
 
+#include <nlohmann/json.hpp>
+
 #include "mm/database/bvh.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/gltf.hpp"
@@ -166,6 +168,43 @@ TEST(Cli, ExportWritesAGlbThatImportsWithTheClipsFramesAndJoints) {
 
   EXPECT_EQ(run_mm("export " + quoted(source)).exit_code, 2);  // no -o
   EXPECT_EQ(run_mm("export " + quoted(dir / "missing.bvh") + " -o " + quoted(out)).exit_code, 1);
+}
+
+// search-bench on generated data: every method and the FLANN reference in the JSON with the
+// documented fields; the exact methods match brute on every query; the reference row only
+// when nothing plays (it cannot apply the rules).
+TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
+  const fs::path dir = test::scratch_dir();
+  for (bool playing : {false, true}) {
+    const fs::path json_path = dir / (playing ? "playing.json" : "plain.json");
+    const CommandRun run = run_mm(std::string("search-bench --synthetic --queries 300 --quiet ") +
+                                  (playing ? "--playing " : "") + "--json " + quoted(json_path));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::ifstream file(json_path);
+    const nlohmann::json json = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
+    ASSERT_FALSE(json.is_discarded()) << json_path;
+    for (const char* method : {"brute", "brute-simd", "aabb", "kdtree", "boxtree", "approx",
+                               "kdtree-eps"}) {
+      ASSERT_TRUE(json.contains(method)) << method;
+      const nlohmann::json& m = json[method];
+      for (const char* field : {"build_ms", "memory_bytes", "median_us", "p99_us",
+                                "exact_match_rate", "cost_ratio"}) {
+        ASSERT_TRUE(m.contains(field) && m[field].is_number()) << method << " " << field;
+      }
+      EXPECT_GT(m["memory_bytes"].get<double>(), 0) << method;
+      EXPECT_GT(m["median_us"].get<double>(), 0) << method;
+      EXPECT_LE(m["median_us"].get<double>(), m["p99_us"].get<double>()) << method;
+      EXPECT_GE(m["cost_ratio"].get<double>(), 1.0 - 1e-6) << method;
+      const std::string name = method;
+      if (name != "approx" && name != "kdtree-eps") {
+        EXPECT_EQ(m["exact_match_rate"].get<double>(), 1.0) << method;
+      }
+    }
+    EXPECT_EQ(json.contains("flann-plain"), !playing);
+    if (!playing) {
+      EXPECT_EQ(json["flann-plain"]["exact_match_rate"].get<double>(), 1.0);
+    }
+  }
 }
 
 }  // namespace

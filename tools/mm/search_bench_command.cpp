@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <flann/flann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
@@ -63,6 +64,9 @@ options:
   --approx-trees N       approx: randomized trees (default 1)
   --approx-checks N      approx: leaf checks per query (default 128)
   --eps E                kdtree-eps: distance within (1 + E) times the best (default 2)
+  --no-flann-reference   leave out the flann-plain row (FLANN's single tree as shipped: raw
+                         columns, no constraints; shown only when nothing plays and no tag
+                         filter is given, to compare this machine with plain FLANN elsewhere)
   --batch                also time batched queries on 1 and 2 threads
   --quiet                no progress on the terminal
 )";
@@ -82,6 +86,7 @@ struct Arguments {
   std::vector<std::string> exclude;
   SearchOptions options;
   bool batch = false;
+  bool flann_reference = true;
   bool quiet = false;
   int repeat = 1;
   bool cpu_clock = false;
@@ -186,6 +191,8 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     } else if (a == "--eps") {
       if (!number(i, a, 0, 1e6, v)) return 2;
       out.options.kdtree_eps = static_cast<float>(v);
+    } else if (a == "--no-flann-reference") {
+      out.flann_reference = false;
     } else if (a == "--batch") {
       out.batch = true;
     } else if (a == "--quiet") {
@@ -278,6 +285,38 @@ class Progress {
   bool enabled_;
   Clock::time_point last_{};
 };
+
+// Times `search(i)` for every query (after a warm-up), keeping each query's fastest of
+// `arguments.repeat` runs, and fills the report's latency fields and results.
+template <class Search>
+void time_queries(MethodReport& report, int count, const Arguments& arguments, Progress& progress,
+                  const Search& search) {
+  // Warm-up: caches and branch predictors see the structure before the timed run.
+  const int warmup = std::min(count, 64);
+  for (int i = 0; i < warmup; ++i) {
+    volatile float sink = search(i).cost;
+    (void)sink;
+  }
+  std::vector<double> times(static_cast<size_t>(count), std::numeric_limits<double>::infinity());
+  report.results.resize(static_cast<size_t>(count));
+  const int total = count * arguments.repeat;
+  for (int round = 0; round < arguments.repeat; ++round) {
+    for (int i = 0; i < count; ++i) {
+      const double start = now_us(arguments.cpu_clock);
+      report.results[static_cast<size_t>(i)] = search(i);
+      const double elapsed = now_us(arguments.cpu_clock) - start;
+      times[static_cast<size_t>(i)] = std::min(times[static_cast<size_t>(i)], elapsed);
+      if ((i & 63) == 0) progress.show(report.name + ": queries", round * count + i, total);
+    }
+  }
+  progress.clear();
+  report.median_us = percentile(times, 0.5);
+  report.p99_us = percentile(times, 0.99);
+  double sum = 0;
+  for (double t : times) sum += t;
+  report.mean_us = sum / static_cast<double>(times.size());
+}
+
 
 std::string human_bytes(size_t bytes) {
   char text[32];
@@ -375,32 +414,49 @@ int run_search_bench(const std::vector<std::string>& args) {
     }
     const Searcher& searcher = *made.value();
     report.memory_bytes = searcher.memory_bytes();
-    // Warm-up: caches and branch predictors see the structure before the timed run.
-    const int warmup = std::min(queries.count(), 64);
-    for (int i = 0; i < warmup; ++i) {
-      volatile float sink = searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]).cost;
-      (void)sink;
+    time_queries(report, queries.count(), arguments, progress, [&](int i) {
+      return searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]);
+    });
+    reports.push_back(std::move(report));
+  }
+  // The reference row: FLANN's exact single tree as shipped (raw columns, FLANN's L2, its
+  // default leaf size, no constraints), on the same queries. It calibrates this machine against
+  // other measurements of plain FLANN; it is not a method (it cannot apply the rules).
+  const bool unconstrained = !arguments.playing && include_tags == 0 && exclude_tags == 0;
+  if (unconstrained && arguments.flann_reference) {
+    MethodReport report;
+    report.name = "flann-plain";
+    progress.show(report.name + ": building", 0, 1);
+    std::vector<float> rows;
+    std::vector<int> row_frame;
+    for (int f = 0; f < input.frame_count(); ++f) {
+      if (!input.searchable[static_cast<size_t>(f)]) continue;
+      const float* row = input.features.data() + static_cast<size_t>(f) * input.dims;
+      rows.insert(rows.end(), row, row + input.dims);
+      row_frame.push_back(f);
     }
-    std::vector<double> times(static_cast<size_t>(queries.count()),
-                              std::numeric_limits<double>::infinity());
-    report.results.resize(static_cast<size_t>(queries.count()));
-    const int total = queries.count() * arguments.repeat;
-    for (int round = 0; round < arguments.repeat; ++round) {
-      for (int i = 0; i < queries.count(); ++i) {
-        const double start = now_us(arguments.cpu_clock);
-        report.results[static_cast<size_t>(i)] =
-            searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]);
-        const double elapsed = now_us(arguments.cpu_clock) - start;
-        times[static_cast<size_t>(i)] = std::min(times[static_cast<size_t>(i)], elapsed);
-        if ((i & 63) == 0) progress.show(name + ": queries", round * queries.count() + i, total);
+    const auto build_start = Clock::now();
+    flann::KDTreeSingleIndex<flann::L2<float>> index(
+        flann::Matrix<float>(rows.data(), row_frame.size(), static_cast<size_t>(input.dims)),
+        flann::KDTreeSingleIndexParams());
+    index.buildIndex();
+    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    report.memory_bytes = rows.size() * sizeof(float) * 2 + static_cast<size_t>(index.usedMemory());
+    time_queries(report, queries.count(), arguments, progress, [&](int i) {
+      int nearest = -1;
+      float distance = std::numeric_limits<float>::infinity();
+      flann::Matrix<int> indices(&nearest, 1, 1);
+      flann::Matrix<float> distances(&distance, 1, 1);
+      const std::span<const float> query = queries.query(i);
+      index.knnSearch(flann::Matrix<float>(const_cast<float*>(query.data()), 1, query.size()),
+                      indices, distances, 1, flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
+      SearchResult result;
+      if (nearest >= 0) {
+        result.frame = row_frame[static_cast<size_t>(nearest)];
+        result.cost = distance + constraints[static_cast<size_t>(i)].transition_cost;
       }
-    }
-    progress.clear();
-    report.median_us = percentile(times, 0.5);
-    report.p99_us = percentile(times, 0.99);
-    double sum = 0;
-    for (double t : times) sum += t;
-    report.mean_us = sum / static_cast<double>(times.size());
+      return result;
+    });
     reports.push_back(std::move(report));
   }
 
