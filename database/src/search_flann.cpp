@@ -2,8 +2,8 @@
 // tree searched with FLANN's eps: within (1 + eps) of the best) and `approx` (flann::KDTreeIndex,
 // randomized trees with a leaf-check budget).
 //
-// All three index the searchable rows only (the mask is fixed when the database is built), split into
-// k-means groups (RowGroups) with one FLANN index per group, each over the group's principal-axes
+// All three index the searchable rows only (the mask is fixed when the database is built),
+// split into k-means groups (RowGroups) with one FLANN index per group, each over the group's principal-axes
 // coordinates. A query visits the groups nearest first by the distance to their bounding box and
 // stops at the first group whose box is farther than the best cost found. Inside a group the
 // per-query rules are applied by a custom FLANN result set: a row that fails the tag filter or
