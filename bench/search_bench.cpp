@@ -127,12 +127,15 @@ void scan_with(benchmark::State& state, search_kernels::ScanBlocksFn scan) {
 
 void BM_Scan_Portable(benchmark::State& state) { scan_with(state, &search_kernels::scan_blocks_portable); }
 
+// False (and the run marked as skipped) on a CPU without AVX2 + FMA.
+bool avx2_or_skip(benchmark::State& state) {
+  if (search_kernels::avx2_supported()) return true;
+  state.SkipWithError("this CPU has no AVX2 + FMA");
+  return false;
+}
+
 void BM_Scan_Avx2(benchmark::State& state) {
-  if (!search_kernels::avx2_supported()) {
-    state.SkipWithError("this CPU has no AVX2 + FMA");
-    return;
-  }
-  scan_with(state, &search_kernels::scan_blocks_avx2);
+  if (avx2_or_skip(state)) scan_with(state, &search_kernels::scan_blocks_avx2);
 }
 
 BENCHMARK(BM_Scan_Scalar)->Unit(benchmark::kMicrosecond);
@@ -165,11 +168,7 @@ void BM_RowDistance_Portable(benchmark::State& state) {
   row_distances_with(state, &search_kernels::row_distance_portable);
 }
 void BM_RowDistance_Avx2(benchmark::State& state) {
-  if (!search_kernels::avx2_supported()) {
-    state.SkipWithError("this CPU has no AVX2 + FMA");
-    return;
-  }
-  row_distances_with(state, &search_kernels::row_distance_avx2);
+  if (avx2_or_skip(state)) row_distances_with(state, &search_kernels::row_distance_avx2);
 }
 
 BENCHMARK(BM_RowDistance_Scalar)->Unit(benchmark::kMicrosecond);
