@@ -43,8 +43,10 @@ struct FlannDistance {
   typedef float ResultType;
 
   template <typename Iterator1, typename Iterator2>
-  float operator()(Iterator1 a, Iterator2 b, size_t size, float /*worst_dist*/ = -1) const {
-    return kernel(&*a, &*b, static_cast<int>(size));
+  float operator()(Iterator1 a, Iterator2 b, size_t size, float worst_dist = -1) const {
+    // FLANN passes -1 when there is no bound.
+    const float bound = worst_dist < 0.0f ? std::numeric_limits<float>::infinity() : worst_dist;
+    return kernel(&*a, &*b, static_cast<int>(size), bound);
   }
   // One column's share of the distance (FLANN's incremental bound of a branch).
   template <typename U, typename V>

@@ -15,6 +15,13 @@ constexpr float kPaddingValue = 1e30f;
 // Eight floats as a GCC vector (two SSE registers on plain x86-64).
 typedef float Float8 __attribute__((vector_size(32)));
 
+// The lanes summed pairwise, the order every row distance uses.
+float sum_lanes(const Float8& acc) {
+  float lanes[8];
+  std::memcpy(lanes, &acc, sizeof lanes);
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+}
+
 // The rare path of a scan: some lane of a block beat the bound; check the lanes in row order
 // and keep the best passing one.
 __attribute__((noinline)) void consider_lanes(const float* distances, int first_row,
@@ -65,7 +72,7 @@ float box_squared_distance_bounded(const float* point, const float* lo, const fl
   return sum;
 }
 
-float row_distance_portable(const float* a, const float* b, int dims) {
+float row_distance_portable(const float* a, const float* b, int dims, float bound) {
   Float8 acc = {};
   int d = 0;
   for (; d + 8 <= dims; d += 8) {
@@ -75,10 +82,13 @@ float row_distance_portable(const float* a, const float* b, int dims) {
     std::memcpy(&y, b + d, sizeof y);
     const Float8 diff = x - y;
     acc += diff * diff;
+    if (d + 16 <= dims) {
+      // The leading columns hold most of the spread (principal axes), so a far row stops early.
+      const float partial = sum_lanes(acc);
+      if (partial > bound) return partial;
+    }
   }
-  float lanes[8];
-  std::memcpy(lanes, &acc, sizeof lanes);
-  float sum = ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  float sum = sum_lanes(acc);
   for (; d < dims; ++d) {
     const float diff = a[d] - b[d];
     sum += diff * diff;
@@ -86,13 +96,25 @@ float row_distance_portable(const float* a, const float* b, int dims) {
   return sum;
 }
 
+__attribute__((target("avx2,fma"))) static float horizontal_sum(__m256 v) {
+  __m128 sum = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  sum = _mm_add_ps(sum, _mm_movehl_ps(sum, sum));
+  sum = _mm_add_ss(sum, _mm_movehdup_ps(sum));
+  return _mm_cvtss_f32(sum);
+}
+
 __attribute__((target("avx2,fma"))) float row_distance_avx2(const float* a, const float* b,
-                                                            int dims) {
+                                                            int dims, float bound) {
   __m256 acc = _mm256_setzero_ps();
   int d = 0;
   for (; d + 8 <= dims; d += 8) {
     const __m256 diff = _mm256_sub_ps(_mm256_loadu_ps(a + d), _mm256_loadu_ps(b + d));
     acc = _mm256_fmadd_ps(diff, diff, acc);
+    if (d + 16 <= dims) {
+      // The leading columns hold most of the spread (principal axes), so a far row stops early.
+      const float partial = horizontal_sum(acc);
+      if (partial > bound) return partial;
+    }
   }
   if (d < dims) {
     // The masked loads read only the remaining columns (never past the end of a row).
@@ -101,10 +123,7 @@ __attribute__((target("avx2,fma"))) float row_distance_avx2(const float* a, cons
     const __m256 diff = _mm256_sub_ps(_mm256_maskload_ps(a + d, mask), _mm256_maskload_ps(b + d, mask));
     acc = _mm256_fmadd_ps(diff, diff, acc);
   }
-  __m128 sum = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps(acc, 1));
-  sum = _mm_add_ps(sum, _mm_movehl_ps(sum, sum));
-  sum = _mm_add_ss(sum, _mm_movehdup_ps(sum));
-  return _mm_cvtss_f32(sum);
+  return horizontal_sum(acc);
 }
 
 size_t blocked_float_count(int row_count, int dims) {
