@@ -204,7 +204,37 @@ TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
     if (!playing) {
       EXPECT_EQ(json["flann-plain"]["exact_match_rate"].get<double>(), 1.0);
     }
+    // The neighbourhood shares: percentiles in order, the wider factor holding at least as many
+    // rows, and never less than the nearest row itself.
+    const double candidates = json["run"]["candidates"].get<double>();
+    const nlohmann::json& near = json["run"]["share_within_1.2x_nearest"];
+    const nlohmann::json& wide = json["run"]["share_within_1.5x_nearest"];
+    for (const char* stat : {"median", "p90", "p99"}) {
+      ASSERT_TRUE(near.contains(stat) && wide.contains(stat)) << stat;
+      EXPECT_GE(near[stat].get<double>(), 1.0 / candidates - 1e-12) << stat;
+      EXPECT_GE(wide[stat].get<double>(), near[stat].get<double>()) << stat;
+      EXPECT_LE(wide[stat].get<double>(), 1.0) << stat;
+    }
+    EXPECT_LE(near["median"].get<double>(), near["p90"].get<double>());
+    EXPECT_LE(near["p90"].get<double>(), near["p99"].get<double>());
   }
+}
+
+// Without noise every query is a searchable row, which is its own nearest row at distance 0; on
+// the synthetic data no other row coincides with it, so exactly one candidate is within any
+// factor of the nearest distance.
+TEST(Cli, SearchBenchNeighbourhoodOfExactRowsIsTheRowItself) {
+  const fs::path json_path = test::scratch_dir() / "noiseless.json";
+  const CommandRun run = run_mm("search-bench --synthetic --queries 100 --noise 0 --quiet "
+                                "--methods brute,brute-simd --no-flann-reference --json " +
+                                quoted(json_path));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::ifstream file(json_path);
+  const nlohmann::json json = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
+  ASSERT_FALSE(json.is_discarded()) << json_path;
+  const double one_row = 1.0 / json["run"]["candidates"].get<double>();
+  EXPECT_DOUBLE_EQ(json["run"]["share_within_1.5x_nearest"]["p99"].get<double>(), one_row);
+  EXPECT_DOUBLE_EQ(json["run"]["share_within_1.2x_nearest"]["median"].get<double>(), one_row);
 }
 
 }  // namespace

@@ -36,6 +36,9 @@ Builds each search structure over the database (timed), runs the same queries th
 method and prints, per method: build time, memory, median and p99 latency per query, the rate
 of exact matches (same cost as brute within 1e-5 relative), the mean cost ratio to the exact
 cost, and the speed-up of the median over brute and over brute-simd (always run as baselines).
+Then how crowded the queries' neighbourhoods are: the share of the candidates within 1.2x and
+1.5x of the nearest row's distance (median, p90, p99 over the queries). Where a large share lies
+that close, an exact search has little to skip and cannot be much faster than a scan.
 
 options:
   --db FILE              the database (.mmdb, from `mm build`)
@@ -318,6 +321,50 @@ void time_queries(MethodReport& report, int count, const Arguments& arguments, P
 }
 
 
+// How crowded each query's neighbourhood is: the share of the candidates (searchable rows that
+// pass the tag filter) whose squared distance is within `factor` times the nearest one's. An
+// exact method must rule out every row below the best cost, and the more rows lie just above it
+// the less a bound can skip: when a large share lies within 1.5x, no exact structure can be
+// much faster than a scan. The play rules are left out: this describes the data, not a method.
+struct Neighbourhood {
+  static constexpr double kFactors[2] = {1.2, 1.5};
+  std::vector<double> shares[2];  // per factor: one share per query
+};
+
+Neighbourhood measure_neighbourhood(const SearchInput& input, const NoisyQueries& queries,
+                                    uint64_t include_tags, uint64_t exclude_tags,
+                                    Progress& progress) {
+  std::vector<const float*> rows;
+  for (int f = 0; f < input.frame_count(); ++f) {
+    const uint64_t tags = input.clips[static_cast<size_t>(input.frame_clip[static_cast<size_t>(f)])].tags;
+    if (input.searchable[static_cast<size_t>(f)] && (tags & include_tags) == include_tags &&
+        (tags & exclude_tags) == 0) {
+      rows.push_back(input.features.data() + static_cast<size_t>(f) * input.dims);
+    }
+  }
+  Neighbourhood out;
+  if (rows.empty()) return out;
+  const search_kernels::RowDistanceFn distance = search_kernels::row_distance();
+  std::vector<float> distances(rows.size());
+  for (int i = 0; i < queries.count(); ++i) {
+    if ((i & 63) == 0) progress.show("neighbourhoods", i, queries.count());
+    const float* query = queries.query(i).data();
+    float nearest = std::numeric_limits<float>::infinity();
+    for (size_t r = 0; r < rows.size(); ++r) {
+      distances[r] = distance(query, rows[r], input.dims, std::numeric_limits<float>::infinity());
+      nearest = std::min(nearest, distances[r]);
+    }
+    for (int k = 0; k < 2; ++k) {
+      const auto limit = static_cast<float>(nearest * Neighbourhood::kFactors[k]);
+      const auto within = std::count_if(distances.begin(), distances.end(),
+                                        [&](float d) { return d <= limit; });
+      out.shares[k].push_back(static_cast<double>(within) / static_cast<double>(rows.size()));
+    }
+  }
+  progress.clear();
+  return out;
+}
+
 std::string human_bytes(size_t bytes) {
   char text[32];
   if (bytes >= (size_t{1} << 20)) {
@@ -493,6 +540,16 @@ int run_search_bench(const std::vector<std::string>& args) {
                 r.exact_match_rate, r.cost_ratio, r.speedup_brute, r.speedup_brute_simd);
   }
 
+  const Neighbourhood neighbourhood =
+      measure_neighbourhood(input, queries, include_tags, exclude_tags, progress);
+  if (!neighbourhood.shares[0].empty()) {
+    std::printf("\nneighbourhood: share of the candidates within 1.2x / 1.5x of the nearest row's "
+                "distance:\n  median %.2f %% / %.2f %%, p90 %.2f %% / %.2f %%, p99 %.2f %% / %.2f %%\n",
+                100 * percentile(neighbourhood.shares[0], 0.5), 100 * percentile(neighbourhood.shares[1], 0.5),
+                100 * percentile(neighbourhood.shares[0], 0.9), 100 * percentile(neighbourhood.shares[1], 0.9),
+                100 * percentile(neighbourhood.shares[0], 0.99), 100 * percentile(neighbourhood.shares[1], 0.99));
+  }
+
   nlohmann::json json;
   if (arguments.batch) {
     // Many characters per call: the same queries in one batch, on one and on two threads.
@@ -531,6 +588,14 @@ int run_search_bench(const std::vector<std::string>& args) {
                    {"repeat", arguments.repeat},
                    {"clock", arguments.cpu_clock ? "thread_cpu" : "wall"},
                    {"scan_kernel", search_kernels::scan_blocks_isa()}};
+    for (int k = 0; k < 2; ++k) {
+      if (neighbourhood.shares[k].empty()) continue;
+      char key[64];
+      std::snprintf(key, sizeof key, "share_within_%.1fx_nearest", Neighbourhood::kFactors[k]);
+      json["run"][key] = {{"median", percentile(neighbourhood.shares[k], 0.5)},
+                          {"p90", percentile(neighbourhood.shares[k], 0.9)},
+                          {"p99", percentile(neighbourhood.shares[k], 0.99)}};
+    }
     for (const MethodReport& r : reports) {
       nlohmann::json& m = json[r.name];
       m["build_ms"] = r.build_ms;
