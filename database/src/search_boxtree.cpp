@@ -244,9 +244,16 @@ class BoxTree {
     const TreeView view{nodes_.data(), boxes_.data(), node_tags_or_.data(), node_tags_and_.data(),
                         blocks_.data(), set.dims, box_dims_, base, scan};
     traverse_fn(view, point, filter, tag_filter, best);
-    if (best.row >= 0) {
-      shared.distance = rotation_.empty() ? best.distance : ranker.best_distance;
-      shared.row = tree_row_[static_cast<size_t>(best.row)];
+    int found = best.row;
+    float found_distance = best.distance;
+    if (!rotation_.empty()) {
+      ranker.finish();
+      found = ranker.best_row;
+      found_distance = ranker.best_distance;
+    }
+    if (found >= 0) {
+      shared.distance = found_distance;
+      shared.row = tree_row_[static_cast<size_t>(found)];
     }
   }
 

@@ -61,7 +61,7 @@ struct FlannDistance {
 class ConstrainedBestResultSet final : public flann::ResultSet<float> {
  public:
   ConstrainedBestResultSet(const search_kernels::RowFilter& filter, float threshold)
-      : filter_(filter) {
+      : filter_(filter), restricts_(filter.restricts()) {
     best_.distance = threshold;
   }
 
@@ -72,7 +72,7 @@ class ConstrainedBestResultSet final : public flann::ResultSet<float> {
   }
   void addPoint(float distance, size_t index) override {
     const int row = static_cast<int>(index);
-    if (!(distance < best_.distance) || !filter_.passes(row)) return;
+    if (!(distance < best_.distance) || (restricts_ && !filter_.passes(row))) return;
     if (filter_.offer != nullptr) {
       filter_.offer(filter_.offer_context, row, distance, best_);
     } else {
@@ -86,6 +86,7 @@ class ConstrainedBestResultSet final : public flann::ResultSet<float> {
 
  private:
   const search_kernels::RowFilter& filter_;
+  const bool restricts_;  // false: every row passes, so its tags and frame need not be read
   search_kernels::ScanBest best_;
 };
 
@@ -114,7 +115,8 @@ struct ApproxTraits {
 template <class Index>
 struct FlannGroup {
   FeatureRotation rotation;      // empty when the index is over the raw columns
-  std::vector<float> points;     // the group's rows in the index's space (FLANN points into it)
+  std::vector<float> points;     // the group's rows in the index's space (FLANN points into
+                                 // it), released once built when the index keeps its own copy
   std::vector<int> set_rows;     // index row -> candidate row
   std::vector<int> frames;       // index row -> frame
   std::vector<uint64_t> tags;    // index row -> clip tags
@@ -144,7 +146,8 @@ struct FlannForest {
 
   // Copies group g's rows (into its principal axes when `rotate`) and builds its index.
   Status build_group(size_t g, const CandidateSet& set, bool rotate,
-                     const flann::IndexParams& params, std::string_view method) {
+                     const flann::IndexParams& params, std::string_view method,
+                     bool index_copies_rows) {
     const int dims = set.dims;
     FlannGroup<Index>& group = trees[g];
     const int count = static_cast<int>(group.set_rows.size());
@@ -173,6 +176,8 @@ struct FlannForest {
                                   static_cast<size_t>(dims));
       group.index = std::make_unique<Index>(matrix, params);
       group.index->buildIndex();
+      // A reordering single tree searches its own copy of the rows; ours is not read again.
+      if (index_copies_rows) std::vector<float>().swap(group.points);
     } catch (const std::exception& e) {
       return Error{std::string(method) + ": FLANN failed to build an index: " + e.what()};
     }
@@ -226,9 +231,16 @@ struct FlannForest {
       }
       ConstrainedBestResultSet result(filter, threshold);
       group.index->findNeighbors(result, point, search_params);
-      if (result.best().row >= 0) {
-        best_distance = group.rotation.empty() ? result.best().distance : ranker.best_distance;
-        best_row = group.set_rows[static_cast<size_t>(result.best().row)];
+      int found = result.best().row;
+      float found_distance = result.best().distance;
+      if (!group.rotation.empty()) {
+        ranker.finish();
+        found = ranker.best_row;
+        found_distance = ranker.best_distance;
+      }
+      if (found >= 0) {
+        best_distance = found_distance;
+        best_row = group.set_rows[static_cast<size_t>(found)];
       }
     }
   }
@@ -275,7 +287,7 @@ class FlannSearcher final : public Searcher {
                         [&](int, size_t j) {
                           built[j] = jobs[j].forest->build_group(jobs[j].group, set,
                                                                  options.principal_axes, params,
-                                                                 Traits::kName);
+                                                                 Traits::kName, Traits::kCopiesRows);
                         });
     for (const Status& status : built) {
       if (!status) return Error{status.message()};

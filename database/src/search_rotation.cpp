@@ -165,17 +165,34 @@ FeatureRotation principal_axes(const float* rows, int row_count, int dims, int m
   return rotation;
 }
 
-void ExactRanker::offer(void* context, int row, float /*scanned_distance*/,
+void ExactRanker::resolve() {
+  const float limit = threshold();
+  for (int i = 0; i < pending; ++i) {
+    if (!(pending_distance[i] <= limit)) continue;
+    const int row = pending_row[i];
+    const int set_row = scanned_to_set != nullptr ? scanned_to_set[row] : row;
+    const float distance = search_kernels::squared_distance(query, set->row(set_row), set->dims);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best_row = row;
+    }
+  }
+  pending = 0;
+  // Every offered row is decided: the best of them (or the bound) is the tightest upper bound.
+  upper = best_distance;
+}
+
+void ExactRanker::offer(void* context, int row, float scanned_distance,
                         search_kernels::ScanBest& best) {
   ExactRanker& ranker = *static_cast<ExactRanker*>(context);
-  const int set_row = ranker.scanned_to_set != nullptr ? ranker.scanned_to_set[row] : row;
-  const float distance =
-      search_kernels::squared_distance(ranker.query, ranker.set->row(set_row), ranker.set->dims);
-  if (distance < ranker.best_distance) {
-    ranker.best_distance = distance;
-    best.row = row;
-    best.distance = ranker.threshold();
-  }
+  if (ranker.pending == kPendingRows) ranker.resolve();
+  ranker.pending_row[ranker.pending] = row;
+  ranker.pending_distance[ranker.pending] = scanned_distance;
+  ++ranker.pending;
+  // The row's canonical distance is at most its scanned one plus the slack.
+  ranker.upper = std::min(ranker.upper, scanned_distance + ranker.slack(scanned_distance));
+  best.row = row;
+  best.distance = ranker.threshold();
 }
 
 }  // namespace mm::search_detail

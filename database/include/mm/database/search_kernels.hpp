@@ -73,6 +73,10 @@ struct RowFilter {
   void (*offer)(void* context, int row, float scanned_distance, ScanBest& best) = nullptr;
   void* offer_context = nullptr;
 
+  // False when every row below row_count passes (no tag filter, no window).
+  bool restricts() const {
+    return include_tags != 0 || exclude_tags != 0 || window_first <= window_last;
+  }
   // True when `row` may be returned.
   bool passes(int row) const {
     if (row >= row_count) return false;
