@@ -66,7 +66,7 @@ options:
   --clock wall|cpu       wall time (default) or the thread's CPU time (ignores preemption)
   --approx-trees N       approx: randomized trees (default 1)
   --approx-checks N      approx: leaf checks per query (default 128)
-  --eps E                kdtree-eps: distance within (1 + E) times the best (default 2)
+  --eps E                kdtree-eps: distance within (1 + E) times the best (default 3)
   --no-flann-reference   leave out the flann-plain row (FLANN's single tree as shipped: raw
                          columns, no constraints; shown only when nothing plays and no tag
                          filter is given, to compare this machine with plain FLANN elsewhere)

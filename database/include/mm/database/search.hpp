@@ -99,8 +99,10 @@ struct SearchOptions {
   int approx_trees = 1;
   // Leaf checks per query of the approximate method (its budget; never unlimited).
   int approx_checks = 128;
-  // eps of `kdtree-eps`: the distance found is within (1 + eps) times the best.
-  float kdtree_eps = 2.0f;
+  // eps of `kdtree-eps`: the distance found is within (1 + eps) times the best. 3: on all styles
+  // (noise 0.1) 99.95 % of the answers are exact at about 4.7 us median, against 100 % at about
+  // 5.9 us with eps 2 (same run); the bound is loose, the real mean cost ratio was 1.00005.
+  float kdtree_eps = 3.0f;
   // Threads that build the trees' groups in parallel (`kdtree`, `approx`); 0: every core.
   int build_threads = 0;
 };
