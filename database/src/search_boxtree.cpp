@@ -436,7 +436,8 @@ class BoxTreeSearcher final : public Searcher {
       trees_[g].build(set_, rows[g], options.principal_axes, options.boxtree_leaf_size);
     }
     traverse_ = search_kernels::avx2_supported() ? &traverse_avx2 : &traverse_portable;
-    scan_ = search_kernels::scan_blocks();
+    // In principal axes most rows of a visited leaf are decided by their first 8 or 16 columns.
+    scan_ = options.principal_axes ? search_kernels::scan_blocks_staged() : search_kernels::scan_blocks();
   }
 
   std::string_view method() const override { return "boxtree"; }

@@ -3,6 +3,7 @@
 #include <immintrin.h>
 
 #include <cstring>
+#include <initializer_list>
 
 namespace mm::search_kernels {
 
@@ -182,20 +183,16 @@ void scan_blocks_portable(const float* blocks, int first_block, int last_block, 
 
 namespace {
 
-// Squared distances of the rows of `Count` consecutive blocks (1, 2 or 4) to the query, each
-// block summed in two chains (even and odd columns) so that 2 * Count independent FMA chains
-// hide the FMA latency.
+// Adds columns [from, to) of the rows of `Count` consecutive blocks to their squared distances,
+// each block summed in two chains (even and odd columns) so that 2 * Count independent FMA
+// chains hide the FMA latency. `from` is even, so splitting a row into column ranges adds the
+// same terms to the same chains in the same order as one pass.
 template <int Count>
-__attribute__((target("avx2,fma"), always_inline)) inline void block_distances_avx2(
-    const float* first_block, size_t stride, int dims, const float* query, __m256* out) {
-  __m256 even[Count];
-  __m256 odd[Count];
-  for (int k = 0; k < Count; ++k) {
-    even[k] = _mm256_setzero_ps();
-    odd[k] = _mm256_setzero_ps();
-  }
-  int d = 0;
-  for (; d + 1 < dims; d += 2) {
+__attribute__((target("avx2,fma"), always_inline)) inline void add_columns_avx2(
+    const float* first_block, size_t stride, int from, int to, const float* query, __m256* even,
+    __m256* odd) {
+  int d = from;
+  for (; d + 1 < to; d += 2) {
     const __m256 q0 = _mm256_broadcast_ss(query + d);
     const __m256 q1 = _mm256_broadcast_ss(query + d + 1);
     for (int k = 0; k < Count; ++k) {
@@ -206,7 +203,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline void block_distances_a
       odd[k] = _mm256_fmadd_ps(diff1, diff1, odd[k]);
     }
   }
-  if (d < dims) {
+  if (d < to) {
     const __m256 q0 = _mm256_broadcast_ss(query + d);
     for (int k = 0; k < Count; ++k) {
       const __m256 diff0 =
@@ -214,21 +211,48 @@ __attribute__((target("avx2,fma"), always_inline)) inline void block_distances_a
       even[k] = _mm256_fmadd_ps(diff0, diff0, even[k]);
     }
   }
-  for (int k = 0; k < Count; ++k) out[k] = _mm256_add_ps(even[k], odd[k]);
 }
 
-// Checks `Count` blocks of distances against the bound; the rare path keeps the best row.
+// True when some row of the `Count` blocks has a (partial) distance below the bound.
 template <int Count>
-__attribute__((target("avx2,fma"), always_inline)) inline void scan_group_avx2(
-    const float* blocks, int b, size_t stride, int dims, const float* query,
-    const RowFilter& filter, ScanBest& best, __m256& bound) {
-  __m256 distances[Count];
-  block_distances_avx2<Count>(blocks + b * stride, stride, dims, query, distances);
+__attribute__((target("avx2,fma"), always_inline)) inline bool any_below_avx2(
+    const __m256* distances, __m256 bound) {
   __m256 below = _mm256_cmp_ps(distances[0], bound, _CMP_LT_OQ);
   for (int k = 1; k < Count; ++k) {
     below = _mm256_or_ps(below, _mm256_cmp_ps(distances[k], bound, _CMP_LT_OQ));
   }
-  if (_mm256_movemask_ps(below) == 0) return;
+  return _mm256_movemask_ps(below) != 0;
+}
+
+// Checks `Count` blocks of distances against the bound; the rare path keeps the best row. When
+// `Staged`, the partial distances after 8 and after 16 columns are checked first, and the blocks
+// are left as soon as every row is already at or above the bound (partial sums only grow): in
+// principal axes the leading columns carry most of the spread, so far rows stop early.
+template <int Count, bool Staged>
+__attribute__((target("avx2,fma"), always_inline)) inline void scan_group_avx2(
+    const float* blocks, int b, size_t stride, int dims, const float* query,
+    const RowFilter& filter, ScanBest& best, __m256& bound) {
+  const float* first_block = blocks + b * stride;
+  __m256 even[Count];
+  __m256 odd[Count];
+  __m256 distances[Count];
+  for (int k = 0; k < Count; ++k) {
+    even[k] = _mm256_setzero_ps();
+    odd[k] = _mm256_setzero_ps();
+  }
+  int from = 0;
+  if constexpr (Staged) {
+    for (const int stage_end : {8, 16}) {
+      if (stage_end + 8 > dims) break;
+      add_columns_avx2<Count>(first_block, stride, from, stage_end, query, even, odd);
+      from = stage_end;
+      for (int k = 0; k < Count; ++k) distances[k] = _mm256_add_ps(even[k], odd[k]);
+      if (!any_below_avx2<Count>(distances, bound)) return;
+    }
+  }
+  add_columns_avx2<Count>(first_block, stride, from, dims, query, even, odd);
+  for (int k = 0; k < Count; ++k) distances[k] = _mm256_add_ps(even[k], odd[k]);
+  if (!any_below_avx2<Count>(distances, bound)) return;
   alignas(32) float lanes[kBlockRows];
   for (int k = 0; k < Count; ++k) {
     if (!filter.block_may_pass(b + k)) continue;
@@ -238,13 +262,10 @@ __attribute__((target("avx2,fma"), always_inline)) inline void scan_group_avx2(
   bound = _mm256_set1_ps(best.distance);
 }
 
-}  // namespace
-
-__attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, int first_block,
-                                                          int last_block, int dims,
-                                                          const float* query,
-                                                          const RowFilter& filter,
-                                                          ScanBest& best) {
+template <bool Staged>
+__attribute__((target("avx2,fma"), always_inline)) inline void scan_blocks_avx2_impl(
+    const float* blocks, int first_block, int last_block, int dims, const float* query,
+    const RowFilter& filter, ScanBest& best) {
   const size_t stride = static_cast<size_t>(dims) * kBlockRows;
   __m256 bound = _mm256_set1_ps(best.distance);
   int b = first_block;
@@ -254,17 +275,35 @@ __attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, i
         !filter.block_may_pass(b + 2) && !filter.block_may_pass(b + 3)) {
       continue;
     }
-    scan_group_avx2<4>(blocks, b, stride, dims, query, filter, best, bound);
+    scan_group_avx2<4, Staged>(blocks, b, stride, dims, query, filter, best, bound);
   }
   if (b + 2 <= last_block) {
     if (filter.block_may_pass(b) || filter.block_may_pass(b + 1)) {
-      scan_group_avx2<2>(blocks, b, stride, dims, query, filter, best, bound);
+      scan_group_avx2<2, Staged>(blocks, b, stride, dims, query, filter, best, bound);
     }
     b += 2;
   }
   if (b < last_block && filter.block_may_pass(b)) {
-    scan_group_avx2<1>(blocks, b, stride, dims, query, filter, best, bound);
+    scan_group_avx2<1, Staged>(blocks, b, stride, dims, query, filter, best, bound);
   }
+}
+
+}  // namespace
+
+__attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, int first_block,
+                                                          int last_block, int dims,
+                                                          const float* query,
+                                                          const RowFilter& filter,
+                                                          ScanBest& best) {
+  scan_blocks_avx2_impl<false>(blocks, first_block, last_block, dims, query, filter, best);
+}
+
+__attribute__((target("avx2,fma"))) void scan_blocks_staged_avx2(const float* blocks,
+                                                                 int first_block, int last_block,
+                                                                 int dims, const float* query,
+                                                                 const RowFilter& filter,
+                                                                 ScanBest& best) {
+  scan_blocks_avx2_impl<true>(blocks, first_block, last_block, dims, query, filter, best);
 }
 
 bool avx2_supported() {
@@ -276,6 +315,10 @@ bool avx2_supported() {
 }
 
 ScanBlocksFn scan_blocks() { return avx2_supported() ? &scan_blocks_avx2 : &scan_blocks_portable; }
+
+ScanBlocksFn scan_blocks_staged() {
+  return avx2_supported() ? &scan_blocks_staged_avx2 : &scan_blocks_portable;
+}
 
 RowDistanceFn row_distance() {
   return avx2_supported() ? &row_distance_avx2 : &row_distance_portable;

@@ -348,7 +348,7 @@ TEST(SearchKernels, PackBlocksIsColumnMajorPerBlockWithFarPadding) {
 void check_scan(search_kernels::ScanBlocksFn scan) {
   std::mt19937 rng(7);
   std::normal_distribution<float> gauss;
-  for (int dims : {1, 2, 7, 27, 33}) {
+  for (int dims : {1, 2, 7, 16, 24, 27, 33}) {
     const int rows = 203;  // not a multiple of 8 or 32: exercises the tails
     std::vector<float> data(static_cast<size_t>(rows) * dims);
     for (float& v : data) v = gauss(rng);
@@ -416,6 +416,15 @@ TEST(SearchKernels, Avx2ScanMatchesScalarLoop) {
   }
   EXPECT_STREQ(search_kernels::scan_blocks_isa(), "avx2");
   check_scan(&search_kernels::scan_blocks_avx2);
+}
+
+TEST(SearchKernels, StagedAvx2ScanMatchesScalarLoop) {
+  if (!search_kernels::avx2_supported()) {
+    EXPECT_EQ(search_kernels::scan_blocks_staged(), &search_kernels::scan_blocks_portable);
+    return;
+  }
+  EXPECT_EQ(search_kernels::scan_blocks_staged(), &search_kernels::scan_blocks_staged_avx2);
+  check_scan(&search_kernels::scan_blocks_staged_avx2);
 }
 
 // Row distances against the column-order sum, for every column count up to 40 (whole blocks of

@@ -105,10 +105,17 @@ void scan_blocks_portable(const float* blocks, int first_block, int last_block, 
 // AVX2 + FMA version: call only when avx2_supported().
 void scan_blocks_avx2(const float* blocks, int first_block, int last_block, int dims,
                       const float* query, const RowFilter& filter, ScanBest& best);
+// Like scan_blocks_avx2(), but a group of blocks is left once the distances of all its rows over
+// the first 8 (then 16) columns reach the bound: for rows in principal axes, where the leading
+// columns carry most of the spread. The same best row and distance as scan_blocks_avx2().
+void scan_blocks_staged_avx2(const float* blocks, int first_block, int last_block, int dims,
+                             const float* query, const RowFilter& filter, ScanBest& best);
 // True when this CPU runs AVX2 and FMA (checked once with __builtin_cpu_supports).
 bool avx2_supported();
 // The fastest scan this CPU supports, chosen once at run time.
 ScanBlocksFn scan_blocks();
+// The staged scan this CPU supports (the portable scan has no stages).
+ScanBlocksFn scan_blocks_staged();
 // "avx2" or "portable": which scan_blocks() runs here.
 const char* scan_blocks_isa();
 
