@@ -19,7 +19,9 @@
 // In a group's principal axes the leading columns carry nearly all of its spread, so node boxes
 // keep only the first 16 columns (two vectors, half the memory to read) and the group's root box
 // bounds the remaining columns once per query: every row lies inside the root box, so its
-// distance over those columns is at least the root box's.
+// distance over those columns is at least the root box's. For the same reason leaves are scanned
+// in stages (search_kernels::scan_blocks_staged_avx2): a group of blocks whose rows are all
+// beyond the bound after 8 or 16 columns is left there.
 //
 // Rows found in a rotated space are decided by their canonical distance (ExactRanker), so the
 // answer is exactly brute force's. Per node, the OR and AND of its rows' tags skip subtrees that

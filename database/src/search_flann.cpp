@@ -36,7 +36,9 @@ namespace mm::search_detail {
 namespace {
 
 // FLANN's L2, with the row distance from our kernel (8 columns at a time, AVX2 when the CPU has
-// it) instead of FLANN's column-at-a-time loop: a third less time per query on the real data.
+// it) instead of FLANN's column-at-a-time loop: a third less time per query on the real data. The
+// single tree passes its threshold, and the kernel stops after 8 or 16 columns once the partial
+// sum exceeds it: in principal axes 92 % of the rows a leaf visits on all styles stop after 8.
 struct FlannDistance {
   typedef bool is_kdtree_distance;
   typedef float ElementType;
