@@ -152,8 +152,8 @@ BENCHMARK(BM_Scan_Avx2_Staged)->Unit(benchmark::kMicrosecond);
 
 // Every row's distance to one query, row-major, as a tree's leaf visits them: the full distance,
 // or bounded by the best so far (FLANN's single tree passes its threshold).
-void row_distances_with(benchmark::State& state, search_kernels::RowDistanceFn distance,
-                        bool bounded) {
+template <class Distance>
+void row_distances_with(benchmark::State& state, const Distance& distance) {
   const BenchData& d = data();
   const int dims = d.input.dims;
   const int rows = row_count();
@@ -162,27 +162,30 @@ void row_distances_with(benchmark::State& state, search_kernels::RowDistanceFn d
     const float* query = d.queries.query(q++ % d.queries.count()).data();
     float best = std::numeric_limits<float>::infinity();
     for (int r = 0; r < rows; ++r) {
-      const float bound = bounded ? best : std::numeric_limits<float>::infinity();
-      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, bound));
+      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best));
     }
     benchmark::DoNotOptimize(best);
   }
   state.SetItemsProcessed(state.iterations() * rows);
 }
 
+// A full distance in the bounded signature (the bound is not used).
+template <search_kernels::RowDistanceFn Full>
+float ignoring_bound(const float* a, const float* b, int dims, float) {
+  return Full(a, b, dims);
+}
+
 void BM_RowDistance_Scalar(benchmark::State& state) {
-  row_distances_with(
-      state, [](const float* a, const float* b, int dims, float) { return search_kernels::squared_distance(a, b, dims); },
-      false);
+  row_distances_with(state, &ignoring_bound<&search_kernels::squared_distance>);
 }
 void BM_RowDistance_Portable(benchmark::State& state) {
-  row_distances_with(state, &search_kernels::row_distance_portable, false);
+  row_distances_with(state, &ignoring_bound<&search_kernels::row_distance_portable>);
 }
 void BM_RowDistance_Avx2(benchmark::State& state) {
-  if (avx2_or_skip(state)) row_distances_with(state, &search_kernels::row_distance_avx2, false);
+  if (avx2_or_skip(state)) row_distances_with(state, &ignoring_bound<&search_kernels::row_distance_avx2>);
 }
 void BM_RowDistance_Avx2_Bounded(benchmark::State& state) {
-  if (avx2_or_skip(state)) row_distances_with(state, &search_kernels::row_distance_avx2, true);
+  if (avx2_or_skip(state)) row_distances_with(state, &search_kernels::row_distance_bounded_avx2);
 }
 
 BENCHMARK(BM_RowDistance_Scalar)->Unit(benchmark::kMicrosecond);

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <span>
+#include <numeric>
 #include <vector>
 
 #include "mm/database/search.hpp"
@@ -96,6 +97,8 @@ struct FeatureRotation {
   std::vector<double> variance;  // dims: variance along each axis, descending
 
   bool empty() const { return dims == 0; }
+  // Sum of the variances along the axes (the rows' total variance).
+  double total_variance() const { return std::accumulate(variance.begin(), variance.end(), 0.0); }
   // y = axes^T (x - mean) in float; y holds padded_dims floats (the padding comes out 0).
   void apply(const float* x, float* y) const;
   // Bound on |computed y - exact y| per unit of |x - mean|: each coordinate sums dims products
@@ -205,6 +208,10 @@ struct RowGroups {
   // distance is a float sum in the original space, and a relative margin covers its rounding.
   static bool beyond(float distance, float best) { return distance > best * 1.00001f; }
 };
+
+// A group of rows whose total variance (the sum over columns) is below this is dense, such as
+// the standing gestures: 1 % of the variance of an even sample of all candidates.
+double dense_variance_below(const CandidateSet& set);
 
 // Groups the candidate rows; `rows_out` receives each group's candidate rows. group_rows <= 0
 // makes one group of all rows.

@@ -149,6 +149,14 @@ constexpr double kDenseVarianceFraction = 0.01;
 // The most rows the grouping looks at (evenly spaced over the candidates).
 constexpr int kGroupingSampleRows = 16384;
 
+// Every step-th candidate row, step = row count / kGroupingSampleRows (at least 1).
+std::vector<int> grouping_sample(const CandidateSet& set) {
+  const int step = std::max(1, set.row_count() / kGroupingSampleRows);
+  std::vector<int> sample;
+  for (int r = 0; r < set.row_count(); r += step) sample.push_back(r);
+  return sample;
+}
+
 // Groups of about `group_rows` candidate rows. The grouping is decided on an evenly spaced
 // sample of at most kGroupingSampleRows rows: k-means over the sample, then again inside every
 // group still more than twice the (scaled) size (a dense cluster, such as the standing gestures,
@@ -165,8 +173,7 @@ std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_r
   std::iota(all.begin(), all.end(), 0);
   if (group_rows <= 0 || count == 0) return {all};
   const int step = std::max(1, count / kGroupingSampleRows);
-  std::vector<int> sample;
-  for (int r = 0; r < count; r += step) sample.push_back(r);
+  const std::vector<int> sample = grouping_sample(set);
   const int sample_group_rows = std::max(1, group_rows / step);
   const auto groups_for = [&](size_t rows) {
     return static_cast<int>(std::clamp<size_t>((rows + sample_group_rows / 2) / sample_group_rows,
@@ -194,7 +201,7 @@ std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_r
     pending = std::move(next);
   }
   for (auto& group : pending) done.push_back(std::move(group));
-  const double dense_below = kDenseVarianceFraction * total_variance(set, sample);
+  const double dense_below = dense_variance_below(set);
   std::vector<uint8_t> dense(done.size(), 0);
   bool any_dense = false;
   for (size_t g = 0; g < done.size(); ++g) {
@@ -231,6 +238,10 @@ std::vector<std::vector<int>> kmeans_groups(const CandidateSet& set, int group_r
 }
 
 }  // namespace
+
+double dense_variance_below(const CandidateSet& set) {
+  return kDenseVarianceFraction * total_variance(set, grouping_sample(set));
+}
 
 size_t RowGroups::memory_bytes() const {
   return boxes.capacity() * sizeof(float) + (tags_or.capacity() + tags_and.capacity()) * sizeof(uint64_t);

@@ -429,11 +429,11 @@ TEST(SearchKernels, StagedAvx2ScanMatchesScalarLoop) {
 
 // Row distances against the column-order sum, for every column count up to 40 (whole blocks of
 // 8 and every tail length), with each row placed at the very end of its own allocation so that
-// reading past `dims` floats would touch memory the sanitizer build reports. Then the bound: a
-// result <= bound must be the full distance, bit for bit, and a row above the bound must report
-// a value above it.
-void check_row_distance(search_kernels::RowDistanceFn distance) {
-  constexpr float kNoBound = std::numeric_limits<float>::infinity();
+// reading past `dims` floats would touch memory the sanitizer build reports. Then the bounded
+// version: a result <= bound must be the full distance, bit for bit, and a row above the bound
+// must report a value above it.
+void check_row_distance(search_kernels::RowDistanceFn distance,
+                        search_kernels::BoundedRowDistanceFn bounded) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> value(-3.0f, 3.0f);
   int stopped_early = 0;
@@ -448,12 +448,12 @@ void check_row_distance(search_kernels::RowDistanceFn distance) {
         const double diff = static_cast<double>(a[static_cast<size_t>(d)]) - b[static_cast<size_t>(d)];
         exact += diff * diff;
       }
-      const float full = distance(a.get(), b.get(), dims, kNoBound);
+      const float full = distance(a.get(), b.get(), dims);
       EXPECT_NEAR(full, exact, 1e-5 * exact + 1e-30) << "dims " << dims;
       EXPECT_NEAR(full, search_kernels::squared_distance(a.get(), b.get(), dims), 1e-5 * exact + 1e-30);
       for (const float fraction : {0.0f, 0.1f, 0.5f, 0.999f, 1.0f, 2.0f}) {
         const float bound = full * fraction;
-        const float got = distance(a.get(), b.get(), dims, bound);
+        const float got = bounded(a.get(), b.get(), dims, bound);
         if (full <= bound) {
           EXPECT_EQ(got, full) << "dims " << dims << ", bound " << bound;
         } else {
@@ -461,26 +461,30 @@ void check_row_distance(search_kernels::RowDistanceFn distance) {
           stopped_early += got < full ? 1 : 0;
         }
       }
+      EXPECT_EQ(bounded(a.get(), b.get(), dims, kInf), full) << "dims " << dims;
     }
   }
   // Rows of 16 columns or more stop after their first 8 when the bound is 0.
   EXPECT_GT(stopped_early, 0);
   const float a[3] = {1, 2, 3};
   const float b[3] = {2, 0, 3};
-  EXPECT_FLOAT_EQ(distance(a, b, 3, kNoBound), 5.0f);
+  EXPECT_FLOAT_EQ(distance(a, b, 3), 5.0f);
 }
 
 TEST(SearchKernels, PortableRowDistanceMatchesColumnSum) {
-  check_row_distance(&search_kernels::row_distance_portable);
+  check_row_distance(&search_kernels::row_distance_portable,
+                     &search_kernels::row_distance_bounded_portable);
 }
 
 TEST(SearchKernels, Avx2RowDistanceMatchesColumnSum) {
   if (!search_kernels::avx2_supported()) {
     EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_portable);
+    EXPECT_EQ(search_kernels::row_distance_bounded(), &search_kernels::row_distance_bounded_portable);
     return;
   }
   EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_avx2);
-  check_row_distance(&search_kernels::row_distance_avx2);
+  EXPECT_EQ(search_kernels::row_distance_bounded(), &search_kernels::row_distance_bounded_avx2);
+  check_row_distance(&search_kernels::row_distance_avx2, &search_kernels::row_distance_bounded_avx2);
 }
 
 // --- every method against brute on synthetic data --------------------------------------------

@@ -351,7 +351,7 @@ Neighbourhood measure_neighbourhood(const SearchInput& input, const NoisyQueries
     const float* query = queries.query(i).data();
     float nearest = std::numeric_limits<float>::infinity();
     for (size_t r = 0; r < rows.size(); ++r) {
-      distances[r] = distance(query, rows[r], input.dims, std::numeric_limits<float>::infinity());
+      distances[r] = distance(query, rows[r], input.dims);
       nearest = std::min(nearest, distances[r]);
     }
     for (int k = 0; k < 2; ++k) {

@@ -23,16 +23,25 @@ float box_squared_distance_bounded(const float* point, const float* lo, const fl
 
 // Squared distance of two rows summed 8 columns at a time, for structures that visit one row at
 // a time (the FLANN trees). The order of summation differs from squared_distance(), so the
-// result may differ from the canonical value by rounding. Reads at most `dims` floats of each.
-// While at least 8 columns remain, a partial sum above `bound` is returned at once: a result
-// <= bound is always the full distance, and a result > bound means the full one is > bound too
-// (the partial sums only grow). Pass infinity for the full distance.
-using RowDistanceFn = float (*)(const float* a, const float* b, int dims, float bound);
-float row_distance_portable(const float* a, const float* b, int dims, float bound);
+// result may differ from the canonical value by rounding. Reads exactly `dims` floats of each.
+using RowDistanceFn = float (*)(const float* a, const float* b, int dims);
+float row_distance_portable(const float* a, const float* b, int dims);
 // AVX2 + FMA version: call only when avx2_supported().
-float row_distance_avx2(const float* a, const float* b, int dims, float bound);
+float row_distance_avx2(const float* a, const float* b, int dims);
 // The fastest row distance this CPU supports, chosen once at run time.
 RowDistanceFn row_distance();
+
+// The row distance with a bound: while at least 8 columns remain (after 8, then 16 columns), a
+// partial sum above `bound` is returned at once. A result <= bound is the full distance, bit for
+// bit the value of the unbounded version, and a result > bound means the full one is > bound too
+// (the partial sums only grow). Reads at most `dims` floats of each row. Worth it where most
+// rows stop early (rows in principal axes, far from the query).
+using BoundedRowDistanceFn = float (*)(const float* a, const float* b, int dims, float bound);
+float row_distance_bounded_portable(const float* a, const float* b, int dims, float bound);
+// AVX2 + FMA version: call only when avx2_supported().
+float row_distance_bounded_avx2(const float* a, const float* b, int dims, float bound);
+// The fastest bounded row distance this CPU supports.
+BoundedRowDistanceFn row_distance_bounded();
 
 // Rows per block of the blocked layout.
 inline constexpr int kBlockRows = 8;
