@@ -11,8 +11,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,8 +63,9 @@ options:
   --boxtree-group-rows N own tree in their own axes, the rest share one; 0 for a single tree)
   --approx-group-rows N
   --raw-axes             build the trees over the raw columns instead of the principal axes
-  --repeat R             time every query R times and keep its fastest run (default 1), which
-                         removes interference from other processes on a shared machine
+  --repeat R             time every query R times and keep its fastest run (default 1): R rounds,
+                         each one pass per method, so that a slow spell of a shared machine
+                         hits every method alike
   --clock wall|cpu       wall time (default) or the thread's CPU time (ignores preemption)
   --approx-trees N       approx: randomized trees (default 1)
   --approx-checks N      approx: leaf checks per query (default 128)
@@ -289,37 +292,43 @@ class Progress {
   Clock::time_point last_{};
 };
 
-// Times `search(i)` for every query (after a warm-up), keeping each query's fastest of
-// `arguments.repeat` runs, and fills the report's latency fields and results.
-template <class Search>
-void time_queries(MethodReport& report, int count, const Arguments& arguments, Progress& progress,
-                  const Search& search) {
-  // Warm-up: caches and branch predictors see the structure before the timed run.
+// One method under test: its report, how to run query i, and each query's fastest time so far.
+struct TimedMethod {
+  MethodReport report;
+  std::function<SearchResult(int)> search;
+  std::vector<double> times;
+};
+
+// Runs every query once through `method`, keeping each query's fastest time. A warm-up comes
+// first: the passes of the other methods have evicted this one's structure from the caches.
+void time_pass(TimedMethod& method, int count, bool cpu_clock, Progress& progress,
+               const std::string& stage) {
   const int warmup = std::min(count, 64);
   for (int i = 0; i < warmup; ++i) {
-    volatile float sink = search(i).cost;
+    volatile float sink = method.search(i).cost;
     (void)sink;
   }
-  std::vector<double> times(static_cast<size_t>(count), std::numeric_limits<double>::infinity());
-  report.results.resize(static_cast<size_t>(count));
-  const int total = count * arguments.repeat;
-  for (int round = 0; round < arguments.repeat; ++round) {
-    for (int i = 0; i < count; ++i) {
-      const double start = now_us(arguments.cpu_clock);
-      report.results[static_cast<size_t>(i)] = search(i);
-      const double elapsed = now_us(arguments.cpu_clock) - start;
-      times[static_cast<size_t>(i)] = std::min(times[static_cast<size_t>(i)], elapsed);
-      if ((i & 63) == 0) progress.show(report.name + ": queries", round * count + i, total);
-    }
+  method.times.resize(static_cast<size_t>(count), std::numeric_limits<double>::infinity());
+  method.report.results.resize(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const double start = now_us(cpu_clock);
+    method.report.results[static_cast<size_t>(i)] = method.search(i);
+    const double elapsed = now_us(cpu_clock) - start;
+    method.times[static_cast<size_t>(i)] = std::min(method.times[static_cast<size_t>(i)], elapsed);
+    if ((i & 63) == 0) progress.show(stage, i, count);
   }
   progress.clear();
-  report.median_us = percentile(times, 0.5);
-  report.p99_us = percentile(times, 0.99);
-  double sum = 0;
-  for (double t : times) sum += t;
-  report.mean_us = sum / static_cast<double>(times.size());
 }
 
+// The report's latency fields from the fastest time of every query.
+void summarize_times(TimedMethod& method) {
+  MethodReport& report = method.report;
+  report.median_us = percentile(method.times, 0.5);
+  report.p99_us = percentile(method.times, 0.99);
+  double sum = 0;
+  for (double t : method.times) sum += t;
+  report.mean_us = sum / static_cast<double>(method.times.size());
+}
 
 // How crowded each query's neighbourhood is: the share of the candidates (searchable rows that
 // pass the tag filter) whose squared distance is within `factor` times the nearest one's. An
@@ -438,73 +447,94 @@ int run_search_bench(const std::vector<std::string>& args) {
   }
 
   std::printf("search-bench: %s\n  %d frames, %d candidates, %d dims; %d queries, noise %g, %s; "
-              "scan kernel %s; %s clock, fastest of %d run%s per query\n",
+              "scan kernel %s; %s clock, fastest of %d run%s per query (rounds over all methods)\n",
               source.c_str(), input.frame_count(), candidates, input.dims, queries.count(),
               static_cast<double>(arguments.noise),
               arguments.playing ? "playing the source frame" : "nothing playing",
               search_kernels::scan_blocks_isa(), arguments.cpu_clock ? "thread CPU" : "wall",
               arguments.repeat, arguments.repeat == 1 ? "" : "s");
 
+  // Every structure is built first (timed), then the queries run in `repeat` rounds, each
+  // round one pass per method: a slow spell of a shared machine then hits every method alike,
+  // and each query keeps its fastest run.
   Progress progress(!arguments.quiet);
-  std::vector<MethodReport> reports;
+  std::vector<std::unique_ptr<Searcher>> searchers;
+  std::vector<TimedMethod> methods;
   for (const std::string& name : arguments.methods) {
-    MethodReport report;
-    report.name = name;
+    TimedMethod method;
+    method.report.name = name;
     progress.show(name + ": building", 0, 1);
     const auto build_start = Clock::now();
     auto made = make_searcher(name, input, arguments.options);
-    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    method.report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    progress.clear();
     if (!made) {
-      progress.clear();
       std::fprintf(stderr, "mm search-bench: %s\n", made.message().c_str());
       return 1;
     }
-    const Searcher& searcher = *made.value();
-    report.memory_bytes = searcher.memory_bytes();
-    time_queries(report, queries.count(), arguments, progress, [&](int i) {
-      return searcher.search(queries.query(i), constraints[static_cast<size_t>(i)]);
-    });
-    reports.push_back(std::move(report));
+    const Searcher* searcher = made.value().get();
+    searchers.push_back(std::move(made.value()));
+    method.report.memory_bytes = searcher->memory_bytes();
+    method.search = [searcher, &queries, &constraints](int i) {
+      return searcher->search(queries.query(i), constraints[static_cast<size_t>(i)]);
+    };
+    methods.push_back(std::move(method));
   }
   // The reference row: FLANN's exact single tree as shipped (raw columns, FLANN's L2, its
   // default leaf size, no constraints), on the same queries. It calibrates this machine against
   // other measurements of plain FLANN; it is not a method (it cannot apply the rules).
   const bool unconstrained = !arguments.playing && include_tags == 0 && exclude_tags == 0;
+  std::vector<float> plain_rows;
+  std::vector<int> plain_row_frame;
+  std::unique_ptr<flann::KDTreeSingleIndex<flann::L2<float>>> plain_index;
   if (unconstrained && arguments.flann_reference) {
-    MethodReport report;
-    report.name = "flann-plain";
-    progress.show(report.name + ": building", 0, 1);
-    std::vector<float> rows;
-    std::vector<int> row_frame;
+    TimedMethod method;
+    method.report.name = "flann-plain";
+    progress.show(method.report.name + ": building", 0, 1);
     for (int f = 0; f < input.frame_count(); ++f) {
       if (!input.searchable[static_cast<size_t>(f)]) continue;
       const float* row = input.features.data() + static_cast<size_t>(f) * input.dims;
-      rows.insert(rows.end(), row, row + input.dims);
-      row_frame.push_back(f);
+      plain_rows.insert(plain_rows.end(), row, row + input.dims);
+      plain_row_frame.push_back(f);
     }
     const auto build_start = Clock::now();
-    flann::KDTreeSingleIndex<flann::L2<float>> index(
-        flann::Matrix<float>(rows.data(), row_frame.size(), static_cast<size_t>(input.dims)),
+    plain_index = std::make_unique<flann::KDTreeSingleIndex<flann::L2<float>>>(
+        flann::Matrix<float>(plain_rows.data(), plain_row_frame.size(), static_cast<size_t>(input.dims)),
         flann::KDTreeSingleIndexParams());
-    index.buildIndex();
-    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
-    report.memory_bytes = rows.size() * sizeof(float) * 2 + static_cast<size_t>(index.usedMemory());
-    time_queries(report, queries.count(), arguments, progress, [&](int i) {
+    plain_index->buildIndex();
+    method.report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    progress.clear();
+    method.report.memory_bytes =
+        plain_rows.size() * sizeof(float) * 2 + static_cast<size_t>(plain_index->usedMemory());
+    const auto* index = plain_index.get();
+    method.search = [index, &plain_row_frame, &queries, &constraints](int i) {
       int nearest = -1;
       float distance = std::numeric_limits<float>::infinity();
       flann::Matrix<int> indices(&nearest, 1, 1);
       flann::Matrix<float> distances(&distance, 1, 1);
       const std::span<const float> query = queries.query(i);
-      index.knnSearch(flann::Matrix<float>(const_cast<float*>(query.data()), 1, query.size()),
-                      indices, distances, 1, flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
+      index->knnSearch(flann::Matrix<float>(const_cast<float*>(query.data()), 1, query.size()),
+                       indices, distances, 1, flann::SearchParams(flann::FLANN_CHECKS_UNLIMITED));
       SearchResult result;
       if (nearest >= 0) {
-        result.frame = row_frame[static_cast<size_t>(nearest)];
+        result.frame = plain_row_frame[static_cast<size_t>(nearest)];
         result.cost = distance + constraints[static_cast<size_t>(i)].transition_cost;
       }
       return result;
-    });
-    reports.push_back(std::move(report));
+    };
+    methods.push_back(std::move(method));
+  }
+  for (int round = 0; round < arguments.repeat; ++round) {
+    for (TimedMethod& method : methods) {
+      std::string stage = method.report.name + ": queries";
+      if (arguments.repeat > 1) stage += ", round " + std::to_string(round + 1) + "/" + std::to_string(arguments.repeat);
+      time_pass(method, queries.count(), arguments.cpu_clock, progress, stage);
+    }
+  }
+  std::vector<MethodReport> reports;
+  for (TimedMethod& method : methods) {
+    summarize_times(method);
+    reports.push_back(std::move(method.report));
   }
 
   // Quality against brute (reports[0]) and speed-ups over the baselines (reports[0], [1]).
