@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
-#include <span>
 #include <numeric>
+#include <span>
 #include <vector>
 
 #include "mm/database/search.hpp"
@@ -125,7 +125,7 @@ float row_norm(const float* x, int dims);
 // distance by at most `slack(d)`. Offered rows wait in a small buffer and get their canonical
 // distance only when it is full or the search ends (finish()), and then only those still under
 // the threshold: most rows offered early are beaten later, and each canonical distance costs
-// reads far from the structure's own rows (about a third of a kdtree query on all styles).
+// reads far from the structure's own rows (about a quarter of a kdtree query on all styles).
 // Meanwhile the scan threshold follows `upper`, an upper bound on the best canonical distance:
 // the canonical best row lies at most slack above it in the scanned space, so it is never pruned.
 struct ExactRanker {
