@@ -14,6 +14,7 @@
 #include "mm/database/builder.hpp"
 #include "mm/database/search.hpp"
 #include "mm/database/search_synthetic.hpp"
+#include "search_rules.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -104,28 +105,7 @@ std::vector<Query> real_queries(const Database& db, int count, uint64_t seed) {
 
 // The rules, checked independently of any searcher (cost recomputed in double).
 void expect_valid(const Database& db, const Query& q, const SearchResult& r) {
-  if (r.frame < 0) return;
-  const SearchConstraints& c = q.constraints;
-  ASSERT_LT(r.frame, db.frame_count);
-  EXPECT_TRUE(db.searchable[r.frame]);
-  const uint64_t tags = db.clips[db.frame_clip[r.frame]].tags;
-  EXPECT_EQ(tags & c.include_tags, c.include_tags);
-  EXPECT_EQ(tags & c.exclude_tags, 0u);
-  const bool is_next = c.current_frame >= 0 && r.frame == c.current_frame + 1 &&
-                       db.frame_clip[r.frame] == db.frame_clip[c.current_frame];
-  EXPECT_EQ(r.continuation, is_next);
-  if (!is_next && c.current_frame >= 0) {
-    EXPECT_TRUE(r.frame < c.current_frame - c.window_frames ||
-                r.frame > c.current_frame + c.window_frames);
-  }
-  double d = 0;
-  const int dims = db.feature_dims();
-  for (int k = 0; k < dims; ++k) {
-    const double diff = double(q.features[k]) - db.features[static_cast<size_t>(r.frame) * dims + k];
-    d += diff * diff;
-  }
-  const double expected = d + (is_next ? 0.0 : c.transition_cost);
-  EXPECT_NEAR(r.cost, expected, 1e-5 * std::max(1.0, expected));
+  test::expect_obeys_search_rules(search_input(db), q.features, q.constraints, r);
 }
 
 // A method and the options that change its structure (each variant is its own code path).

@@ -13,11 +13,13 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mm/database/search.hpp"
 #include "mm/database/search_kernels.hpp"
 #include "mm/database/search_synthetic.hpp"
+#include "search_rules.hpp"
 
 // Every allocation of this test program is counted, so that a test can check that a searcher's
 // hot path allocates nothing.
@@ -543,29 +545,19 @@ std::vector<Query> constrained_queries(const SyntheticSearchData& data, int per_
   return queries;
 }
 
+// The queries as one batch: their features back to back, and one constraint each.
+std::pair<std::vector<float>, std::vector<SearchConstraints>> as_batch(const std::vector<Query>& queries) {
+  std::pair<std::vector<float>, std::vector<SearchConstraints>> batch;
+  for (const Query& q : queries) {
+    batch.first.insert(batch.first.end(), q.features.begin(), q.features.end());
+    batch.second.push_back(q.constraints);
+  }
+  return batch;
+}
+
 // Checks that `r` obeys the rules for query `q`, with its cost recomputed independently.
 void expect_valid(const SyntheticSearchData& data, const Query& q, const SearchResult& r) {
-  if (r.frame < 0) return;
-  const SearchConstraints& c = q.constraints;
-  ASSERT_LT(r.frame, data.frame_count());
-  EXPECT_TRUE(data.searchable[r.frame]);
-  const uint64_t tags = data.clips[data.frame_clip[r.frame]].tags;
-  EXPECT_EQ(tags & c.include_tags, c.include_tags);
-  EXPECT_EQ(tags & c.exclude_tags, 0u);
-  const bool is_next = c.current_frame >= 0 && r.frame == c.current_frame + 1 &&
-                       data.frame_clip[r.frame] == data.frame_clip[c.current_frame];
-  EXPECT_EQ(r.continuation, is_next);
-  if (!is_next && c.current_frame >= 0) {
-    EXPECT_TRUE(r.frame < c.current_frame - c.window_frames ||
-                r.frame > c.current_frame + c.window_frames);
-  }
-  double d = 0;
-  for (int k = 0; k < data.dims; ++k) {
-    const double diff = double(q.features[k]) - data.features[static_cast<size_t>(r.frame) * data.dims + k];
-    d += diff * diff;
-  }
-  const double expected = d + (is_next ? 0.0 : c.transition_cost);
-  EXPECT_NEAR(r.cost, expected, 1e-5 * std::max(1.0, expected));
+  test::expect_obeys_search_rules(data.input(), q.features, q.constraints, r);
 }
 
 class SyntheticExactness : public ::testing::TestWithParam<std::string_view> {};
@@ -650,12 +642,7 @@ TEST(SearchBatch, BatchedResultsEqualSingleSearches) {
   auto kdtree = make("kdtree", data.input());
   ASSERT_NE(kdtree, nullptr);
   const std::vector<Query> queries = constrained_queries(data, 3, 5);
-  std::vector<float> flat;
-  std::vector<SearchConstraints> constraints;
-  for (const Query& q : queries) {
-    flat.insert(flat.end(), q.features.begin(), q.features.end());
-    constraints.push_back(q.constraints);
-  }
+  const auto [flat, constraints] = as_batch(queries);
   std::vector<SearchResult> results(queries.size());
   SearchBatchRunner runner(2);
   EXPECT_EQ(runner.thread_count(), 2);
@@ -691,12 +678,7 @@ TEST(SearchAllocations, HotPathsDoNotAllocate) {
     EXPECT_TRUE(std::isfinite(sum) || std::isinf(sum));
   }
   auto boxtree = make("boxtree", data.input());
-  std::vector<float> flat;
-  std::vector<SearchConstraints> constraints;
-  for (const Query& q : queries) {
-    flat.insert(flat.end(), q.features.begin(), q.features.end());
-    constraints.push_back(q.constraints);
-  }
+  const auto [flat, constraints] = as_batch(queries);
   std::vector<SearchResult> results(queries.size());
   SearchBatchRunner runner(2);
   runner.run(*boxtree, flat, constraints, results);  // the worker has started and waited once
