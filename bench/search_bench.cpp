@@ -83,9 +83,10 @@ const BenchData& data() {
 
 int row_count() { return static_cast<int>(data().rows.size() / static_cast<size_t>(data().input.dims)); }
 
-// --- the blocked scan kernel against a plain loop ----------------------------------------------
-
-void BM_Scan_Scalar(benchmark::State& state) {
+// Every row's distance to one query, row-major, as a tree's leaf visits them: the full distance,
+// or bounded by the best so far (FLANN's single tree passes its threshold).
+template <class Distance>
+void row_distances_with(benchmark::State& state, const Distance& distance) {
   const BenchData& d = data();
   const int dims = d.input.dims;
   const int rows = row_count();
@@ -93,18 +94,25 @@ void BM_Scan_Scalar(benchmark::State& state) {
   for (auto _ : state) {
     const float* query = d.queries.query(q++ % d.queries.count()).data();
     float best = std::numeric_limits<float>::infinity();
-    int best_row = -1;
     for (int r = 0; r < rows; ++r) {
-      const float distance = search_kernels::squared_distance_bounded(
-          query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best);
-      if (distance < best) {
-        best = distance;
-        best_row = r;
-      }
+      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best));
     }
-    benchmark::DoNotOptimize(best_row);
+    benchmark::DoNotOptimize(best);
   }
   state.SetItemsProcessed(state.iterations() * rows);
+}
+
+// A full distance in the bounded signature (the bound is not used).
+template <search_kernels::RowDistanceFn Full>
+float ignoring_bound(const float* a, const float* b, int dims, float) {
+  return Full(a, b, dims);
+}
+
+// --- the blocked scan kernel against a plain loop ----------------------------------------------
+
+// The scalar loop: the column-order distance with an early exit per row, over every row.
+void BM_Scan_Scalar(benchmark::State& state) {
+  row_distances_with(state, &search_kernels::squared_distance_bounded);
 }
 
 void scan_with(benchmark::State& state, search_kernels::ScanBlocksFn scan) {
@@ -149,31 +157,6 @@ BENCHMARK(BM_Scan_Avx2)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Scan_Avx2_Staged)->Unit(benchmark::kMicrosecond);
 
 // --- the row distance (FLANN's inner loop) against the column-order sum -----------------------
-
-// Every row's distance to one query, row-major, as a tree's leaf visits them: the full distance,
-// or bounded by the best so far (FLANN's single tree passes its threshold).
-template <class Distance>
-void row_distances_with(benchmark::State& state, const Distance& distance) {
-  const BenchData& d = data();
-  const int dims = d.input.dims;
-  const int rows = row_count();
-  int q = 0;
-  for (auto _ : state) {
-    const float* query = d.queries.query(q++ % d.queries.count()).data();
-    float best = std::numeric_limits<float>::infinity();
-    for (int r = 0; r < rows; ++r) {
-      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best));
-    }
-    benchmark::DoNotOptimize(best);
-  }
-  state.SetItemsProcessed(state.iterations() * rows);
-}
-
-// A full distance in the bounded signature (the bound is not used).
-template <search_kernels::RowDistanceFn Full>
-float ignoring_bound(const float* a, const float* b, int dims, float) {
-  return Full(a, b, dims);
-}
 
 void BM_RowDistance_Scalar(benchmark::State& state) {
   row_distances_with(state, &ignoring_bound<&search_kernels::squared_distance>);

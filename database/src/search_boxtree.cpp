@@ -249,7 +249,7 @@ class BoxTree {
     int found = best.row;
     float found_distance = best.distance;
     if (!rotation_.empty()) {
-      ranker.finish();
+      ranker.resolve();
       found = ranker.best_row;
       found_distance = ranker.best_distance;
     }

@@ -123,7 +123,7 @@ float row_norm(const float* x, int dims);
 // Decides rows found in a rotated space by their canonical (unrotated) distance, so a rotated
 // structure returns exactly what brute force returns. Rotation and float rounding move a
 // distance by at most `slack(d)`. Offered rows wait in a small buffer and get their canonical
-// distance only when it is full or the search ends (finish()), and then only those still under
+// distance only when it is full or the search ends (resolve()), and then only those still under
 // the threshold: most rows offered early are beaten later, and each canonical distance costs
 // reads far from the structure's own rows (about a quarter of a kdtree query on all styles).
 // Meanwhile the scan threshold follows `upper`, an upper bound on the best canonical distance:
@@ -169,11 +169,9 @@ struct ExactRanker {
   }
   // The scan threshold: no row scanned at or above it can be the canonical best.
   float threshold() const { return upper + slack(upper); }
-  // Decides the pending rows that may still win; best_row and best_distance are then final for
-  // the rows offered so far.
+  // Decides the pending rows that may still win; best_row (-1 if no row beat the bound) and
+  // best_distance are then final for the rows offered so far. Call once the scan is done.
   void resolve();
-  // Call once the scan is done: best_row (-1 if no row beat the bound) and best_distance.
-  void finish() { resolve(); }
   // RowFilter::offer hook: context is an ExactRanker. Sets best.row to the offered row (a row
   // was found) and best.distance to the new threshold.
   static void offer(void* context, int row, float scanned_distance, search_kernels::ScanBest& best);

@@ -246,7 +246,7 @@ struct FlannForest {
       int found = result.best().row;
       float found_distance = result.best().distance;
       if (!group.rotation.empty()) {
-        ranker.finish();
+        ranker.resolve();
         found = ranker.best_row;
         found_distance = ranker.best_distance;
       }
