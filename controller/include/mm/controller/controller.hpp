@@ -1,0 +1,354 @@
+#pragma once
+// The motion-matching character controller: one per character, updated once per game frame.
+//
+// Every update(dt, input):
+//   input -> desired velocity and facing (camera-relative stick, walk/run speeds per direction)
+//   -> simulation object: a spring character (position, velocity, acceleration) and a rotation
+//      spring (facing, angular velocity), with its trajectory predicted at the feature times
+//   -> search every search_interval seconds, at once on a sharp change of the desired motion, a
+//      new tag request or the end of the playing clip; switch only when the best candidate beats
+//      continuing (the search's transition cost)
+//   -> inertialized transition: joint and root offsets that decay with a halflife
+//   -> playback advances continuously; poses between database frames are interpolated
+//   -> root motion: the database root's motion re-expressed in the character's frame through
+//      the transition source and destination
+//   -> synchronization of the character and the simulation object
+//   -> foot locking: a foot in contact keeps its toe where it landed (two-bone IK, then
+//      distance-constraint relaxation for exact bone lengths), released smoothly
+//   -> forward kinematics: global transforms and skinning matrices.
+//
+// update() never allocates, logs or touches files: every buffer is sized in create(). Any
+// number of controllers may share one ControllerDatabase and update in parallel threads.
+// Units: metres, seconds, radians; Y up (docs/conventions.md).
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mm/controller/input.hpp"
+#include "mm/database/database.hpp"
+#include "mm/database/search.hpp"
+#include "mm/runtime/inertialization.hpp"
+#include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/result.hpp"
+#include "mm/runtime/transform.hpp"
+
+namespace mm {
+
+// How the animated character and the simulation object are kept together.
+enum class SyncMode : uint8_t {
+  CharacterFollowsSimulation,  // the character's root is pulled toward the simulation object
+  SimulationFollowsCharacter,  // the simulation object is placed where the character went
+  None,                        // each goes its own way (for debugging)
+};
+
+// "character", "simulation" or "none".
+std::string_view sync_mode_name(SyncMode mode);
+// Parses the names of sync_mode_name(); false for an unknown name.
+bool parse_sync_mode(std::string_view name, SyncMode& mode);
+
+// Read-only data that many controllers share: the database, the candidate frames the
+// controller may jump to, search structures (built once per method), default speeds measured
+// on the data, and the tags that mean "locomotion" and "idle".
+struct ControllerDatabaseOptions {
+  // Frames this close to the end of their clip are never jumped to (seconds), on top of the
+  // feature times' own margin: clip ends stop mid-stride, and a transition there lands on a
+  // take that is about to run out.
+  float clip_end_exclusion = 1.0f;
+  // Options of the search structures.
+  SearchOptions search;
+};
+
+class ControllerDatabase {
+ public:
+  // Validates the database for a controller (joint roles, a trajectory in the schema, at least
+  // one candidate) and measures its speeds. Does not build a searcher yet.
+  static Result<std::shared_ptr<const ControllerDatabase>> create(
+      std::shared_ptr<const Database> database, const ControllerDatabaseOptions& options = {});
+
+  const Database& database() const { return *database_; }
+  const ControllerDatabaseOptions& options() const { return options_; }
+
+  // The searcher of this method over the controller's candidates, built on first use (cold;
+  // thread-safe). Fails on an unknown method.
+  Result<const Searcher*> searcher(std::string_view method) const;
+
+  // Speeds measured on the database's locomotion (m/s): medians of the root's horizontal speed
+  // over frames moving forward, sideways and backward relative to the facing, walking and
+  // running. Directions the data lacks fall back to a fraction of the forward speed.
+  struct Speeds {
+    float walk_forward = 1.4f, walk_sideways = 1.0f, walk_backward = 1.0f;
+    float run_forward = 3.5f, run_sideways = 2.5f, run_backward = 2.0f;
+  };
+  const Speeds& speeds() const { return speeds_; }
+
+  // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
+  uint64_t action_tags() const { return action_tags_; }
+  uint64_t idle_tags() const { return idle_tags_; }
+  // The candidate flags the searchers are built over (searchable and not near a clip end).
+  std::span<const uint8_t> candidates() const { return candidates_; }
+
+  ControllerDatabase(const ControllerDatabase&) = delete;
+  ControllerDatabase& operator=(const ControllerDatabase&) = delete;
+
+ private:
+  ControllerDatabase() = default;
+  std::shared_ptr<const Database> database_;
+  ControllerDatabaseOptions options_;
+  std::vector<uint8_t> candidates_;
+  Speeds speeds_;
+  uint64_t action_tags_ = 0;
+  uint64_t idle_tags_ = 0;
+  struct SearcherEntry {
+    std::string method;
+    std::unique_ptr<Searcher> searcher;
+  };
+  mutable std::mutex mutex_;
+  mutable std::vector<SearcherEntry> searchers_;
+};
+
+// Every tunable of a controller, with its unit and default.
+struct ControllerSettings {
+  // ---- Desired motion. A speed of 0 (the default) takes the database's measured speed.
+  float walk_speed_forward = 0.0f;   // m/s
+  float walk_speed_sideways = 0.0f;  // m/s
+  float walk_speed_backward = 0.0f;  // m/s
+  float run_speed_forward = 0.0f;    // m/s
+  float run_speed_sideways = 0.0f;   // m/s
+  float run_speed_backward = 0.0f;   // m/s
+  // Stick deflection below this counts as released (0..1).
+  float stick_deadzone = 0.2f;
+
+  // ---- Simulation object (halflives as in spring.hpp: a spring at rest closes half the
+  // distance to its goal in one halflife).
+  float simulation_velocity_halflife = 0.3f;  // s
+  float simulation_rotation_halflife = 0.2f;  // s
+
+  // ---- Matching.
+  std::string search_method = "boxtree";  // a name from search_method_names()
+  float search_interval = 0.1f;           // s between searches while nothing changes
+  // Extra cost every candidate but the continuation pays (normalized feature units).
+  float transition_cost = 0.0f;
+  // Frames within this time of the playing frame are not jumped to (s).
+  float ignore_window = 0.2f;
+  // A change of the desired velocity (m/s) or facing (radians) since the last search this large
+  // searches at once.
+  float replan_velocity_change = 0.5f;
+  float replan_facing_change = 0.35f;
+  // The playing clip is about to end when less than this remains (s): search at once.
+  float clip_end_lookahead = 0.1f;
+  // Sampling between database frames.
+  InterpolationMethod interpolation = InterpolationMethod::Nlerp;
+
+  // ---- Transitions.
+  float inertialization_halflife = 0.12f;  // s
+
+  // ---- Synchronization.
+  SyncMode sync_mode = SyncMode::CharacterFollowsSimulation;
+  float adjustment_halflife = 0.15f;  // s: how fast the character is pulled to the simulation
+  // The pull's speed is at most this ratio of the character's own speed (linear and angular),
+  // so a standing character is never slid.
+  float adjustment_max_velocity_ratio = 0.5f;
+  // The character never strays farther than this from the simulation (m, radians).
+  float clamp_max_distance = 0.15f;
+  float clamp_max_angle = 0.6f;
+
+  // ---- Foot locking and IK.
+  bool ik_enabled = true;        // false: the animation's feet as they are
+  bool foot_lock_enabled = true; // hold a foot's toe where it landed while in contact
+  // A locked toe is released when the animation drags it farther than this (m).
+  float foot_unlock_radius = 0.2f;
+  // After a release the foot eases back onto the animation with this halflife (s).
+  float foot_lock_release_halflife = 0.1f;
+  // Passes of the distance-constraint solver that restores the leg's bone lengths.
+  int bone_length_iterations = 2;
+
+  // ---- Robustness. A dt larger than this is clamped to it (s).
+  float max_dt = 0.1f;
+  // Fills skinning_matrices() on every update.
+  bool compute_skinning = true;
+
+  // Checks every field (finite, in range, a known search method).
+  Status validate() const;
+};
+
+// The per-channel cost of the last search: squared normalized distance between the query and
+// the chosen frame's features, channel by channel (as the database's schema lists them).
+inline constexpr int kMaxDebugChannels = 16;
+
+// What a debug drawing, a panel or an evaluation reads after update().
+struct ControllerDebug {
+  // Desired motion.
+  glm::vec3 desired_velocity{0.0f};                       // m/s, world
+  glm::quat desired_rotation{1.0f, 0.0f, 0.0f, 0.0f};     // the desired facing
+  // The simulation object.
+  glm::vec3 simulation_position{0.0f};
+  glm::vec3 simulation_velocity{0.0f};
+  glm::vec3 simulation_acceleration{0.0f};
+  glm::quat simulation_rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 simulation_angular_velocity{0.0f};
+  // The predicted trajectory at the feature times (world positions and facings); the desired
+  // trajectory is the same springs with their goals already reached, i.e. where the stick says.
+  static constexpr int kMaxTrajectoryPoints = 8;
+  int trajectory_count = 0;
+  float trajectory_times[kMaxTrajectoryPoints] = {};
+  glm::vec3 predicted_positions[kMaxTrajectoryPoints] = {};
+  glm::quat predicted_rotations[kMaxTrajectoryPoints] = {};
+  glm::vec3 desired_positions[kMaxTrajectoryPoints] = {};
+
+  // Playback.
+  int clip = -1;              // index into database().clips
+  int frame = -1;             // the database frame nearest the playback time
+  float clip_time = 0.0f;     // seconds since the clip's first frame
+  bool transitioned = false;  // this update jumped to a new frame
+  int transitions = 0;        // since create()
+  bool standing = false;      // the desired speed is zero
+
+  // The last search.
+  int searches = 0;                   // since create()
+  bool searched = false;              // this update searched
+  float search_seconds = 0.0f;        // wall time of this update's search (0 when none)
+  int channel_count = 0;
+  float last_cost = 0.0f;             // the chosen candidate's cost (transition cost included)
+  float last_channel_costs[kMaxDebugChannels] = {};
+  int last_best_frame = -1;
+  static constexpr int kMaxQueryDims = 64;
+  int query_dims = 0;
+  float last_query[kMaxQueryDims] = {};  // normalized; the first kMaxQueryDims columns
+
+  // Feet: 0 left, 1 right.
+  bool contact[2] = {false, false};     // the database's contact of the playing frame
+  bool locked[2] = {false, false};      // the toe is held by the foot lock
+  glm::vec3 lock_position[2] = {};      // where a locked toe is held
+  glm::vec3 ik_target[2] = {};          // where IK put the toe (equals the animation when free)
+};
+
+class Controller {
+ public:
+  // A controller at the world origin facing +Z, standing on the calmest candidate frame until
+  // its first update. Fails on invalid settings or an unknown search method.
+  static Result<Controller> create(std::shared_ptr<const ControllerDatabase> database,
+                                   const ControllerSettings& settings = {});
+
+  // Advances by dt seconds of game time. dt <= 0 or non-finite changes nothing; dt above
+  // settings.max_dt is clamped to it; non-finite or out-of-range input is sanitized.
+  void update(float dt, const ControllerInput& input);
+
+  // Places the character and its simulation object (cold; clears any transition).
+  void teleport(const glm::vec3& position, float yaw);
+
+  // Global (model = world) transforms of every database joint after the last update.
+  std::span<const Transform> global_transforms() const { return globals_; }
+  // Local transforms after inertialization and IK.
+  std::span<const Transform> local_transforms() const { return locals_; }
+  // global * inverse(bind global), with the database skeleton's rest pose as the bind pose.
+  std::span<const glm::mat4> skinning_matrices() const { return skinning_; }
+  // The character's root (joint 0): its ground position and facing.
+  const Transform& root_transform() const { return globals_[0]; }
+  const ControllerDebug& debug() const { return debug_; }
+  const ControllerSettings& settings() const { return settings_; }
+  const ControllerDatabase& controller_database() const { return *shared_; }
+  // The speeds in use (settings, or the database's where the settings say 0).
+  const ControllerDatabase::Speeds& speeds() const { return speeds_; }
+
+  // Live tuning between updates (cold). Fails, changing nothing, on invalid settings.
+  Status set_settings(const ControllerSettings& settings);
+
+  // Moves the character's root to this transform now, keeping the transition source and
+  // destination consistent so that playback continues from there (seed 004). Used by the
+  // synchronization; public for games that move characters (teleports, collisions).
+  void adjust_root(const glm::vec3& position, const glm::quat& rotation);
+
+ private:
+  Controller() = default;
+  struct Impl;
+  void desired_motion(const ControllerInput& input);
+  void simulate(float dt);
+  void predict();
+  bool should_search(const ControllerInput& input) const;
+  void build_query();
+  void search(const ControllerInput& input);
+  void transition_to(int frame);
+  void advance_playback(float dt);
+  void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
+                       std::span<glm::vec3> angular_velocities) const;
+  void root_motion(float dt);
+  void synchronize(float dt);
+  void foot_lock(float dt);
+  void finish_pose();
+  uint64_t resolve_tag(std::string_view tag) const;
+
+  std::shared_ptr<const ControllerDatabase> shared_;
+  const Database* db_ = nullptr;
+  const Searcher* searcher_ = nullptr;
+  ControllerSettings settings_;
+  ControllerDatabase::Speeds speeds_;
+
+  // Schema facts resolved at create().
+  std::vector<float> trajectory_times_;  // unique trajectory times of the schema (s)
+  struct TrajectoryColumn {
+    int column = 0;       // first column in the feature row
+    int time_index = 0;   // index into trajectory_times_
+    bool direction = false;
+  };
+  std::vector<TrajectoryColumn> trajectory_columns_;
+  std::vector<int> leg_joints_[2];  // upper leg, lower leg, foot, toe per side
+
+  // Simulation object.
+  glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
+  glm::quat sim_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 sim_angular_velocity_{0.0f};
+  glm::vec3 desired_velocity_{0.0f};
+  glm::quat desired_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 desired_velocity_at_search_{0.0f};
+  glm::quat desired_rotation_at_search_{1.0f, 0.0f, 0.0f, 0.0f};
+  uint64_t tag_bits_ = 0;  // resolved tag request (0: locomotion)
+  uint64_t tag_bits_at_search_ = 0;
+  float search_timer_ = 0.0f;
+  bool force_search_ = true;
+
+  // Playback: the clip and the time since its first frame.
+  int clip_ = -1;
+  float clip_time_ = 0.0f;
+
+  // Root: world = source * inverse(destination) * database root (seed 004).
+  glm::vec3 transition_src_position_{0.0f};
+  glm::quat transition_src_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 transition_dst_position_{0.0f};
+  glm::quat transition_dst_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+
+  InertializationOffsets offsets_;
+  // Per-joint buffers, sized at create().
+  std::vector<Transform> sampled_;  // the playing animation (root in world space)
+  std::vector<glm::vec3> sampled_velocities_;
+  std::vector<glm::vec3> sampled_angular_velocities_;
+  std::vector<Transform> other_;  // the other side of a transition
+  std::vector<glm::vec3> other_velocities_;
+  std::vector<glm::vec3> other_angular_velocities_;
+  std::vector<Transform> locals_;
+  std::vector<Transform> globals_;
+  std::vector<Transform> inverse_bind_;
+  std::vector<glm::mat4> skinning_;
+  std::vector<float> query_;
+
+  // Foot locks: 0 left, 1 right.
+  struct FootLock {
+    bool locked = false;
+    glm::vec3 position{0.0f};        // the held toe position
+    glm::vec3 offset{0.0f};          // after a release: target - animation, decaying
+    glm::vec3 offset_velocity{0.0f};
+    bool previous_contact = false;
+  };
+  FootLock feet_[2];
+
+  ControllerDebug debug_;
+};
+
+}  // namespace mm

@@ -1,0 +1,27 @@
+#pragma once
+// What a player (gamepad, keyboard, script) asks of a character on one frame.
+//
+// Conventions (docs/conventions.md): Y up, the ground is y = 0. The camera's yaw is a rotation
+// about +Y; the camera looks along (sin yaw, 0, cos yaw), so yaw 0 looks along world +Z. A stick
+// is read in the camera's frame: +y pushes away from the camera (forward), +x to the camera's
+// right. Sticks outside the unit disc are scaled back onto it; non-finite values count as 0.
+
+#include <string_view>
+
+#include <glm/glm.hpp>
+
+namespace mm {
+
+struct ControllerInput {
+  glm::vec2 left_stick{0.0f};   // move: x right, y forward, relative to the camera
+  glm::vec2 right_stick{0.0f};  // facing while strafing, same axes; ignored otherwise
+  float camera_yaw = 0.0f;      // radians about +Y; the camera looks along (sin, 0, cos)
+  bool run = false;             // run speeds instead of walk speeds
+  bool strafe = false;          // keep facing the right stick (or the current facing)
+  // Play clips carrying this tag (e.g. "wave"): a database tag equal to it, or whose first word
+  // is it ("wave" matches "wave-both-hands" and "wave-left-hand"). Empty: locomotion. The view
+  // is read during update() only; it need not outlive the call.
+  std::string_view tag;
+};
+
+}  // namespace mm

@@ -1,0 +1,71 @@
+#pragma once
+// Scripted input: a text file of timed stick and button states, so that a run is reproducible
+// without a gamepad (mm eval, mm crowd-bench, mm-viewer --script, tests).
+//
+// Format: one line per change of state,
+//   t lx ly rx ry [run] [strafe] [tag=NAME] [camera=DEGREES]
+// - t: seconds, non-decreasing from line to line (equal times: the later line wins);
+// - lx ly: the left stick, rx ry: the right stick, each in [-1, 1] (see input.hpp for axes);
+// - run, strafe: the buttons held (absent: released);
+// - tag=NAME: request clips carrying the tag NAME (absent: locomotion);
+// - camera=DEGREES: the camera's yaw about +Y in degrees (absent: 0, looking along world +Z).
+// Each line is a whole state: it holds until the next line, and the last holds forever. Before
+// the first line's time the input is neutral (sticks released, camera 0). '#' starts a
+// comment; blank lines are ignored. A malformed line is refused with its file name, line
+// number and what was expected.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mm/controller/input.hpp"
+#include "mm/runtime/result.hpp"
+
+namespace mm {
+
+// One line of a script.
+struct ScriptEvent {
+  float time = 0.0f;       // seconds
+  ControllerInput input;   // camera_yaw in radians; input.tag views `tag` below
+  std::string tag;         // owns the tag text (empty: none)
+  int line = 0;            // line number in the source, for messages
+};
+
+class InputScript {
+ public:
+  InputScript() = default;
+  // Copies keep their tag views pointing into their own events.
+  InputScript(const InputScript& other);
+  InputScript& operator=(const InputScript& other);
+  InputScript(InputScript&&) noexcept = default;
+  InputScript& operator=(InputScript&&) noexcept = default;
+
+  // Takes events in time order (non-decreasing; asserted) and re-points their tag views.
+  explicit InputScript(std::vector<ScriptEvent> events);
+
+  const std::vector<ScriptEvent>& events() const { return events_; }
+  // The time of the last line (0 for an empty script).
+  float duration() const;
+  // The input in effect at time t (see the top of this file). Does not allocate.
+  ControllerInput at(float t) const;
+  // Index of the line in effect at t, or -1 before the first line.
+  int index_at(float t) const;
+
+ private:
+  void repoint_tags();
+  std::vector<ScriptEvent> events_;
+};
+
+// Parses script text. `name_for_messages` (a file name) starts every error message, which
+// also gives the 1-based line number and what was expected there.
+Result<InputScript> parse_input_script(std::string_view text, std::string_view name_for_messages);
+
+// Reads and parses a script file.
+Result<InputScript> load_input_script(const std::filesystem::path& path);
+
+// One line of the format for this state (used to record live input); parsing it gives the
+// same state back to the printed precision.
+std::string format_script_line(float time, const ControllerInput& input);
+
+}  // namespace mm
