@@ -1,0 +1,301 @@
+#include "mm/controller/script.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <numbers>
+#include <system_error>
+#include <utility>
+
+namespace mm {
+
+namespace {
+
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
+
+// Longer tokens are cut in messages, so that a binary file given by mistake does not print
+// itself into the error.
+constexpr size_t kMaxQuotedToken = 40;
+
+bool is_separator(char c) {
+  return c == ' ' || c == '\t';
+}
+
+// The same character set as database tags (mm/database/tags.hpp), so that a script can request
+// any tag a database can carry.
+bool is_tag_char(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-' || c == '.' || c == ':' || c == '+';
+}
+
+std::string quoted(std::string_view token) {
+  // Appended piece by piece: g++ 12 gives a false -Wrestrict for "'" + std::string(...).
+  std::string text = "'";
+  text += token.substr(0, kMaxQuotedToken);
+  text += token.size() > kMaxQuotedToken ? "...'" : "'";
+  return text;
+}
+
+// A whole token as a finite float, or false. std::from_chars, unlike strtof, does not follow
+// the C locale, so "0.5" means one half whatever the program's locale is. A leading '+' is
+// accepted because people write it, although from_chars itself does not.
+bool parse_finite(std::string_view token, float& value) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
+    token.remove_prefix(1);
+  }
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  if (ec != std::errc() || ptr != end || !std::isfinite(value)) return false;
+  value += 0.0f;  // -0 becomes +0, so that "-0" and "0" are the same state
+  return true;
+}
+
+// The shortest text that reads back as `value` ("2.5", not "2.500000").
+std::string shortest(float value) {
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  assert(ec == std::errc());
+  (void)ec;
+  return std::string(buffer, end);
+}
+
+// What each stick number of a line is, for messages.
+constexpr std::string_view kStickNames[4] = {"the left stick's x", "the left stick's y",
+                                             "the right stick's x", "the right stick's y"};
+
+// Appends `value` with `decimals` digits after the point, without "-0.000" for a value that
+// rounds to zero. std::to_chars, unlike printf, does not follow the C locale either.
+void append_fixed(std::string& out, double value, int decimals) {
+  char buffer[64];  // enough for any finite float in fixed notation
+  const auto [end, ec] =
+      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals);
+  assert(ec == std::errc());
+  (void)ec;
+  std::string_view text(buffer, static_cast<size_t>(end - buffer));
+  if (text.starts_with('-') && text.find_first_not_of("0.", 1) == std::string_view::npos) {
+    text.remove_prefix(1);
+  }
+  out += text;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// InputScript
+
+InputScript::InputScript(const InputScript& other) : events_(other.events_) {
+  repoint_tags();
+}
+
+InputScript& InputScript::operator=(const InputScript& other) {
+  if (this != &other) {
+    events_ = other.events_;
+    repoint_tags();
+  }
+  return *this;
+}
+
+InputScript::InputScript(std::vector<ScriptEvent> events) : events_(std::move(events)) {
+  assert(
+      std::is_sorted(events_.begin(), events_.end(),
+                     [](const ScriptEvent& a, const ScriptEvent& b) { return a.time < b.time; }));
+  repoint_tags();
+}
+
+// A copied ScriptEvent still views the tag of the event it was copied from; `tag` is the owner,
+// so every view is rebuilt from it. (Moves keep the vector's buffer, hence the strings.)
+void InputScript::repoint_tags() {
+  for (ScriptEvent& event : events_) event.input.tag = event.tag;
+}
+
+float InputScript::duration() const {
+  return events_.empty() ? 0.0f : events_.back().time;
+}
+
+int InputScript::index_at(float t) const {
+  // Written so that a NaN time, like a time before the first line, gives the neutral input.
+  if (events_.empty() || !(t >= events_.front().time)) return -1;
+  const auto after =
+      std::upper_bound(events_.begin(), events_.end(), t,
+                       [](float time, const ScriptEvent& e) { return time < e.time; });
+  // upper_bound passes every line at time t, so of equal times the later line wins.
+  return static_cast<int>(after - events_.begin()) - 1;
+}
+
+ControllerInput InputScript::at(float t) const {
+  const int index = index_at(t);
+  return index < 0 ? ControllerInput{} : events_[static_cast<size_t>(index)].input;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parsing
+
+Result<InputScript> parse_input_script(std::string_view text, std::string_view name_for_messages) {
+  // Some Windows editors start a UTF-8 file with an invisible byte order mark; it is no token.
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  std::vector<ScriptEvent> events;
+  std::vector<std::string_view> tokens;
+  int line_number = 0;
+  size_t line_start = 0;
+  while (line_start <= text.size()) {
+    size_t line_end = text.find('\n', line_start);
+    if (line_end == std::string_view::npos) line_end = text.size();
+    std::string_view line = text.substr(line_start, line_end - line_start);
+    line_start = line_end + 1;
+    ++line_number;
+
+    if (const size_t hash = line.find('#'); hash != std::string_view::npos) {
+      line = line.substr(0, hash);
+    }
+    // A file saved with Windows line ends still reads the same.
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+
+    tokens.clear();
+    for (size_t i = 0; i < line.size();) {
+      while (i < line.size() && is_separator(line[i])) ++i;
+      const size_t start = i;
+      while (i < line.size() && !is_separator(line[i])) ++i;
+      if (i > start) tokens.push_back(line.substr(start, i - start));
+    }
+    if (tokens.empty()) continue;
+
+    const std::string where =
+        std::string(name_for_messages) + ":" + std::to_string(line_number) + ": ";
+    auto found = [&](size_t index) {
+      return index < tokens.size() ? quoted(tokens[index]) : std::string("the end of the line");
+    };
+
+    ScriptEvent event;
+    event.line = line_number;
+    if (!parse_finite(tokens[0], event.time) || event.time < 0.0f) {
+      return Error{where + "expected the time in seconds (a number >= 0), found " + found(0)};
+    }
+    if (!events.empty() && event.time < events.back().time) {
+      return Error{where + "expected a time >= " + shortest(events.back().time) +
+                   " (the time of line " + std::to_string(events.back().line) + "), found " +
+                   found(0)};
+    }
+    float sticks[4] = {};
+    for (size_t k = 0; k < 4; ++k) {
+      const size_t index = k + 1;
+      if (index >= tokens.size() || !parse_finite(tokens[index], sticks[k]) || sticks[k] < -1.0f ||
+          sticks[k] > 1.0f) {
+        return Error{where + "expected " + std::string(kStickNames[k]) +
+                     " (a number in [-1, 1]), found " + found(index)};
+      }
+    }
+    event.input.left_stick = {sticks[0], sticks[1]};
+    event.input.right_stick = {sticks[2], sticks[3]};
+
+    bool seen_run = false, seen_strafe = false, seen_tag = false, seen_camera = false;
+    // True the second time a flag is seen on this line.
+    auto repeated = [](bool& seen) { return std::exchange(seen, true); };
+    for (size_t index = 5; index < tokens.size(); ++index) {
+      const std::string_view token = tokens[index];
+      auto twice = [&](std::string_view flag) {
+        return Error{where + "expected " + std::string(flag) + " at most once on a line, found " +
+                     quoted(token) + " again"};
+      };
+      if (token == "run") {
+        if (repeated(seen_run)) return twice("run");
+        event.input.run = true;
+      } else if (token == "strafe") {
+        if (repeated(seen_strafe)) return twice("strafe");
+        event.input.strafe = true;
+      } else if (token.starts_with("tag=")) {
+        if (repeated(seen_tag)) return twice("tag=NAME");
+        const std::string_view name = token.substr(4);
+        if (name.empty() || !std::all_of(name.begin(), name.end(), is_tag_char)) {
+          return Error{where +
+                       "expected tag=NAME with a name of letters, digits and _-.:+, found " +
+                       quoted(token)};
+        }
+        event.tag = name;
+      } else if (token.starts_with("camera=")) {
+        if (repeated(seen_camera)) return twice("camera=DEGREES");
+        float degrees = 0.0f;
+        if (!parse_finite(token.substr(7), degrees)) {
+          return Error{where + "expected camera=DEGREES with a finite number of degrees, found " +
+                       quoted(token)};
+        }
+        event.input.camera_yaw = static_cast<float>(degrees * kRadiansPerDegree);
+      } else {
+        return Error{where + "expected run, strafe, tag=NAME or camera=DEGREES, found " +
+                     quoted(token)};
+      }
+    }
+    events.push_back(std::move(event));
+  }
+  return InputScript(std::move(events));
+}
+
+Result<InputScript> load_input_script(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    return Error{name + ": is a folder, not an input script"};
+  }
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
+                                                       &std::fclose);
+  if (!file) return Error{name + ": cannot open the input script (" + std::strerror(errno) + ")"};
+  std::string text;
+  char chunk[1 << 14];
+  for (;;) {
+    const size_t got = std::fread(chunk, 1, sizeof chunk, file.get());
+    text.append(chunk, got);
+    if (got < sizeof chunk) {
+      if (std::ferror(file.get())) {
+        return Error{name + ": cannot read the input script (" + std::strerror(errno) + ")"};
+      }
+      break;
+    }
+  }
+  return parse_input_script(text, name);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Formatting
+
+std::string format_script_line(float time, const ControllerInput& input) {
+  // The line must parse whatever a live source hands over: a non-finite value prints as 0
+  // (input.hpp: it counts as 0), a negative time as 0, and a stick with a component beyond
+  // [-1, 1] is scaled back along its direction, which the controller's own scaling onto the
+  // unit disc then treats exactly as the original.
+  auto finite_or_zero = [](float v) { return std::isfinite(v) ? v : 0.0f; };
+  auto printable_stick = [&](glm::vec2 stick) {
+    stick = {finite_or_zero(stick.x), finite_or_zero(stick.y)};
+    const float largest = std::max(std::abs(stick.x), std::abs(stick.y));
+    if (largest > 1.0f) stick = glm::clamp(stick / largest, -1.0f, 1.0f);
+    return stick;
+  };
+  const glm::vec2 left = printable_stick(input.left_stick);
+  const glm::vec2 right = printable_stick(input.right_stick);
+
+  std::string line;
+  append_fixed(line, std::max(finite_or_zero(time), 0.0f), 3);
+  for (const float value : {left.x, left.y, right.x, right.y}) {
+    line += ' ';
+    append_fixed(line, value, 3);
+  }
+  if (input.run) line += " run";
+  if (input.strafe) line += " strafe";
+  if (!input.tag.empty()) {
+    // A tag outside the tag characters would not parse back; tags come from the program.
+    assert(std::all_of(input.tag.begin(), input.tag.end(), is_tag_char));
+    line += " tag=";
+    line += input.tag;
+  }
+  const double degrees = finite_or_zero(input.camera_yaw) / kRadiansPerDegree;
+  if (std::abs(degrees) >= 0.05) {  // absent means 0, which is what "camera=0.0" would say
+    line += " camera=";
+    append_fixed(line, degrees, 1);
+  }
+  return line;
+}
+
+}  // namespace mm
