@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -525,6 +526,36 @@ TEST(InputScript, LoadOfAMissingFileOrAFolderNamesThePath) {
   Result<InputScript> from_folder = load_input_script(dir);
   ASSERT_FALSE(from_folder.ok());
   EXPECT_EQ(from_folder.message(), dir.string() + ": is a folder, not an input script");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scripts shipped in scripts/input/.
+
+TEST(InputScript, EveryShippedScriptParsesAndLastsAtLeastTenSeconds) {
+  const auto folder = std::filesystem::path(MM_SOURCE_DIR) / "scripts" / "input";
+  ASSERT_TRUE(std::filesystem::is_directory(folder)) << folder;
+  std::set<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() != ".txt") continue;
+    names.insert(entry.path().filename().string());
+    Result<InputScript> script = load_input_script(entry.path());
+    ASSERT_TRUE(script.ok()) << script.message();
+    EXPECT_GE(script->duration(), 10.0f) << entry.path();
+    // A header says what the script exercises.
+    std::ifstream in(entry.path());
+    std::string first_line;
+    std::getline(in, first_line);
+    EXPECT_TRUE(first_line.starts_with("# ")) << entry.path();
+  }
+  for (const char* required : {"circle.txt", "zigzag.txt", "stop-and-go.txt", "strafe.txt",
+                               "walk-run.txt", "camera-turns.txt", "random-long.txt"}) {
+    EXPECT_TRUE(names.contains(required)) << required;
+  }
+  // One script requests a tag.
+  Result<InputScript> wave = load_input_script(folder / "tag-wave.txt");
+  ASSERT_TRUE(wave.ok()) << wave.message();
+  EXPECT_TRUE(std::any_of(wave->events().begin(), wave->events().end(),
+                          [](const ScriptEvent& e) { return e.tag == "wave"; }));
 }
 
 }  // namespace
