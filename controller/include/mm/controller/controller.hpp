@@ -125,6 +125,9 @@ struct ControllerSettings {
   float run_speed_backward = 0.0f;   // m/s
   // Stick deflection below this counts as released (0..1).
   float stick_deadzone = 0.2f;
+  // Stopping: when the stick is released and the simulation object is slower than this (m/s),
+  // only the database's idle clip is matched (the data has no stops of its own).
+  float stop_speed = 0.5f;
 
   // ---- Simulation object (halflives as in spring.hpp: a spring at rest closes half the
   // distance to its goal in one halflife).
@@ -178,6 +181,13 @@ struct ControllerSettings {
   // Checks every field (finite, in range, a known search method).
   Status validate() const;
 };
+
+// Sets one field of `settings`, named as in the struct (e.g. "inertialization_halflife"), from
+// text: a number, "on"/"off" for flags, a search method, a sync mode name or an interpolation
+// ("nlerp", "slerp", "sclerp"). Fails, naming the field and the value, on an unknown name or
+// unreadable value; range checks are validate()'s.
+Status set_controller_setting(ControllerSettings& settings, std::string_view name,
+                              std::string_view value);
 
 // The per-channel cost of the last search: squared normalized distance between the query and
 // the chosen frame's features, channel by channel (as the database's schema lists them).
@@ -281,7 +291,9 @@ class Controller {
                        std::span<glm::vec3> angular_velocities) const;
   void root_motion(float dt);
   void synchronize(float dt);
+  void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
+  void restore_leg_lengths(int side, const glm::vec3& target);
   void finish_pose();
   uint64_t resolve_tag(std::string_view tag) const;
 
@@ -299,7 +311,8 @@ class Controller {
     bool direction = false;
   };
   std::vector<TrajectoryColumn> trajectory_columns_;
-  std::vector<int> leg_joints_[2];  // upper leg, lower leg, foot, toe per side
+  std::vector<int> leg_joints_[2];
+  std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)  // upper leg, lower leg, foot, toe per side
 
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
@@ -311,6 +324,8 @@ class Controller {
   glm::quat desired_rotation_at_search_{1.0f, 0.0f, 0.0f, 0.0f};
   uint64_t tag_bits_ = 0;  // resolved tag request (0: locomotion)
   uint64_t tag_bits_at_search_ = 0;
+  bool stopping_ = false;  // stick released and slow: the idle clip only
+  bool stopping_at_search_ = false;
   float search_timer_ = 0.0f;
   bool force_search_ = true;
 
@@ -332,7 +347,9 @@ class Controller {
   std::vector<Transform> other_;  // the other side of a transition
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;
-  std::vector<Transform> locals_;
+  std::vector<Transform> locals_;  // displayed: inertialized, adjusted, with IK
+  std::vector<glm::vec3> displayed_velocities_;
+  std::vector<glm::vec3> displayed_angular_velocities_;
   std::vector<Transform> globals_;
   std::vector<Transform> inverse_bind_;
   std::vector<glm::mat4> skinning_;

@@ -1,0 +1,49 @@
+#pragma once
+// The crowd benchmark (`mm crowd-bench`): many controllers over one shared database, each with
+// its own varied scripted input, updated at a fixed rate on one or more threads. Characters are
+// independent, so the result (every character's final pose) does not depend on the thread count.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mm/controller/controller.hpp"
+#include "mm/controller/script.hpp"
+#include "mm/runtime/result.hpp"
+
+namespace mm {
+
+// A reproducible input script of `seconds` for character `seed`: every 0.5 to 3 s the stick
+// takes a new direction (sometimes released, sometimes running, sometimes strafing with the
+// camera turned). The same seed always gives the same script, on every platform.
+InputScript varied_input_script(uint32_t seed, float seconds);
+
+struct CrowdOptions {
+  int characters = 100;
+  float seconds = 10.0f;   // of game time
+  float dt = 1.0f / 60.0f;
+  int threads = 1;         // >= 1; characters are split into contiguous slices
+  ControllerSettings settings;
+};
+
+struct CrowdResult {
+  int threads = 0;
+  int frames = 0;
+  double wall_seconds = 0.0;          // the whole run, all threads
+  double update_us_mean = 0.0;        // per character per frame (each update timed)
+  double update_us_p99 = 0.0;
+  double search_share = 0.0;          // time in search / time in update
+  double frame_ms_mean = 0.0;         // wall time per frame for the whole crowd
+  // Characters one frame of 1/60 s could update at this run's rate per character and thread
+  // count: characters * (1/60 s) / frame time.
+  int max_characters_60hz = 0;
+  std::vector<glm::vec3> final_positions;  // root of each character after the run
+};
+
+// Runs the crowd. Fails on invalid options or settings.
+Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
+                              const CrowdOptions& options);
+
+}  // namespace mm

@@ -1,0 +1,809 @@
+// The controller's update loop. Its phases, in order, are the private member functions named in
+// controller.hpp; this file keeps them in that order.
+
+#include "mm/controller/controller.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "mm/database/feature_extraction.hpp"
+#include "mm/runtime/constraints.hpp"
+#include "mm/runtime/ik.hpp"
+#include "mm/runtime/pose.hpp"
+#include "mm/runtime/skinning.hpp"
+#include "mm/runtime/spring.hpp"
+
+namespace mm {
+
+namespace {
+
+const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
+// A foot released during a contact locks again once its easing offset is this small (m).
+constexpr float kRelockOffset = 0.01f;
+const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+bool finite(const glm::quat& q) {
+  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+         glm::length(q) > 0.5f;
+}
+
+glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
+
+// The yaw (radians, about +Y) of a rotation's forward axis: atan2(forward.x, forward.z).
+float yaw_of(const glm::quat& q) {
+  const glm::vec3 f = q * kForward;
+  return std::atan2(f.x, f.z);
+}
+
+// The angle in (-pi, pi] equal to `a` modulo 2 pi.
+float wrap_angle(float a) {
+  a = std::fmod(a + glm::pi<float>(), glm::two_pi<float>());
+  if (a < 0.0f) a += glm::two_pi<float>();
+  return a - glm::pi<float>();
+}
+
+// A stick with non-finite axes zeroed, scaled back onto the unit disc, and zero inside the
+// dead zone (outside it the magnitude is rescaled so it still reaches 1).
+glm::vec2 sanitize_stick(glm::vec2 s, float deadzone) {
+  if (!std::isfinite(s.x)) s.x = 0.0f;
+  if (!std::isfinite(s.y)) s.y = 0.0f;
+  // Bring huge values into range before squaring them.
+  const float largest = std::max(std::abs(s.x), std::abs(s.y));
+  if (largest > 1.0f) s /= largest;
+  const float length = glm::length(s);
+  if (length <= deadzone || length < 1e-6f) return glm::vec2(0.0f);
+  const float magnitude = std::min(1.0f, (length - deadzone) / (1.0f - deadzone));
+  return s * (magnitude / length);
+}
+
+// A stick's direction in the world: the camera looks along (sin yaw, 0, cos yaw) and its right
+// is forward x up, so stick +x is the camera's right and +y its forward.
+glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
+  return camera * glm::vec3(-stick.x, 0.0f, stick.y);
+}
+
+// Fraction of the remaining distance an exponential pull with this halflife closes in dt.
+float pull_fraction(float halflife, float dt) {
+  return 1.0f - std::exp2(-dt / std::max(halflife, kMinSpringHalflife));
+}
+
+}  // namespace
+
+std::string_view sync_mode_name(SyncMode mode) {
+  switch (mode) {
+    case SyncMode::CharacterFollowsSimulation:
+      return "character";
+    case SyncMode::SimulationFollowsCharacter:
+      return "simulation";
+    case SyncMode::None:
+      return "none";
+  }
+  return "none";
+}
+
+bool parse_sync_mode(std::string_view name, SyncMode& mode) {
+  for (SyncMode m : {SyncMode::CharacterFollowsSimulation, SyncMode::SimulationFollowsCharacter,
+                     SyncMode::None}) {
+    if (sync_mode_name(m) == name) {
+      mode = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+Status ControllerSettings::validate() const {
+  struct Field {
+    const char* name;
+    float value;
+    float min;
+    float max;
+  };
+  const Field fields[] = {
+      {"walk_speed_forward", walk_speed_forward, 0.0f, 20.0f},
+      {"walk_speed_sideways", walk_speed_sideways, 0.0f, 20.0f},
+      {"walk_speed_backward", walk_speed_backward, 0.0f, 20.0f},
+      {"run_speed_forward", run_speed_forward, 0.0f, 20.0f},
+      {"run_speed_sideways", run_speed_sideways, 0.0f, 20.0f},
+      {"run_speed_backward", run_speed_backward, 0.0f, 20.0f},
+      {"stick_deadzone", stick_deadzone, 0.0f, 0.9f},
+      {"stop_speed", stop_speed, 0.0f, 20.0f},
+      {"simulation_velocity_halflife", simulation_velocity_halflife, 0.0f, 10.0f},
+      {"simulation_rotation_halflife", simulation_rotation_halflife, 0.0f, 10.0f},
+      {"search_interval", search_interval, 0.0f, 10.0f},
+      {"transition_cost", transition_cost, 0.0f, 1e6f},
+      {"ignore_window", ignore_window, 0.0f, 10.0f},
+      {"replan_velocity_change", replan_velocity_change, 0.0f, 100.0f},
+      {"replan_facing_change", replan_facing_change, 0.0f, 10.0f},
+      {"clip_end_lookahead", clip_end_lookahead, 0.0f, 10.0f},
+      {"inertialization_halflife", inertialization_halflife, 0.0f, 10.0f},
+      {"adjustment_halflife", adjustment_halflife, 0.0f, 10.0f},
+      {"adjustment_max_velocity_ratio", adjustment_max_velocity_ratio, 0.0f, 100.0f},
+      {"clamp_max_distance", clamp_max_distance, 0.0f, 1e3f},
+      {"clamp_max_angle", clamp_max_angle, 0.0f, 4.0f},
+      {"foot_unlock_radius", foot_unlock_radius, 0.0f, 10.0f},
+      {"foot_lock_release_halflife", foot_lock_release_halflife, 0.0f, 10.0f},
+      {"max_dt", max_dt, 1e-4f, 10.0f},
+  };
+  for (const Field& f : fields) {
+    if (!std::isfinite(f.value) || f.value < f.min || f.value > f.max) {
+      return Error{std::string("controller settings: ") + f.name + " must be a number in [" +
+                   std::to_string(f.min) + ", " + std::to_string(f.max) + "], found " +
+                   std::to_string(f.value)};
+    }
+  }
+  if (bone_length_iterations < 0 || bone_length_iterations > 100) {
+    return Error{"controller settings: bone_length_iterations must be in [0, 100], found " +
+                 std::to_string(bone_length_iterations)};
+  }
+  const auto names = search_method_names();
+  if (std::find(names.begin(), names.end(), search_method) == names.end()) {
+    std::string list;
+    for (std::string_view n : names) list.append(list.empty() ? "" : ", ").append(n);
+    return Error{"controller settings: unknown search method '" + search_method + "' (one of " +
+                 list + ")"};
+  }
+  return Status::success();
+}
+
+// ---- Creation --------------------------------------------------------------------------------
+
+Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> database,
+                                      const ControllerSettings& settings) {
+  if (!database) return Error{"controller: no controller database given"};
+  Controller c;
+  c.shared_ = std::move(database);
+  c.db_ = &c.shared_->database();
+  if (Status s = c.set_settings(settings); !s) return Error{s.message()};
+  const Database& db = *c.db_;
+  const int joints = db.joint_count();
+
+  // Trajectory channels: their times and where their columns are.
+  for (size_t i = 0; i < db.schema.channels.size(); ++i) {
+    const FeatureChannel& channel = db.schema.channels[i];
+    const bool direction = channel.kind == FeatureKind::TrajectoryDirection;
+    if (channel.kind != FeatureKind::TrajectoryPosition && !direction) continue;
+    int column = db.schema.offset(static_cast<int>(i));
+    for (float t : channel.times) {
+      auto it = std::find(c.trajectory_times_.begin(), c.trajectory_times_.end(), t);
+      if (it == c.trajectory_times_.end()) {
+        if (c.trajectory_times_.size() >= ControllerDebug::kMaxTrajectoryPoints) {
+          return Error{"controller: the schema has more than " +
+                       std::to_string(ControllerDebug::kMaxTrajectoryPoints) +
+                       " distinct trajectory times"};
+        }
+        c.trajectory_times_.push_back(t);
+        it = c.trajectory_times_.end() - 1;
+      }
+      c.trajectory_columns_.push_back(
+          {column, static_cast<int>(it - c.trajectory_times_.begin()), direction});
+      column += 2;
+    }
+  }
+  if (db.schema.channels.size() > static_cast<size_t>(kMaxDebugChannels)) {
+    return Error{"controller: the schema has more than " + std::to_string(kMaxDebugChannels) +
+                 " channels"};
+  }
+
+  // Legs: upper leg, lower leg, foot, toe (the toe may be missing: then the foot is held).
+  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
+  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  for (int side = 0; side < 2; ++side) {
+    const int foot = feet[side];
+    const int knee = db.skeleton.parent(foot);
+    const int hip = knee >= 0 ? db.skeleton.parent(knee) : -1;
+    if (hip <= 0) {
+      return Error{"controller: the foot '" + db.skeleton.name(foot) +
+                   "' does not hang from a two-bone leg"};
+    }
+    const int toe = toes[side] >= 0 && db.skeleton.parent(toes[side]) == foot ? toes[side] : -1;
+    c.leg_joints_[side] = {hip, knee, foot, toe};
+  }
+
+  for (int j = 1; j < joints; ++j) {
+    if (db.skeleton.parent(j) == 0 && db.skeleton.subtree_size(j) > 1 && j != db.roles.hips) {
+      c.folded_joints_.push_back(j);
+    }
+  }
+  const size_t n = static_cast<size_t>(joints);
+  c.offsets_.resize(joints);
+  for (auto* v : {&c.sampled_, &c.other_, &c.locals_, &c.globals_, &c.inverse_bind_}) v->resize(n);
+  for (auto* v : {&c.sampled_velocities_, &c.sampled_angular_velocities_, &c.other_velocities_,
+                  &c.other_angular_velocities_, &c.displayed_velocities_,
+                  &c.displayed_angular_velocities_}) {
+    v->assign(n, glm::vec3(0.0f));
+  }
+  c.skinning_.assign(n, glm::mat4(1.0f));
+  c.query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
+  std::vector<Transform> bind(n);
+  forward_kinematics(db.skeleton.parents(), db.skeleton.rest(), bind);
+  inverse_bind_transforms(bind, c.inverse_bind_);
+  c.debug_.channel_count = static_cast<int>(db.schema.channels.size());
+  c.debug_.trajectory_count = static_cast<int>(c.trajectory_times_.size());
+  std::copy(c.trajectory_times_.begin(), c.trajectory_times_.end(), c.debug_.trajectory_times);
+
+  // Start on the idle clip when there is one, else on the first candidate.
+  const std::span<const uint8_t> candidates = c.shared_->candidates();
+  int start = -1;
+  for (const ClipRange& clip : db.clips) {
+    if (!(clip.tags & c.shared_->idle_tags())) continue;
+    for (int f = clip.start; f < clip.end && start < 0; ++f) {
+      if (candidates[static_cast<size_t>(f)]) start = f;
+    }
+  }
+  if (start < 0) start = static_cast<int>(std::find(candidates.begin(), candidates.end(), 1) -
+                                          candidates.begin());
+  c.teleport(glm::vec3(0.0f), 0.0f);
+  c.transition_to(start);
+  c.offsets_.clear();
+  std::copy(c.sampled_.begin(), c.sampled_.end(), c.locals_.begin());
+  std::copy(c.sampled_velocities_.begin(), c.sampled_velocities_.end(),
+            c.displayed_velocities_.begin());
+  c.predict();
+  c.finish_pose();
+  c.foot_lock(0.0f);
+  mm::skinning_matrices(c.globals_, c.inverse_bind_, c.skinning_);
+  return c;
+}
+
+Status Controller::set_settings(const ControllerSettings& settings) {
+  if (Status s = settings.validate(); !s) return s;
+  Result<const Searcher*> searcher = shared_->searcher(settings.search_method);
+  if (!searcher) return Error{"controller: " + searcher.message()};
+  searcher_ = *searcher;
+  settings_ = settings;
+  const ControllerDatabase::Speeds& measured = shared_->speeds();
+  auto pick = [](float setting, float fallback) { return setting > 0.0f ? setting : fallback; };
+  speeds_.walk_forward = pick(settings.walk_speed_forward, measured.walk_forward);
+  speeds_.walk_sideways = pick(settings.walk_speed_sideways, measured.walk_sideways);
+  speeds_.walk_backward = pick(settings.walk_speed_backward, measured.walk_backward);
+  speeds_.run_forward = pick(settings.run_speed_forward, measured.run_forward);
+  speeds_.run_sideways = pick(settings.run_speed_sideways, measured.run_sideways);
+  speeds_.run_backward = pick(settings.run_speed_backward, measured.run_backward);
+  force_search_ = true;
+  return Status::success();
+}
+
+void Controller::teleport(const glm::vec3& position, float yaw) {
+  const glm::vec3 ground(position.x, 0.0f, position.z);
+  const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
+  sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
+  sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
+  sim_rotation_ = desired_rotation_ = rotation;
+  desired_velocity_ = glm::vec3(0.0f);
+  offsets_.clear();
+  for (FootLock& f : feet_) f = FootLock{};
+  if (clip_ >= 0) {
+    sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
+    move_root(sim_position_, rotation);
+    predict();
+    finish_pose();
+  } else {
+    transition_src_position_ = sim_position_;
+    transition_src_rotation_ = rotation;
+  }
+  force_search_ = true;
+}
+
+// ---- Update ----------------------------------------------------------------------------------
+
+void Controller::update(float dt, const ControllerInput& input) {
+  if (!(dt > 0.0f) || !std::isfinite(dt)) return;
+  dt = std::min(dt, settings_.max_dt);
+  debug_.searched = debug_.transitioned = false;
+  debug_.search_seconds = 0.0f;
+
+  desired_motion(input);
+  search_timer_ += dt;
+  if (should_search(input)) search(input);
+  advance_playback(dt);
+  sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
+  inertialize_update(offsets_,
+                     {sampled_, sampled_velocities_, sampled_angular_velocities_},
+                     settings_.inertialization_halflife, dt, locals_, displayed_velocities_,
+                     displayed_angular_velocities_);
+  simulate(dt);
+  synchronize(dt);
+  predict();
+  finish_pose();
+  foot_lock(dt);
+  if (settings_.compute_skinning) mm::skinning_matrices(globals_, inverse_bind_, skinning_);
+}
+
+// The stick, relative to the camera, becomes a desired velocity (with separate forward,
+// sideways and backward speeds in the desired facing's frame) and a desired facing.
+void Controller::desired_motion(const ControllerInput& input) {
+  const glm::vec2 move = sanitize_stick(input.left_stick, settings_.stick_deadzone);
+  const glm::vec2 face = sanitize_stick(input.right_stick, settings_.stick_deadzone);
+  const float yaw = std::isfinite(input.camera_yaw) ? wrap_angle(input.camera_yaw) : 0.0f;
+  const glm::quat camera = yaw_rotation(yaw);
+  const glm::vec3 move_world = stick_to_world(move, camera);
+
+  if (input.strafe) {
+    if (glm::length(face) > 0.0f) {
+      const glm::vec3 d = stick_to_world(face, camera);
+      desired_rotation_ = yaw_rotation(std::atan2(d.x, d.z));
+    }
+  } else if (glm::length(move) > 0.0f) {
+    desired_rotation_ = yaw_rotation(std::atan2(move_world.x, move_world.z));
+  }
+
+  const glm::vec3 local = glm::conjugate(desired_rotation_) * move_world;
+  const bool run = input.run;
+  const float forward = run ? speeds_.run_forward : speeds_.walk_forward;
+  const float sideways = run ? speeds_.run_sideways : speeds_.walk_sideways;
+  const float backward = run ? speeds_.run_backward : speeds_.walk_backward;
+  const glm::vec3 scaled(local.x * sideways, 0.0f, local.z * (local.z > 0.0f ? forward : backward));
+  desired_velocity_ = desired_rotation_ * scaled;
+
+  tag_bits_ = resolve_tag(input.tag);
+  const bool released = glm::length(move) == 0.0f;
+  stopping_ = released && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
+              glm::length(sim_velocity_) < settings_.stop_speed;
+  debug_.desired_velocity = desired_velocity_;
+  debug_.desired_rotation = desired_rotation_;
+  debug_.standing = released;
+}
+
+uint64_t Controller::resolve_tag(std::string_view tag) const {
+  if (tag.empty()) return 0;
+  uint64_t bits = 0;
+  for (size_t i = 0; i < db_->tag_names.size(); ++i) {
+    const std::string& name = db_->tag_names[i];
+    const bool word = name.size() > tag.size() && name.compare(0, tag.size(), tag) == 0 &&
+                      name[tag.size()] == '-';
+    if (name == tag || word) bits |= uint64_t{1} << i;
+  }
+  return bits;
+}
+
+bool Controller::should_search(const ControllerInput&) const {
+  if (force_search_ || search_timer_ >= settings_.search_interval) return true;
+  if (tag_bits_ != tag_bits_at_search_ || stopping_ != stopping_at_search_) return true;
+  if (glm::length(desired_velocity_ - desired_velocity_at_search_) >
+      settings_.replan_velocity_change) {
+    return true;
+  }
+  if (quat_angle_between(desired_rotation_, desired_rotation_at_search_) >
+      settings_.replan_facing_change) {
+    return true;
+  }
+  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
+  const float remaining = static_cast<float>(clip.frame_count() - 1) * db_->frame_time - clip_time_;
+  return remaining < settings_.clip_end_lookahead;
+}
+
+// The query: the playing frame's own pose features (interpolated between its two frames), with
+// the trajectory columns replaced by the simulation object's predicted trajectory, expressed in
+// the displayed character root's frame and normalized like the database.
+void Controller::build_query() {
+  const Database& db = *db_;
+  const size_t dims = static_cast<size_t>(db.feature_dims());
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const float x = clip_time_ / db.frame_time;
+  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
+  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
+  const float* r0 = db.features.data() + static_cast<size_t>(clip.start + i0) * dims;
+  const float* r1 = db.features.data() + static_cast<size_t>(clip.start + i1) * dims;
+  for (size_t c = 0; c < dims; ++c) query_[c] = r0[c] + a * (r1[c] - r0[c]);
+
+  const Transform& root = globals_[0];
+  const glm::quat inverse = glm::conjugate(root.rotation);
+  for (const TrajectoryColumn& t : trajectory_columns_) {
+    glm::vec3 v;
+    if (t.direction) {
+      v = inverse * (debug_.predicted_rotations[t.time_index] * kForward);
+    } else {
+      v = inverse * (debug_.predicted_positions[t.time_index] - root.translation);
+    }
+    const size_t c = static_cast<size_t>(t.column);
+    query_[c] = (v.x - db.feature_offset[c]) / db.feature_scale[c];
+    query_[c + 1] = (v.z - db.feature_offset[c + 1]) / db.feature_scale[c + 1];
+  }
+}
+
+void Controller::search(const ControllerInput&) {
+  const auto start = std::chrono::steady_clock::now();
+  build_query();
+  const Database& db = *db_;
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const int frame = std::clamp(clip.start + static_cast<int>(std::floor(clip_time_ / db.frame_time)),
+                               clip.start, clip.end - 1);
+  SearchConstraints constraints;
+  constraints.current_frame = frame;
+  constraints.window_frames = static_cast<int>(std::lround(settings_.ignore_window / db.frame_time));
+  constraints.transition_cost = settings_.transition_cost;
+
+  SearchResult best;
+  if (tag_bits_ != 0) {
+    // Any of the requested tags will do: one search per tag, the cheapest wins.
+    for (int bit = 0; bit < 64; ++bit) {
+      if (!(tag_bits_ & (uint64_t{1} << bit))) continue;
+      constraints.include_tags = uint64_t{1} << bit;
+      const SearchResult r = searcher_->search(query_, constraints);
+      if (r.frame >= 0 && (r.cost < best.cost || (r.cost == best.cost && r.continuation))) best = r;
+    }
+  } else if (stopping_) {
+    constraints.include_tags = shared_->idle_tags();
+    best = searcher_->search(query_, constraints);
+  } else {
+    constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
+    best = searcher_->search(query_, constraints);
+  }
+
+  if (best.frame >= 0 && !best.continuation) transition_to(best.frame);
+
+  force_search_ = false;
+  search_timer_ = 0.0f;
+  desired_velocity_at_search_ = desired_velocity_;
+  desired_rotation_at_search_ = desired_rotation_;
+  tag_bits_at_search_ = tag_bits_;
+  stopping_at_search_ = stopping_;
+
+  ++debug_.searches;
+  debug_.searched = true;
+  debug_.last_best_frame = best.frame;
+  debug_.last_cost = best.cost;
+  const int shown = std::min(static_cast<int>(query_.size()), ControllerDebug::kMaxQueryDims);
+  debug_.query_dims = shown;
+  std::copy(query_.begin(), query_.begin() + shown, debug_.last_query);
+  if (best.frame >= 0) {
+    const float* row = db.features.data() + static_cast<size_t>(best.frame) * query_.size();
+    for (size_t ch = 0; ch < db.schema.channels.size(); ++ch) {
+      const int first = db.schema.offset(static_cast<int>(ch));
+      const int count = db.schema.channels[ch].dims();
+      float sum = 0.0f;
+      for (int k = first; k < first + count; ++k) {
+        const float d = query_[static_cast<size_t>(k)] - row[k];
+        sum += d * d;
+      }
+      debug_.last_channel_costs[ch] = sum;
+    }
+  }
+  debug_.search_seconds = std::chrono::duration<float>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Jumps to a database frame. The outgoing pose is what plays now (sampled_); the incoming one is
+// the new frame, its root mapped so that it starts exactly where the outgoing root is (the new
+// transition source) with the database root of the new frame as the destination.
+void Controller::transition_to(int frame) {
+  const Database& db = *db_;
+  const int clip = db.frame_clip[static_cast<size_t>(frame)];
+  const ClipRange& range = db.clips[static_cast<size_t>(clip)];
+  const bool had_clip = clip_ >= 0;
+  if (had_clip) {
+    transition_src_position_ = sampled_[0].translation;
+    transition_src_rotation_ = sampled_[0].rotation;
+  }
+  const size_t k = static_cast<size_t>(frame) * static_cast<size_t>(db.joint_count());
+  transition_dst_position_ = db.local_positions[k];
+  transition_dst_rotation_ = db.local_rotations[k];
+  clip_ = clip;
+  clip_time_ = static_cast<float>(frame - range.start) * db.frame_time;
+  sample_playback(other_, other_velocities_, other_angular_velocities_);
+  if (had_clip) {
+    inertialize_transition(offsets_, {sampled_, sampled_velocities_, sampled_angular_velocities_},
+                           {other_, other_velocities_, other_angular_velocities_});
+    ++debug_.transitions;
+    debug_.transitioned = true;
+  }
+  std::swap(sampled_, other_);
+  std::swap(sampled_velocities_, other_velocities_);
+  std::swap(sampled_angular_velocities_, other_angular_velocities_);
+}
+
+void Controller::advance_playback(float dt) {
+  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
+  const float end = static_cast<float>(clip.frame_count() - 1) * db_->frame_time;
+  clip_time_ = std::min(clip_time_ + dt, end);
+  if (clip_time_ >= end) force_search_ = true;
+}
+
+// The playing clip at clip_time_, interpolated between its two nearest frames, with the root
+// (joint 0) mapped into the world through the transition source and destination:
+//   root = source * inverse(destination) * database root.
+void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
+                                 std::span<glm::vec3> angular_velocities) const {
+  const Database& db = *db_;
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const float x = clip_time_ / db.frame_time;
+  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
+  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const size_t k0 = static_cast<size_t>(clip.start + i0) * joints;
+  const size_t k1 = static_cast<size_t>(clip.start + i1) * joints;
+  for (size_t j = 0; j < joints; ++j) {
+    Transform t0, t1;
+    t0.rotation = db.local_rotations[k0 + j];
+    t0.translation = db.local_positions[k0 + j];
+    t1.rotation = db.local_rotations[k1 + j];
+    t1.translation = db.local_positions[k1 + j];
+    local[j] = interpolate(t0, t1, a, settings_.interpolation);
+    velocities[j] = glm::mix(db.local_velocities[k0 + j], db.local_velocities[k1 + j], a);
+    angular_velocities[j] =
+        glm::mix(db.local_angular_velocities[k0 + j], db.local_angular_velocities[k1 + j], a);
+  }
+  // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
+  // their children so that every joint below the root is relative to the character: their
+  // locals relative to the simulation root differ between takes by whole metres, and offsets
+  // between such values would swing the body around during a transition.
+  for (const int j : folded_joints_) {
+    const Transform folded = local[static_cast<size_t>(j)];
+    const glm::vec3 v = velocities[static_cast<size_t>(j)];
+    const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
+    const int end = j + db.skeleton.subtree_size(j);
+    for (int c = j + 1; c < end; ++c) {
+      if (db.skeleton.parent(c) != j) continue;
+      const size_t k = static_cast<size_t>(c);
+      const glm::vec3 offset = folded.rotation * local[k].translation;
+      velocities[k] = v + glm::cross(w, offset) + folded.rotation * velocities[k];
+      angular_velocities[k] = w + folded.rotation * angular_velocities[k];
+      local[k] = compose(folded, local[k]);
+    }
+    local[static_cast<size_t>(j)] = Transform{};
+    velocities[static_cast<size_t>(j)] = angular_velocities[static_cast<size_t>(j)] = glm::vec3(0.0f);
+  }
+  const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
+  local[0].translation = map * (local[0].translation - transition_dst_position_) +
+                         transition_src_position_;
+  local[0].rotation = glm::normalize(map * local[0].rotation);
+  velocities[0] = map * velocities[0];
+  angular_velocities[0] = map * angular_velocities[0];
+}
+
+void Controller::simulate(float dt) {
+  spring_character_update(sim_position_, sim_velocity_, sim_acceleration_, desired_velocity_,
+                          settings_.simulation_velocity_halflife, dt);
+  critical_spring_update(sim_rotation_, sim_angular_velocity_, desired_rotation_,
+                         settings_.simulation_rotation_halflife, dt);
+  sim_position_.y = 0.0f;
+}
+
+void Controller::predict() {
+  const size_t n = trajectory_times_.size();
+  std::span<glm::vec3> positions(debug_.predicted_positions, n);
+  std::span<glm::quat> rotations(debug_.predicted_rotations, n);
+  spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
+                           desired_velocity_, settings_.simulation_velocity_halflife,
+                           trajectory_times_);
+  critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_, desired_rotation_,
+                          settings_.simulation_rotation_halflife, trajectory_times_);
+  for (size_t i = 0; i < n; ++i) {
+    debug_.desired_positions[i] = sim_position_ + desired_velocity_ * std::max(0.0f, trajectory_times_[i]);
+  }
+  debug_.simulation_position = sim_position_;
+  debug_.simulation_velocity = sim_velocity_;
+  debug_.simulation_acceleration = sim_acceleration_;
+  debug_.simulation_rotation = sim_rotation_;
+  debug_.simulation_angular_velocity = sim_angular_velocity_;
+}
+
+// Keeps the character and the simulation object together (see SyncMode).
+void Controller::synchronize(float dt) {
+  const Transform root = locals_[0];
+  switch (settings_.sync_mode) {
+    case SyncMode::None:
+      return;
+    case SyncMode::SimulationFollowsCharacter:
+      sim_position_ = glm::vec3(root.translation.x, 0.0f, root.translation.z);
+      sim_rotation_ = yaw_rotation(yaw_of(root.rotation));
+      return;
+    case SyncMode::CharacterFollowsSimulation:
+      break;
+  }
+  // Pull the character toward the simulation, no faster than a share of its own motion.
+  const glm::vec3 velocity = displayed_velocities_[0];
+  const float speed = std::sqrt(velocity.x * velocity.x + velocity.z * velocity.z);
+  const float turn_rate = std::abs(displayed_angular_velocities_[0].y);
+  const float fraction = pull_fraction(settings_.adjustment_halflife, dt);
+
+  glm::vec3 error = sim_position_ - root.translation;
+  error.y = 0.0f;
+  glm::vec3 step = error * fraction;
+  const float max_step = settings_.adjustment_max_velocity_ratio * speed * dt;
+  if (glm::length(step) > max_step) step *= max_step / glm::length(step);
+  glm::vec3 position = root.translation + step;
+
+  const float root_yaw = yaw_of(root.rotation);
+  float angle = wrap_angle(yaw_of(sim_rotation_) - root_yaw) * fraction;
+  const float max_angle = settings_.adjustment_max_velocity_ratio * turn_rate * dt;
+  angle = std::clamp(angle, -max_angle, max_angle);
+  float yaw = root_yaw + angle;
+
+  // Never farther than the clamping limits.
+  glm::vec3 away = position - sim_position_;
+  away.y = 0.0f;
+  const float distance = glm::length(away);
+  if (distance > settings_.clamp_max_distance) {
+    position = sim_position_ + away * (settings_.clamp_max_distance / distance);
+  }
+  const float yaw_error = wrap_angle(yaw - yaw_of(sim_rotation_));
+  if (std::abs(yaw_error) > settings_.clamp_max_angle) {
+    yaw = yaw_of(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
+  }
+  position.y = root.translation.y;
+  if (position == root.translation && yaw == root_yaw) return;
+  // Only the yaw changes: the root's rotation is about +Y in this data, and a pure yaw delta
+  // keeps any tilt it might have.
+  const glm::quat delta = yaw_rotation(wrap_angle(yaw - root_yaw));
+  move_root(position, glm::normalize(delta * root.rotation));
+}
+
+void Controller::adjust_root(const glm::vec3& position, const glm::quat& rotation) {
+  if (!finite(position) || !finite(rotation) || clip_ < 0) return;
+  move_root(position, glm::normalize(rotation));
+  // The feet go with the body: held toes would otherwise pull the legs back.
+  for (FootLock& f : feet_) f = FootLock{};
+  finish_pose();
+  foot_lock(0.0f);
+  if (settings_.compute_skinning) mm::skinning_matrices(globals_, inverse_bind_, skinning_);
+}
+
+void Controller::move_root(const glm::vec3& position, const glm::quat& rotation) {
+  // The displayed root is the playing root plus the inertialization offsets; find the playing
+  // root that displays as requested.
+  const glm::quat offset = quat_from_scaled_angle_axis(offsets_.rotations[0]);
+  const glm::vec3 played_position = position - offsets_.positions[0];
+  const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
+  // The database root relative to the destination: M = inverse(destination) * root(t).
+  const Database& db = *db_;
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const float x = clip_time_ / db.frame_time;
+  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
+  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  Transform t0, t1;
+  t0.rotation = db.local_rotations[static_cast<size_t>(clip.start + i0) * joints];
+  t0.translation = db.local_positions[static_cast<size_t>(clip.start + i0) * joints];
+  t1.rotation = db.local_rotations[static_cast<size_t>(clip.start + i1) * joints];
+  t1.translation = db.local_positions[static_cast<size_t>(clip.start + i1) * joints];
+  const Transform root = interpolate(t0, t1, a, settings_.interpolation);
+  const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
+  const glm::quat relative_rotation = inverse_destination * root.rotation;
+  const glm::vec3 relative_position = inverse_destination * (root.translation - transition_dst_position_);
+  // The new source: the destination's rotation mapped onto the requested one, then the source
+  // position recomputed from it so that the mapped root lands exactly on the request.
+  const glm::quat old_map = transition_src_rotation_ * inverse_destination;
+  transition_src_rotation_ = glm::normalize(played_rotation * glm::conjugate(relative_rotation));
+  transition_src_position_ = played_position - transition_src_rotation_ * relative_position;
+  const glm::quat new_map = transition_src_rotation_ * inverse_destination;
+  const glm::quat turn = new_map * glm::conjugate(old_map);
+
+  sampled_[0].translation = played_position;
+  sampled_[0].rotation = played_rotation;
+  sampled_velocities_[0] = turn * sampled_velocities_[0];
+  sampled_angular_velocities_[0] = turn * sampled_angular_velocities_[0];
+  locals_[0].translation = position;
+  locals_[0].rotation = glm::normalize(rotation);
+  displayed_velocities_[0] = turn * displayed_velocities_[0];
+}
+
+void Controller::finish_pose() {
+  forward_kinematics(db_->skeleton.parents(), locals_, globals_);
+  const Database& db = *db_;
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const int frame = std::clamp(clip.start + static_cast<int>(std::lround(clip_time_ / db.frame_time)),
+                               clip.start, clip.end - 1);
+  debug_.clip = clip_;
+  debug_.frame = frame;
+  debug_.clip_time = clip_time_;
+  debug_.contact[0] = db.contacts[static_cast<size_t>(frame) * 2] != 0;
+  debug_.contact[1] = db.contacts[static_cast<size_t>(frame) * 2 + 1] != 0;
+}
+
+// Foot locking. A foot whose playing frame says "contact" keeps its toe where it was when the
+// contact began; the leg reaches it by two-bone IK (hip, knee, ankle; the foot keeps its
+// animated global rotation, so the ankle goes where that rotation puts it above the held toe),
+// then distance-constraint relaxation restores the leg's bone lengths should the solve have been
+// clamped. A lock ends when the contact ends or the animation drags the toe beyond the unlock
+// radius; the foot then eases back onto the animation through a decaying offset.
+void Controller::foot_lock(float dt) {
+  const std::span<const int> parents = db_->skeleton.parents();
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<int>& leg = leg_joints_[side];
+    const int hip = leg[0], knee = leg[1], foot = leg[2], toe = leg[3];
+    const int effector = toe >= 0 ? toe : foot;
+    const glm::vec3 animated = globals_[static_cast<size_t>(effector)].translation;
+    FootLock& f = feet_[side];
+    const bool contact = debug_.contact[side];
+    if (!settings_.ik_enabled || !settings_.foot_lock_enabled) {
+      f = FootLock{};
+      debug_.locked[side] = false;
+      debug_.lock_position[side] = debug_.ik_target[side] = animated;
+      continue;
+    }
+    // A lock starts with a contact, or once a foot released during one (dragged away) has
+    // eased back onto the animation.
+    if (contact && !f.locked && (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
+      f.locked = true;
+      f.position = animated + f.offset;
+      f.offset = f.offset_velocity = glm::vec3(0.0f);
+    }
+    f.previous_contact = contact;
+    if (f.locked) {
+      glm::vec3 drag = animated - f.position;
+      drag.y = 0.0f;
+      if (!contact || glm::length(drag) > settings_.foot_unlock_radius) {
+        f.locked = false;
+        f.offset = f.position - animated;
+        f.offset_velocity = glm::vec3(0.0f);
+      }
+    }
+    if (!f.locked) {
+      critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
+                             settings_.foot_lock_release_halflife, dt);
+    }
+    const glm::vec3 target = f.locked ? f.position : animated + f.offset;
+    debug_.locked[side] = f.locked;
+    debug_.lock_position[side] = f.position;
+    debug_.ik_target[side] = target;
+    if (glm::length(target - animated) < 1e-5f) continue;
+
+    // Reach: the ankle goes where the animated foot rotation puts it above the target toe.
+    const glm::quat foot_rotation = globals_[static_cast<size_t>(foot)].rotation;
+    const glm::vec3 ankle_target =
+        target - (animated - globals_[static_cast<size_t>(foot)].translation);
+    const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
+                           0.5f * (globals_[static_cast<size_t>(hip)].translation +
+                                   globals_[static_cast<size_t>(foot)].translation);
+    apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target,
+                      glm::length(pole) > 1e-6f ? pole : foot_rotation * kForward);
+    locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
+        glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
+    restore_leg_lengths(side, target);
+  }
+}
+
+// Distance-constraint relaxation over the leg's joints (hip pinned, the held toe pinned), then
+// each bone turned to point at its relaxed child. After an exact two-bone solve the constraints
+// already hold and nothing moves; when the solve was clamped at full reach the knee and ankle
+// share the shortfall instead of the toe leaving the ground target alone.
+void Controller::restore_leg_lengths(int side, const glm::vec3& target) {
+  const std::vector<int>& leg = leg_joints_[side];
+  const int count = leg[3] >= 0 ? 4 : 3;
+  const std::span<const int> parents = db_->skeleton.parents();
+  glm::vec3 points[4];
+  DistanceConstraint constraints[3];
+  for (int i = 0; i < count; ++i) points[i] = globals_[static_cast<size_t>(leg[i])].translation;
+  for (int i = 0; i + 1 < count; ++i) {
+    const float rest = glm::length(db_->skeleton.rest(leg[i + 1]).translation);
+    constraints[i] = {i, i + 1, rest, i == 0 ? 0.0f : 1.0f, 1.0f};
+  }
+  const float before = max_distance_constraint_error({points, static_cast<size_t>(count)},
+                                                     {constraints, static_cast<size_t>(count - 1)});
+  if (before < 1e-4f || settings_.bone_length_iterations == 0) return;
+  (void)target;
+  relax_distance_constraints({points, static_cast<size_t>(count)},
+                             {constraints, static_cast<size_t>(count - 1)},
+                             settings_.bone_length_iterations);
+  // Turn each bone of the chain toward its child's relaxed position, parents first.
+  for (int i = 0; i + 1 < count; ++i) {
+    const size_t joint = static_cast<size_t>(leg[i]);
+    const size_t child = static_cast<size_t>(leg[i + 1]);
+    const glm::vec3 from = globals_[child].translation - globals_[joint].translation;
+    const glm::vec3 to = points[i + 1] - globals_[joint].translation;
+    const glm::quat swing = quat_between(from, to);
+    const glm::quat global = glm::normalize(swing * globals_[joint].rotation);
+    const int parent = parents[joint];
+    const glm::quat parent_rotation = parent >= 0 ? globals_[static_cast<size_t>(parent)].rotation
+                                                  : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    locals_[joint].rotation = glm::normalize(glm::conjugate(parent_rotation) * global);
+    const int end = leg[i] + db_->skeleton.subtree_size(leg[i]);
+    for (int j = leg[i]; j < end; ++j) {
+      const int p = parents[static_cast<size_t>(j)];
+      globals_[static_cast<size_t>(j)] =
+          p < 0 ? locals_[static_cast<size_t>(j)]
+                : compose(globals_[static_cast<size_t>(p)], locals_[static_cast<size_t>(j)]);
+    }
+  }
+}
+
+}  // namespace mm

@@ -1,0 +1,136 @@
+// ControllerDatabase: what every controller of one database shares (candidates, searchers,
+// measured speeds, tag bits), made once, read-only afterwards.
+
+#include <algorithm>
+#include <cmath>
+
+#include "mm/controller/controller.hpp"
+
+namespace mm {
+
+namespace {
+
+// Bit mask of one tag name, 0 when the database does not have it.
+uint64_t tag_bit(const Database& db, std::string_view name) {
+  for (size_t i = 0; i < db.tag_names.size(); ++i) {
+    if (db.tag_names[i] == name) return uint64_t{1} << i;
+  }
+  return 0;
+}
+
+float median(std::vector<float>& values) {
+  if (values.empty()) return 0.0f;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// Root speeds of the locomotion frames, split by gait and by direction of travel relative to
+// the facing. A direction with too few frames (the Bandai data has no side steps and almost
+// no backward walking) takes a fraction of the forward speed.
+ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_tags) {
+  const uint64_t run_tags = tag_bit(db, "run") | tag_bit(db, "dash");
+  const int joints = db.joint_count();
+  // Samples: [gait][direction], gait 0 walk, 1 run; direction 0 forward, 1 sideways, 2 backward.
+  std::vector<float> samples[2][3];
+  for (const ClipRange& clip : db.clips) {
+    if (clip.tags & excluded_tags) continue;
+    const bool tagged_run = (clip.tags & run_tags) != 0;
+    for (int f = clip.start; f < clip.end; ++f) {
+      const size_t k = static_cast<size_t>(f) * static_cast<size_t>(joints);
+      const glm::vec3 v = db.local_velocities[k];
+      const float speed = std::sqrt(v.x * v.x + v.z * v.z);
+      if (speed < 0.3f) continue;
+      const glm::vec3 local = glm::conjugate(db.local_rotations[k]) * v;
+      const float angle = std::abs(std::atan2(local.x, local.z));
+      const int gait = run_tags ? (tagged_run ? 1 : 0) : (speed > 2.5f ? 1 : 0);
+      int direction = -1;
+      if (angle < glm::radians(30.0f)) {
+        direction = 0;
+      } else if (angle > glm::radians(60.0f) && angle < glm::radians(120.0f)) {
+        direction = 1;
+      } else if (angle > glm::radians(150.0f)) {
+        direction = 2;
+      }
+      if (direction >= 0) samples[gait][direction].push_back(speed);
+    }
+  }
+  // Fewer samples than this (one second of data at 30 Hz) do not make a speed.
+  const size_t kMinSamples = 30;
+  auto speed_or = [&](int gait, int direction, float fallback) {
+    std::vector<float>& s = samples[gait][direction];
+    return s.size() >= kMinSamples ? median(s) : fallback;
+  };
+  ControllerDatabase::Speeds speeds;
+  speeds.walk_forward = speed_or(0, 0, speeds.walk_forward);
+  speeds.run_forward = speed_or(1, 0, std::max(speeds.run_forward, 2.0f * speeds.walk_forward));
+  speeds.walk_sideways = speed_or(0, 1, 0.75f * speeds.walk_forward);
+  speeds.walk_backward = speed_or(0, 2, 0.65f * speeds.walk_forward);
+  speeds.run_sideways = speed_or(1, 1, 0.75f * speeds.run_forward);
+  speeds.run_backward = speed_or(1, 2, 0.65f * speeds.run_forward);
+  return speeds;
+}
+
+}  // namespace
+
+Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
+    std::shared_ptr<const Database> database, const ControllerDatabaseOptions& options) {
+  if (!database) return Error{"controller database: no database given"};
+  const Database& db = *database;
+  if (Status s = db.validate(); !s) return Error{"controller database: " + s.message()};
+  if (db.roles.hips < 0 || db.roles.left_foot < 0 || db.roles.right_foot < 0) {
+    return Error{"controller database: the database has no hips or feet joint roles"};
+  }
+  bool has_trajectory = false;
+  for (const FeatureChannel& c : db.schema.channels) {
+    has_trajectory |= c.kind == FeatureKind::TrajectoryPosition ||
+                      c.kind == FeatureKind::TrajectoryDirection;
+  }
+  if (!has_trajectory) {
+    return Error{
+        "controller database: the feature schema has no trajectory channel, so the stick "
+        "could not steer the search"};
+  }
+  if (!std::isfinite(options.clip_end_exclusion) || options.clip_end_exclusion < 0.0f) {
+    return Error{"controller database: clip_end_exclusion must be >= 0 seconds"};
+  }
+
+  std::shared_ptr<ControllerDatabase> out(new ControllerDatabase());
+  out->database_ = std::move(database);
+  out->options_ = options;
+  out->action_tags_ = tag_bit(db, "action");
+  out->idle_tags_ = tag_bit(db, "idle");
+
+  const int excluded = static_cast<int>(std::lround(options.clip_end_exclusion / db.frame_time));
+  out->candidates_.assign(db.searchable.begin(), db.searchable.end());
+  for (const ClipRange& clip : db.clips) {
+    // The idle clip is one held pose: its end is as good as its start.
+    if (clip.tags & out->idle_tags_) continue;
+    for (int f = std::max(clip.start, clip.end - excluded); f < clip.end; ++f) {
+      out->candidates_[static_cast<size_t>(f)] = 0;
+    }
+  }
+  if (std::find(out->candidates_.begin(), out->candidates_.end(), uint8_t{1}) ==
+      out->candidates_.end()) {
+    return Error{
+        "controller database: no frame can be matched (every clip is shorter than the feature "
+        "times and the clip-end exclusion need)"};
+  }
+  out->speeds_ = measure_speeds(db, out->action_tags_ | out->idle_tags_);
+  return std::shared_ptr<const ControllerDatabase>(std::move(out));
+}
+
+Result<const Searcher*> ControllerDatabase::searcher(std::string_view method) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const SearcherEntry& e : searchers_) {
+    if (e.method == method) return static_cast<const Searcher*>(e.searcher.get());
+  }
+  SearchInput input = search_input(*database_);
+  input.searchable = candidates_;
+  Result<std::unique_ptr<Searcher>> made = make_searcher(method, input, options_.search);
+  if (!made) return Error{made.message()};
+  searchers_.push_back({std::string(method), std::move(made).value()});
+  return static_cast<const Searcher*>(searchers_.back().searcher.get());
+}
+
+}  // namespace mm

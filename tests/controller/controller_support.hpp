@@ -1,0 +1,42 @@
+#pragma once
+// The controller tests' shared database: the whole Bandai normal folder built with the default
+// options (the database the controller's targets are measured on), once per test program.
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "mm/controller/controller.hpp"
+#include "mm/database/builder.hpp"
+#include "test_support.hpp"
+
+namespace mm::test {
+
+inline std::shared_ptr<const ControllerDatabase> normal_controller_database() {
+  static const std::shared_ptr<const ControllerDatabase> shared = [] {
+    const std::filesystem::path inputs[] = {data_dir()};
+    Result<Database> db = build_database(inputs, BuildOptions{});
+    EXPECT_TRUE(db.ok()) << (db.ok() ? "" : db.message());
+    Result<std::shared_ptr<const ControllerDatabase>> made =
+        ControllerDatabase::create(std::make_shared<const Database>(std::move(db).value()));
+    EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.message());
+    return made.ok() ? *made : nullptr;
+  }();
+  return shared;
+}
+
+// A stick pushed fully toward world yaw `degrees` with the camera at 0 (yaw 0 is +Z, 90 is +X).
+inline ControllerInput push_toward(float degrees, bool run = false) {
+  ControllerInput input;
+  const float yaw = glm::radians(degrees);
+  // The camera at yaw 0 looks along +Z and its right is -X: stick +x is world -X.
+  input.left_stick = glm::vec2(-std::sin(yaw), std::cos(yaw));
+  input.run = run;
+  return input;
+}
+
+inline float horizontal_speed(const glm::vec3& a, const glm::vec3& b, float dt) {
+  return std::hypot(a.x - b.x, a.z - b.z) / dt;
+}
+
+}  // namespace mm::test

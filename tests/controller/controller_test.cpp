@@ -1,0 +1,314 @@
+// The controller on the real database: settings, bad input, determinism, transitions, the root
+// adjustment invariant, standing still, starting again, tags and the candidate rules.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "controller_support.hpp"
+#include "mm/controller/controller.hpp"
+
+namespace mm {
+namespace {
+
+using test::horizontal_speed;
+using test::normal_controller_database;
+using test::push_toward;
+
+constexpr float kDt = 1.0f / 60.0f;
+
+Controller make(const ControllerSettings& settings = {}) {
+  Result<Controller> c = Controller::create(normal_controller_database(), settings);
+  EXPECT_TRUE(c.ok()) << (c.ok() ? "" : c.message());
+  return std::move(c).value();
+}
+
+bool finite_pose(const Controller& c) {
+  for (const Transform& t : c.global_transforms()) {
+    const glm::vec3 p = t.translation;
+    const glm::quat q = t.rotation;
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) ||
+        !std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+float yaw_of(const glm::quat& q) {
+  const glm::vec3 f = q * glm::vec3(0.0f, 0.0f, 1.0f);
+  return std::atan2(f.x, f.z);
+}
+
+float yaw_difference(float a, float b) {
+  float d = std::fmod(a - b + glm::pi<float>(), glm::two_pi<float>());
+  if (d < 0.0f) d += glm::two_pi<float>();
+  return d - glm::pi<float>();
+}
+
+TEST(ControllerSettingsTest, EveryInvalidFieldIsNamed) {
+  ControllerSettings s;
+  EXPECT_TRUE(s.validate().ok());
+  s.inertialization_halflife = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_NE(s.validate().message().find("inertialization_halflife"), std::string::npos);
+  s = {};
+  s.search_interval = -1.0f;
+  EXPECT_NE(s.validate().message().find("search_interval must be a number in"), std::string::npos);
+  s = {};
+  s.search_method = "nonsense";
+  EXPECT_NE(s.validate().message().find("unknown search method 'nonsense'"), std::string::npos);
+  s = {};
+  s.bone_length_iterations = -1;
+  EXPECT_NE(s.validate().message().find("bone_length_iterations"), std::string::npos);
+
+  Result<Controller> bad = Controller::create(normal_controller_database(), s);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("bone_length_iterations"), std::string::npos);
+}
+
+TEST(ControllerSettingsTest, SetByName) {
+  ControllerSettings s;
+  EXPECT_TRUE(set_controller_setting(s, "inertialization_halflife", "0.25").ok());
+  EXPECT_FLOAT_EQ(s.inertialization_halflife, 0.25f);
+  EXPECT_TRUE(set_controller_setting(s, "ik_enabled", "off").ok());
+  EXPECT_FALSE(s.ik_enabled);
+  EXPECT_TRUE(set_controller_setting(s, "sync_mode", "none").ok());
+  EXPECT_EQ(s.sync_mode, SyncMode::None);
+  EXPECT_EQ(set_controller_setting(s, "inertialization_halflife", "fast").message(),
+            "setting 'inertialization_halflife': expected a number, found 'fast'");
+  EXPECT_EQ(set_controller_setting(s, "sync_mode", "both").message(),
+            "setting 'sync_mode': expected character, simulation or none, found 'both'");
+  EXPECT_EQ(set_controller_setting(s, "warp_speed", "9").message(), "unknown setting 'warp_speed'");
+}
+
+TEST(ControllerDatabaseTest, CandidatesLeaveClipEndsOutAndSpeedsComeFromTheData) {
+  const auto shared = normal_controller_database();
+  const Database& db = shared->database();
+  const int excluded = static_cast<int>(std::lround(shared->options().clip_end_exclusion / db.frame_time));
+  ASSERT_GT(excluded, 0);
+  int candidates = 0;
+  for (const ClipRange& clip : db.clips) {
+    const bool idle = (clip.tags & shared->idle_tags()) != 0;
+    for (int f = clip.start; f < clip.end; ++f) {
+      const bool candidate = shared->candidates()[static_cast<size_t>(f)] != 0;
+      candidates += candidate ? 1 : 0;
+      if (candidate) {
+        EXPECT_TRUE(db.searchable[static_cast<size_t>(f)]) << clip.name << " " << f;
+      }
+      if (!idle && f >= clip.end - excluded) {
+        EXPECT_FALSE(candidate) << clip.name << " " << f;
+      }
+    }
+  }
+  EXPECT_GT(candidates, 1000);
+  const ControllerDatabase::Speeds& s = shared->speeds();
+  // Bandai walks are about 1 m/s and runs two to three times that.
+  EXPECT_GT(s.walk_forward, 0.7f);
+  EXPECT_LT(s.walk_forward, 1.6f);
+  EXPECT_GT(s.run_forward, 1.8f * s.walk_forward);
+  EXPECT_NE(shared->action_tags(), 0u);
+}
+
+TEST(ControllerTest, BadInputNeverPoisonsTheState) {
+  Controller c = make();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  ControllerInput bad;
+  bad.left_stick = glm::vec2(nan, inf);
+  bad.right_stick = glm::vec2(-inf, nan);
+  bad.camera_yaw = nan;
+  bad.strafe = true;
+  for (int i = 0; i < 60; ++i) c.update(kDt, bad);
+  EXPECT_TRUE(finite_pose(c));
+
+  ControllerInput huge = push_toward(0.0f);
+  huge.left_stick *= 1e30f;
+  huge.camera_yaw = 1e30f;
+  for (int i = 0; i < 60; ++i) c.update(kDt, huge);
+  EXPECT_TRUE(finite_pose(c));
+  // An oversized stick is read as a full one: the desired speed is the run or walk speed.
+  EXPECT_NEAR(glm::length(c.debug().desired_velocity), c.speeds().walk_forward, 1e-3f);
+
+  // dt <= 0 or non-finite changes nothing at all.
+  const std::vector<Transform> before(c.global_transforms().begin(), c.global_transforms().end());
+  for (float dt : {0.0f, -1.0f, nan, inf, -inf}) c.update(dt, push_toward(90.0f));
+  for (size_t j = 0; j < before.size(); ++j) {
+    EXPECT_EQ(before[j].translation, c.global_transforms()[j].translation);
+    EXPECT_EQ(before[j].rotation, c.global_transforms()[j].rotation);
+  }
+
+  // A huge dt is clamped to max_dt: one such step moves no farther than max_dt at a run.
+  const glm::vec3 root = c.root_transform().translation;
+  c.update(1e6f, push_toward(0.0f, true));
+  EXPECT_TRUE(finite_pose(c));
+  EXPECT_LT(horizontal_speed(c.root_transform().translation, root, c.settings().max_dt), 10.0f);
+
+  // An unknown tag matches nothing and locomotion goes on.
+  ControllerInput tagged = push_toward(0.0f);
+  tagged.tag = "no-such-tag";
+  for (int i = 0; i < 30; ++i) c.update(kDt, tagged);
+  EXPECT_TRUE(finite_pose(c));
+}
+
+TEST(ControllerTest, SameInputSameOutputBitForBit) {
+  Controller a = make();
+  Controller b = make();
+  for (int i = 0; i < 600; ++i) {
+    ControllerInput input = push_toward(static_cast<float>((i / 90) * 70), (i / 200) % 2 == 1);
+    if (i > 450) input.left_stick = glm::vec2(0.0f);
+    a.update(kDt, input);
+    b.update(kDt, input);
+  }
+  for (size_t j = 0; j < a.global_transforms().size(); ++j) {
+    EXPECT_EQ(a.global_transforms()[j].translation, b.global_transforms()[j].translation);
+    EXPECT_EQ(a.global_transforms()[j].rotation, b.global_transforms()[j].rotation);
+  }
+  EXPECT_EQ(a.debug().transitions, b.debug().transitions);
+  EXPECT_GT(a.debug().transitions, 3);
+}
+
+// Largest per-joint displacement between two frames of global transforms.
+float largest_step(std::span<const Transform> a, std::span<const Transform> b) {
+  float step = 0.0f;
+  for (size_t j = 1; j < a.size(); ++j) {
+    step = std::max(step, glm::length(a[j].translation - b[j].translation));
+  }
+  return step;
+}
+
+// Over a run of turns: the largest joint displacement on frames with a transition, and on the
+// others.
+std::pair<float, float> transition_steps(const ControllerSettings& settings) {
+  Controller c = make(settings);
+  std::vector<Transform> previous(c.global_transforms().begin(), c.global_transforms().end());
+  float at_transitions = 0.0f, elsewhere = 0.0f;
+  int transitions = 0;
+  for (int i = 0; i < 1200; ++i) {
+    c.update(kDt, push_toward(static_cast<float>((i / 100) * 100)));
+    const float step = largest_step(c.global_transforms(), previous);
+    if (c.debug().transitioned) {
+      at_transitions = std::max(at_transitions, step);
+      ++transitions;
+    } else {
+      elsewhere = std::max(elsewhere, step);
+    }
+    previous.assign(c.global_transforms().begin(), c.global_transforms().end());
+  }
+  EXPECT_GT(transitions, 10);
+  return {at_transitions, elsewhere};
+}
+
+TEST(ControllerTest, TransitionsAreContinuous) {
+  ControllerSettings settings;
+  settings.ik_enabled = false;  // the animation alone
+  const auto [at_transitions, elsewhere] = transition_steps(settings);
+  // A transition frame moves no joint more than ordinary playback does.
+  EXPECT_LE(at_transitions, elsewhere);
+  // Without inertialization the same run pops: the test can tell.
+  settings.inertialization_halflife = 0.0f;
+  const auto [popping, ordinary] = transition_steps(settings);
+  EXPECT_GT(popping, ordinary);
+}
+
+TEST(ControllerTest, RootAdjustmentKeepsTransitionSourceAndDestinationConsistent) {
+  ControllerSettings settings;
+  settings.sync_mode = SyncMode::None;
+  settings.search_interval = 10.0f;  // no search while the invariant is checked
+  settings.ik_enabled = false;
+  Controller adjusted = make(settings);
+  for (int i = 0; i < 90; ++i) adjusted.update(kDt, push_toward(0.0f));
+  Controller twin = adjusted;
+
+  const glm::vec3 requested(3.0f, 0.0f, -2.0f);
+  const glm::quat requested_rotation = glm::angleAxis(1.0f, glm::vec3(0.0f, 1.0f, 0.0f));
+  adjusted.adjust_root(requested, requested_rotation);
+  EXPECT_LT(glm::length(adjusted.root_transform().translation - requested), 1e-5f);
+  EXPECT_LT(quat_angle_between(adjusted.root_transform().rotation, requested_rotation), 1e-4f);
+
+  // Every later frame: the adjusted root moves exactly as the twin's, turned by the adjustment.
+  const float turn = yaw_difference(yaw_of(requested_rotation), yaw_of(twin.root_transform().rotation));
+  const glm::quat turn_rotation = glm::angleAxis(turn, glm::vec3(0.0f, 1.0f, 0.0f));
+  const glm::vec3 twin_start = twin.root_transform().translation;
+  for (int i = 0; i < 20; ++i) {
+    adjusted.update(kDt, push_toward(0.0f));
+    twin.update(kDt, push_toward(0.0f));
+    ASSERT_FALSE(adjusted.debug().searched);
+    const glm::vec3 expected = requested + turn_rotation * (twin.root_transform().translation - twin_start);
+    EXPECT_LT(glm::length(adjusted.root_transform().translation - expected), 1e-4f) << i;
+    EXPECT_NEAR(yaw_difference(yaw_of(adjusted.root_transform().rotation),
+                               yaw_of(twin.root_transform().rotation)),
+                turn, 1e-4f);
+  }
+}
+
+TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
+  Controller c = make();
+  for (int i = 0; i < 180; ++i) c.update(kDt, push_toward(0.0f));
+  ASSERT_GT(glm::length(c.debug().simulation_velocity), 0.5f);
+  const Database& db = c.controller_database().database();
+  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  // Released: after about a second the root and the toes are still, and stay so.
+  ControllerInput released;
+  std::vector<Transform> previous(c.global_transforms().begin(), c.global_transforms().end());
+  for (int i = 0; i < 240; ++i) {
+    c.update(kDt, released);
+    if (i >= 75) {
+      EXPECT_LT(horizontal_speed(c.root_transform().translation, previous[0].translation, kDt), 0.02f)
+          << "frame " << i;
+      for (int toe : toes) {
+        EXPECT_LT(horizontal_speed(c.global_transforms()[static_cast<size_t>(toe)].translation,
+                                   previous[static_cast<size_t>(toe)].translation, kDt),
+                  0.02f)
+            << "frame " << i;
+      }
+    }
+    previous.assign(c.global_transforms().begin(), c.global_transforms().end());
+  }
+  EXPECT_TRUE(c.controller_database().database().clips[static_cast<size_t>(c.debug().clip)].tags &
+              c.controller_database().idle_tags());
+  // Pushed again: moving within half a second.
+  const glm::vec3 start = c.root_transform().translation;
+  for (int i = 0; i < 30; ++i) c.update(kDt, push_toward(90.0f));
+  EXPECT_GT(glm::length(c.root_transform().translation - start), 0.1f);
+}
+
+TEST(ControllerTest, TagRequestPlaysTaggedClipsThenLocomotionResumes) {
+  Controller c = make();
+  const auto shared = normal_controller_database();
+  const Database& db = shared->database();
+  uint64_t wave = 0;
+  for (size_t i = 0; i < db.tag_names.size(); ++i) {
+    if (db.tag_names[i].rfind("wave-", 0) == 0) wave |= uint64_t{1} << i;
+  }
+  ASSERT_NE(wave, 0u);
+  ControllerInput input;
+  input.tag = "wave";
+  for (int i = 0; i < 60; ++i) c.update(kDt, input);
+  EXPECT_TRUE(db.clips[static_cast<size_t>(c.debug().clip)].tags & wave)
+      << db.clips[static_cast<size_t>(c.debug().clip)].name;
+  for (int i = 0; i < 60; ++i) c.update(kDt, push_toward(0.0f));
+  EXPECT_FALSE(db.clips[static_cast<size_t>(c.debug().clip)].tags & shared->action_tags())
+      << db.clips[static_cast<size_t>(c.debug().clip)].name;
+}
+
+TEST(ControllerTest, DifferentFrameRatesTrackTheSameTrajectory) {
+  // The game's rate is not the database's: at 30, 60 and 144 Hz the character ends up near the
+  // same place after the same script.
+  glm::vec3 ends[3];
+  const float rates[3] = {30.0f, 60.0f, 144.0f};
+  for (int r = 0; r < 3; ++r) {
+    Controller c = make();
+    const float dt = 1.0f / rates[r];
+    for (int i = 0; i < static_cast<int>(4.0f * rates[r]); ++i) {
+      c.update(dt, push_toward(i * dt < 2.0f ? 0.0f : 90.0f));
+    }
+    ends[r] = c.root_transform().translation;
+    EXPECT_TRUE(finite_pose(c));
+  }
+  EXPECT_LT(glm::length(ends[0] - ends[1]), 0.35f);
+  EXPECT_LT(glm::length(ends[2] - ends[1]), 0.35f);
+}
+
+}  // namespace
+}  // namespace mm

@@ -1,0 +1,79 @@
+// update() never allocates: every operator new of this program is counted while controllers
+// walk, run, turn, strafe, stop, request tags and get bad input.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <limits>
+#include <new>
+
+#include "controller_support.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t size, std::align_val_t align) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  const std::size_t a = static_cast<std::size_t>(align);
+  if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t align) {
+  return operator new(size, align);
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+namespace mm {
+namespace {
+
+TEST(ControllerNoAllocationTest, UpdateNeverAllocates) {
+  const auto shared = test::normal_controller_database();
+  ControllerSettings settings;
+  Result<Controller> made = Controller::create(shared, settings);
+  ASSERT_TRUE(made.ok()) << made.message();
+  Controller& c = *made;
+  // The counter can see allocations at all.
+  const long probe = g_allocations.load();
+  ::operator delete(::operator new(16));
+  ASSERT_GT(g_allocations.load(), probe);
+
+  const long before = g_allocations.load();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int i = 0; i < 3000; ++i) {
+    ControllerInput input = test::push_toward(static_cast<float>((i / 120) * 75), (i / 400) % 2);
+    if ((i / 300) % 4 == 3) input.left_stick = glm::vec2(0.0f);
+    if ((i / 500) % 3 == 1) {
+      input.strafe = true;
+      input.right_stick = glm::vec2(1.0f, 0.0f);
+    }
+    if (i > 2500 && i < 2700) input.tag = "wave";
+    if (i == 1000) input.left_stick = glm::vec2(nan, nan);
+    input.camera_yaw = 0.001f * static_cast<float>(i);
+    c.update(i % 7 == 0 ? 1.0f / 30.0f : 1.0f / 60.0f, input);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(c.debug().searches, 100);
+  EXPECT_GT(c.debug().transitions, 10);
+}
+
+}  // namespace
+}  // namespace mm

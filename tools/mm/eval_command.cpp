@@ -1,0 +1,237 @@
+// `mm eval`: runs a controller on scripted input, headless, and prints its quality metrics
+// (definitions in controller/include/mm/controller/evaluation.hpp).
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "database_summary.hpp"
+#include "mm/controller/evaluation.hpp"
+#include "mm/database/database_file.hpp"
+
+namespace mm::cli {
+namespace {
+
+const char* const kUsage = R"(usage: mm eval --db FILE.mmdb --script FILE [options]
+
+Runs one character controller on a script of timed stick and button states (see
+controller/include/mm/controller/script.hpp; examples in scripts/input/), headless, at a fixed
+dt, and prints its quality metrics. Several --script options print one row per script.
+
+options:
+  --db FILE          the database (required)
+  --script FILE      the input script (required; repeatable)
+  --dt SECONDS       seconds per update (default 1/60)
+  --ik on|off        foot locking with IK (default on)
+  --set NAME=VALUE   any controller setting by its name (e.g. inertialization_halflife=0.1,
+                     sync_mode=none, search_method=kdtree); repeatable
+  --json FILE        also write the metrics as JSON (one script: the keys at the top level;
+                     several: a list under "runs")
+  --dump FILE        one CSV row per frame (one script only): t, simulation, root, desired
+                     motion, transition, contacts, then every joint's global position
+  -h, --help         this text
+
+exit status: 0 fine, 1 bad database or script, 2 bad usage
+)";
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "mm eval: %s\n\n%s", message.c_str(), kUsage);
+  return 2;
+}
+
+struct Arguments {
+  std::string db;
+  std::vector<std::string> scripts;
+  EvaluationOptions options;
+  std::string json_path;
+  std::string dump_path;
+};
+
+// Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
+int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    if (a == "--db" || a == "--script" || a == "--json" || a == "--dump") {
+      const std::string* v = value();
+      if (!v) return usage_error(a + " needs a file name");
+      if (a == "--db") out.db = *v;
+      if (a == "--script") out.scripts.push_back(*v);
+      if (a == "--json") out.json_path = *v;
+      if (a == "--dump") out.dump_path = *v;
+    } else if (a == "--dt") {
+      const std::string* v = value();
+      const std::optional<double> dt = v ? parse_number(*v) : std::nullopt;
+      if (!dt || *dt <= 0.0 || *dt > 1.0) return usage_error("--dt needs seconds in (0, 1]");
+      out.options.dt = static_cast<float>(*dt);
+    } else if (a == "--ik") {
+      const std::string* v = value();
+      if (!v || (*v != "on" && *v != "off")) return usage_error("--ik needs on or off");
+      out.options.settings.ik_enabled = *v == "on";
+    } else if (a == "--set") {
+      const std::string* v = value();
+      const size_t equals = v ? v->find('=') : std::string::npos;
+      if (equals == std::string::npos) return usage_error("--set needs NAME=VALUE");
+      if (Status s = set_controller_setting(out.options.settings, v->substr(0, equals),
+                                            v->substr(equals + 1));
+          !s) {
+        return usage_error(s.message());
+      }
+    } else {
+      return usage_error("unknown argument '" + a + "'");
+    }
+  }
+  if (out.db.empty()) return usage_error("--db is required");
+  if (out.scripts.empty()) return usage_error("--script is required");
+  if (!out.dump_path.empty() && out.scripts.size() != 1) {
+    return usage_error("--dump takes one script");
+  }
+  if (Status s = out.options.settings.validate(); !s) return usage_error(s.message());
+  return -1;
+}
+
+nlohmann::json to_json(const EvaluationMetrics& m) {
+  return {{"foot_skate_cm_s_mean", m.foot_skate_cm_s_mean},
+          {"foot_skate_cm_s_p95", m.foot_skate_cm_s_p95},
+          {"root_sim_distance_cm_mean", m.root_sim_distance_cm_mean},
+          {"root_sim_distance_cm_max", m.root_sim_distance_cm_max},
+          {"facing_error_deg_mean", m.facing_error_deg_mean},
+          {"speed_response_s", m.speed_response_s},
+          {"speed_events", m.speed_events},
+          {"speed_events_reached", m.speed_events_reached},
+          {"heading_response_s", m.heading_response_s},
+          {"heading_events", m.heading_events},
+          {"heading_events_reached", m.heading_events_reached},
+          {"stand_root_speed_cm_s_mean", m.stand_root_speed_cm_s_mean},
+          {"stand_foot_speed_cm_s_mean", m.stand_foot_speed_cm_s_mean},
+          {"stand_frames", m.stand_frames},
+          {"transitions_per_s", m.transitions_per_s},
+          {"transition_accel_ratio", m.transition_accel_ratio},
+          {"transition_accel_p99_m_s2", m.transition_accel_p99},
+          {"database_accel_p99_m_s2", m.database_accel_p99},
+          {"search_us_mean", m.search_us_mean},
+          {"update_us_mean", m.update_us_mean},
+          {"frames", m.frames},
+          {"seconds", m.seconds}};
+}
+
+void print_table_header() {
+  std::printf(
+      "%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "skate", "skate95",
+      "rootsim", "rs_max", "facing", "speed_s", "head_s", "stand_r", "stand_f", "trans/s",
+      "accel", "search", "update");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "cm/s", "cm/s",
+              "cm", "cm", "deg", "s", "s", "cm/s", "cm/s", "", "ratio", "us", "us");
+}
+
+void print_table_row(const std::string& name, const EvaluationMetrics& m) {
+  std::printf(
+      "%-22s %7.2f %7.2f %7.2f %7.2f %7.2f %7.3f %7.3f %7.2f %7.2f %7.2f %7.3f %7.2f %7.2f\n",
+      name.c_str(), m.foot_skate_cm_s_mean, m.foot_skate_cm_s_p95, m.root_sim_distance_cm_mean,
+      m.root_sim_distance_cm_max, m.facing_error_deg_mean, m.speed_response_s,
+      m.heading_response_s, m.stand_root_speed_cm_s_mean, m.stand_foot_speed_cm_s_mean,
+      m.transitions_per_s, m.transition_accel_ratio, m.search_us_mean, m.update_us_mean);
+}
+
+void print_metrics(const EvaluationMetrics& m) {
+  std::printf("foot_skate_cm_s_mean        %10.3f\n", m.foot_skate_cm_s_mean);
+  std::printf("foot_skate_cm_s_p95         %10.3f\n", m.foot_skate_cm_s_p95);
+  std::printf("root_sim_distance_cm_mean   %10.3f\n", m.root_sim_distance_cm_mean);
+  std::printf("root_sim_distance_cm_max    %10.3f\n", m.root_sim_distance_cm_max);
+  std::printf("facing_error_deg_mean       %10.3f\n", m.facing_error_deg_mean);
+  std::printf("speed_response_s            %10.3f   (%d of %d changes reached)\n",
+              m.speed_response_s, m.speed_events_reached, m.speed_events);
+  std::printf("heading_response_s          %10.3f   (%d of %d turns reached)\n",
+              m.heading_response_s, m.heading_events_reached, m.heading_events);
+  std::printf("stand_root_speed_cm_s_mean  %10.3f   (%d standing frames)\n",
+              m.stand_root_speed_cm_s_mean, m.stand_frames);
+  std::printf("stand_foot_speed_cm_s_mean  %10.3f\n", m.stand_foot_speed_cm_s_mean);
+  std::printf("transitions_per_s           %10.3f\n", m.transitions_per_s);
+  std::printf("transition_accel_ratio      %10.3f   (%.1f / %.1f m/s^2)\n",
+              m.transition_accel_ratio, m.transition_accel_p99, m.database_accel_p99);
+  std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
+  std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
+}
+
+int run_eval(const std::vector<std::string>& args) {
+  Arguments arguments;
+  if (const int code = parse_arguments(args, arguments); code >= 0) return code;
+  arguments.options.keep_frames = !arguments.dump_path.empty();
+
+  Result<Database> loaded = load_database(arguments.db);
+  if (!loaded) {
+    std::fprintf(stderr, "mm eval: %s\n", loaded.message().c_str());
+    return 1;
+  }
+  Result<std::shared_ptr<const ControllerDatabase>> shared = ControllerDatabase::create(
+      std::make_shared<const Database>(std::move(loaded).value()));
+  if (!shared) {
+    std::fprintf(stderr, "mm eval: %s\n", shared.message().c_str());
+    return 1;
+  }
+
+  const bool table = arguments.scripts.size() > 1;
+  if (table) print_table_header();
+  nlohmann::json runs = nlohmann::json::array();
+  nlohmann::json single;
+  for (const std::string& path : arguments.scripts) {
+    Result<InputScript> script = load_input_script(path);
+    if (!script) {
+      std::fprintf(stderr, "mm eval: %s\n", script.message().c_str());
+      return 1;
+    }
+    Result<EvaluationResult> result = evaluate_script(*shared, *script, arguments.options);
+    if (!result) {
+      std::fprintf(stderr, "mm eval: %s\n", result.message().c_str());
+      return 1;
+    }
+    const std::string name = std::filesystem::path(path).stem().string();
+    nlohmann::json json = to_json(result->metrics);
+    json["script"] = path;
+    json["dt"] = arguments.options.dt;
+    json["ik"] = arguments.options.settings.ik_enabled;
+    if (table) {
+      print_table_row(name, result->metrics);
+      runs.push_back(json);
+    } else {
+      std::printf("script %s, dt %.5f s, IK %s, %d frames (%.1f s)\n", path.c_str(),
+                  arguments.options.dt, arguments.options.settings.ik_enabled ? "on" : "off",
+                  result->metrics.frames, result->metrics.seconds);
+      print_metrics(result->metrics);
+      single = json;
+    }
+    if (!arguments.dump_path.empty()) {
+      std::ofstream dump(arguments.dump_path);
+      dump << result->csv_header << "\n";
+      for (const std::string& row : result->csv_rows) dump << row << "\n";
+      if (!dump) {
+        std::fprintf(stderr, "mm eval: could not write %s\n", arguments.dump_path.c_str());
+        return 1;
+      }
+    }
+  }
+  if (!arguments.json_path.empty()) {
+    std::ofstream file(arguments.json_path);
+    file << (table ? nlohmann::json{{"runs", runs}} : single).dump(2) << "\n";
+    if (!file) {
+      std::fprintf(stderr, "mm eval: could not write %s\n", arguments.json_path.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}
+
+const bool registered =
+    register_command({"eval", "scripted controller run and its quality metrics", &run_eval});
+
+}  // namespace
+}  // namespace mm::cli
