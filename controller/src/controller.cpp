@@ -67,6 +67,22 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
   return camera * glm::vec3(-stick.x, 0.0f, stick.y);
 }
 
+// Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
+// target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
+// kSoftReach of the leg's length are kept, longer ones approach the full length exponentially.
+constexpr float kSoftReach = 0.9f;
+// How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
+// line: enough to decide for a straight leg, small beside the bend of a walking knee.
+constexpr float kKneeForwardBias = 0.05f;
+glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float length) {
+  const float d = glm::length(hip_to_ankle);
+  const float soft = kSoftReach * length;
+  if (d <= soft || d < 1e-6f) return hip_to_ankle;
+  const float span = length - soft;
+  const float reached = soft + span * (1.0f - std::exp(-(d - soft) / span));
+  return hip_to_ankle * (reached / d);
+}
+
 // Fraction of the remaining distance an exponential pull with this halflife closes in dt.
 float pull_fraction(float halflife, float dt) {
   return 1.0f - std::exp2(-dt / std::max(halflife, kMinSpringHalflife));
@@ -212,17 +228,18 @@ Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> 
   }
   const size_t n = static_cast<size_t>(joints);
   c.offsets_.resize(joints);
-  for (auto* v : {&c.sampled_, &c.other_, &c.locals_, &c.globals_, &c.inverse_bind_}) v->resize(n);
+  for (auto* v : {&c.sampled_, &c.other_, &c.locals_, &c.globals_}) v->resize(n);
   for (auto* v : {&c.sampled_velocities_, &c.sampled_angular_velocities_, &c.other_velocities_,
-                  &c.other_angular_velocities_, &c.displayed_velocities_,
-                  &c.displayed_angular_velocities_}) {
+                  &c.other_angular_velocities_}) {
     v->assign(n, glm::vec3(0.0f));
   }
   c.skinning_.assign(n, glm::mat4(1.0f));
   c.query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
-  std::vector<Transform> bind(n);
+  std::vector<Transform> bind(n), inverse_bind(n);
   forward_kinematics(db.skeleton.parents(), db.skeleton.rest(), bind);
-  inverse_bind_transforms(bind, c.inverse_bind_);
+  inverse_bind_transforms(bind, inverse_bind);
+  c.inverse_bind_.resize(n);
+  for (size_t j = 0; j < n; ++j) c.inverse_bind_[j] = to_matrix(inverse_bind[j]);
   c.debug_.channel_count = static_cast<int>(db.schema.channels.size());
   c.debug_.trajectory_count = static_cast<int>(c.trajectory_times_.size());
   std::copy(c.trajectory_times_.begin(), c.trajectory_times_.end(), c.debug_.trajectory_times);
@@ -242,8 +259,7 @@ Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> 
   c.transition_to(start);
   c.offsets_.clear();
   std::copy(c.sampled_.begin(), c.sampled_.end(), c.locals_.begin());
-  std::copy(c.sampled_velocities_.begin(), c.sampled_velocities_.end(),
-            c.displayed_velocities_.begin());
+  c.displayed_velocity_ = c.sampled_velocities_[0];
   c.predict();
   c.finish_pose();
   c.foot_lock(0.0f);
@@ -305,8 +321,13 @@ void Controller::update(float dt, const ControllerInput& input) {
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
   inertialize_update(offsets_,
                      {sampled_, sampled_velocities_, sampled_angular_velocities_},
-                     settings_.inertialization_halflife, dt, locals_, displayed_velocities_,
-                     displayed_angular_velocities_);
+                     settings_.inertialization_halflife, dt, locals_, {}, {});
+  // Only the root's displayed motion is needed (by the synchronization): the playing root's
+  // plus its offsets' rates.
+  displayed_velocity_ = sampled_velocities_[0] + offsets_.velocities[0];
+  displayed_angular_velocity_ =
+      sampled_angular_velocities_[0] +
+      rotation_vector_rate_to_angular_velocity(offsets_.rotations[0], offsets_.rotation_rates[0]);
   simulate(dt);
   synchronize(dt);
   predict();
@@ -599,9 +620,9 @@ void Controller::synchronize(float dt) {
       break;
   }
   // Pull the character toward the simulation, no faster than a share of its own motion.
-  const glm::vec3 velocity = displayed_velocities_[0];
+  const glm::vec3 velocity = displayed_velocity_;
   const float speed = std::sqrt(velocity.x * velocity.x + velocity.z * velocity.z);
-  const float turn_rate = std::abs(displayed_angular_velocities_[0].y);
+  const float turn_rate = std::abs(displayed_angular_velocity_.y);
   const float fraction = pull_fraction(settings_.adjustment_halflife, dt);
 
   glm::vec3 error = sim_position_ - root.translation;
@@ -683,7 +704,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
   sampled_angular_velocities_[0] = turn * sampled_angular_velocities_[0];
   locals_[0].translation = position;
   locals_[0].rotation = glm::normalize(rotation);
-  displayed_velocities_[0] = turn * displayed_velocities_[0];
+  displayed_velocity_ = turn * displayed_velocity_;
 }
 
 void Controller::finish_pose() {
@@ -720,28 +741,37 @@ void Controller::foot_lock(float dt) {
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
-    // A lock starts with a contact, or once a foot released during one (dragged away) has
-    // eased back onto the animation.
-    if (contact && !f.locked && (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
-      f.locked = true;
-      f.position = animated + f.offset;
-      f.offset = f.offset_velocity = glm::vec3(0.0f);
+    const glm::vec3 animated_velocity =
+        f.has_previous && dt > 0.0f ? (animated - f.previous_animated) / dt : glm::vec3(0.0f);
+    f.previous_animated = animated;
+    if (!f.has_previous) {
+      f.target = animated;
+      f.has_previous = true;
     }
-    f.previous_contact = contact;
-    if (f.locked) {
+    // The target is the lock point or the animated toe, plus an offset that decays after a
+    // release and keeps the target's position and velocity continuous there. A lock starts
+    // where the toe is, at once: easing it to rest would be a slide on the ground.
+    if (contact && !f.locked && (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
+      // A lock starts with a contact, or once a foot released during one (dragged away) has
+      // eased back onto the animation.
+      f.locked = true;
+      f.position = f.target;
+      f.offset = f.offset_velocity = glm::vec3(0.0f);
+    } else if (f.locked) {
       glm::vec3 drag = animated - f.position;
       drag.y = 0.0f;
       if (!contact || glm::length(drag) > settings_.foot_unlock_radius) {
         f.locked = false;
-        f.offset = f.position - animated;
+        f.offset = f.target - animated;
         f.offset_velocity = glm::vec3(0.0f);
       }
     }
-    if (!f.locked) {
-      critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
-                             settings_.foot_lock_release_halflife, dt);
-    }
-    const glm::vec3 target = f.locked ? f.position : animated + f.offset;
+    f.previous_contact = contact;
+    critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
+                           settings_.foot_lock_release_halflife, dt);
+    const glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
+    f.target = target;
+    f.target_velocity = (f.locked ? glm::vec3(0.0f) : animated_velocity) + f.offset_velocity;
     debug_.locked[side] = f.locked;
     debug_.lock_position[side] = f.position;
     debug_.ik_target[side] = target;
@@ -749,15 +779,19 @@ void Controller::foot_lock(float dt) {
 
     // Reach: the ankle goes where the animated foot rotation puts it above the target toe.
     const glm::quat foot_rotation = globals_[static_cast<size_t>(foot)].rotation;
-    const glm::vec3 ankle_target =
-        target - (animated - globals_[static_cast<size_t>(foot)].translation);
+    const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
+    glm::vec3 ankle_target = target - (animated - globals_[static_cast<size_t>(foot)].translation);
+    ankle_target = hip_position + soft_reach(ankle_target - hip_position, leg_length(side));
+    // The knee bends toward where it points now; a nearly straight leg has no such direction
+    // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
+    // so the character's forward breaks the tie.
     const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
-                           0.5f * (globals_[static_cast<size_t>(hip)].translation +
-                                   globals_[static_cast<size_t>(foot)].translation);
-    apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target,
-                      glm::length(pole) > 1e-6f ? pole : foot_rotation * kForward);
+                           0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
+                           kKneeForwardBias * (globals_[0].rotation * kForward);
+    apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
     locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
         glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
+    refresh_subtree(foot);
     restore_leg_lengths(side, target);
   }
 }
@@ -796,13 +830,24 @@ void Controller::restore_leg_lengths(int side, const glm::vec3& target) {
     const glm::quat parent_rotation = parent >= 0 ? globals_[static_cast<size_t>(parent)].rotation
                                                   : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
     locals_[joint].rotation = glm::normalize(glm::conjugate(parent_rotation) * global);
-    const int end = leg[i] + db_->skeleton.subtree_size(leg[i]);
-    for (int j = leg[i]; j < end; ++j) {
-      const int p = parents[static_cast<size_t>(j)];
-      globals_[static_cast<size_t>(j)] =
-          p < 0 ? locals_[static_cast<size_t>(j)]
-                : compose(globals_[static_cast<size_t>(p)], locals_[static_cast<size_t>(j)]);
-    }
+    refresh_subtree(leg[i]);
+  }
+}
+
+float Controller::leg_length(int side) const {
+  const std::vector<int>& leg = leg_joints_[side];
+  return glm::length(db_->skeleton.rest(leg[1]).translation) +
+         glm::length(db_->skeleton.rest(leg[2]).translation);
+}
+
+void Controller::refresh_subtree(int joint) {
+  const std::span<const int> parents = db_->skeleton.parents();
+  const int end = joint + db_->skeleton.subtree_size(joint);
+  for (int j = joint; j < end; ++j) {
+    const int p = parents[static_cast<size_t>(j)];
+    globals_[static_cast<size_t>(j)] =
+        p < 0 ? locals_[static_cast<size_t>(j)]
+              : compose(globals_[static_cast<size_t>(p)], locals_[static_cast<size_t>(j)]);
   }
 }
 

@@ -149,12 +149,13 @@ std::string csv_row(const FrameRecord& r, const glm::vec3* joints, size_t joint_
 
 }  // namespace
 
-double database_acceleration_p99(const Database& db, float dt) {
+double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   std::vector<double> accelerations;
   std::vector<Transform> local(joints), global(joints);
   std::vector<glm::vec3> positions;
   for (const ClipRange& clip : db.clips) {
+    if (clip.tags & excluded_tags) continue;
     const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time;
     const int steps = static_cast<int>(std::floor(duration / dt)) + 1;
     if (steps < 3) continue;
@@ -283,7 +284,8 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     }
   }
   m.transition_accel_p99 = percentile(accelerations, 99.0);
-  m.database_accel_p99 = database_acceleration_p99(db, dt);
+  m.database_accel_p99 =
+      database_acceleration_p99(db, dt, database->action_tags() | database->idle_tags());
   m.transition_accel_ratio =
       m.database_accel_p99 > 0.0 ? m.transition_accel_p99 / m.database_accel_p99 : 0.0;
 

@@ -127,9 +127,10 @@ void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incom
   assert(out_velocities.empty() || out_velocities.size() == n);
   assert(out_angular_velocities.empty() || out_angular_velocities.size() == n);
   const glm::vec3 zero(0.0f);
+  const CriticalSpringStep step = critical_spring_step(halflife, dt);
   for (size_t i = 0; i < n; ++i) {
-    critical_spring_update(offsets.positions[i], offsets.velocities[i], zero, halflife, dt);
-    critical_spring_update(offsets.rotations[i], offsets.rotation_rates[i], zero, halflife, dt);
+    critical_spring_apply(offsets.positions[i], offsets.velocities[i], zero, step);
+    critical_spring_apply(offsets.rotations[i], offsets.rotation_rates[i], zero, step);
 
     const Transform& in = incoming.local[i];
     const glm::quat offset_rotation = quat_from_scaled_angle_axis(offsets.rotations[i]);

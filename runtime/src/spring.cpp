@@ -126,8 +126,28 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
 
 void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
                             float dt) {
-  if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(goal)) return;
-  apply_spring(x, v, goal, spring_coefficients(angular_frequency(halflife), dt));
+  critical_spring_apply(x, v, goal, critical_spring_step(halflife, dt));
+}
+
+CriticalSpringStep critical_spring_step(float halflife, float dt) {
+  CriticalSpringStep step;
+  if (!(dt > 0.0f) || !usable(halflife, dt)) return step;
+  const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
+  step.xx = static_cast<float>(c.xx);
+  step.xv = static_cast<float>(c.xv);
+  step.vx = static_cast<float>(c.vx);
+  step.vv = static_cast<float>(c.vv);
+  step.moves = true;
+  return step;
+}
+
+void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
+                           const CriticalSpringStep& step) {
+  if (!step.moves || !finite(goal)) return;
+  const glm::vec3 j0 = x - goal;
+  const glm::vec3 v0 = v;
+  x = goal + step.xx * j0 + step.xv * v0;
+  v = step.vx * j0 + step.vv * v0;
 }
 
 void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity,

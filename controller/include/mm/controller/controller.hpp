@@ -138,7 +138,7 @@ struct ControllerSettings {
   std::string search_method = "boxtree";  // a name from search_method_names()
   float search_interval = 0.1f;           // s between searches while nothing changes
   // Extra cost every candidate but the continuation pays (normalized feature units).
-  float transition_cost = 0.0f;
+  float transition_cost = 1.0f;
   // Frames within this time of the playing frame are not jumped to (s).
   float ignore_window = 0.2f;
   // A change of the desired velocity (m/s) or facing (radians) since the last search this large
@@ -155,20 +155,20 @@ struct ControllerSettings {
 
   // ---- Synchronization.
   SyncMode sync_mode = SyncMode::CharacterFollowsSimulation;
-  float adjustment_halflife = 0.15f;  // s: how fast the character is pulled to the simulation
+  float adjustment_halflife = 0.1f;  // s: how fast the character is pulled to the simulation
   // The pull's speed is at most this ratio of the character's own speed (linear and angular),
   // so a standing character is never slid.
-  float adjustment_max_velocity_ratio = 0.5f;
+  float adjustment_max_velocity_ratio = 1.0f;
   // The character never strays farther than this from the simulation (m, radians).
-  float clamp_max_distance = 0.15f;
+  float clamp_max_distance = 0.4f;
   float clamp_max_angle = 0.6f;
 
   // ---- Foot locking and IK.
   bool ik_enabled = true;        // false: the animation's feet as they are
   bool foot_lock_enabled = true; // hold a foot's toe where it landed while in contact
   // A locked toe is released when the animation drags it farther than this (m).
-  float foot_unlock_radius = 0.2f;
-  // After a release the foot eases back onto the animation with this halflife (s).
+  float foot_unlock_radius = 0.5f;
+  // A released foot eases back onto the animation with this halflife (s).
   float foot_lock_release_halflife = 0.1f;
   // Passes of the distance-constraint solver that restores the leg's bone lengths.
   int bone_length_iterations = 2;
@@ -294,6 +294,8 @@ class Controller {
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
   void restore_leg_lengths(int side, const glm::vec3& target);
+  void refresh_subtree(int joint);
+  float leg_length(int side) const;  // upper plus lower leg (m)  // globals of a joint and its descendants from the locals
   void finish_pose();
   uint64_t resolve_tag(std::string_view tag) const;
 
@@ -348,10 +350,10 @@ class Controller {
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;
   std::vector<Transform> locals_;  // displayed: inertialized, adjusted, with IK
-  std::vector<glm::vec3> displayed_velocities_;
-  std::vector<glm::vec3> displayed_angular_velocities_;
+  glm::vec3 displayed_velocity_{0.0f};  // of the root
+  glm::vec3 displayed_angular_velocity_{0.0f};
   std::vector<Transform> globals_;
-  std::vector<Transform> inverse_bind_;
+  std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::mat4> skinning_;
   std::vector<float> query_;
 
@@ -359,8 +361,12 @@ class Controller {
   struct FootLock {
     bool locked = false;
     glm::vec3 position{0.0f};        // the held toe position
-    glm::vec3 offset{0.0f};          // after a release: target - animation, decaying
+    glm::vec3 offset{0.0f};          // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
+    glm::vec3 target{0.0f};          // the toe's target last update, and its velocity
+    glm::vec3 target_velocity{0.0f};
+    glm::vec3 previous_animated{0.0f};  // the animated toe last update
+    bool has_previous = false;
     bool previous_contact = false;
   };
   FootLock feet_[2];

@@ -17,7 +17,8 @@
 // - transitions_per_s: jumps to a new database frame per second of script;
 // - transition_accel_ratio: the 99th percentile of joint acceleration (second differences of
 //   global joint positions, every joint but the simulation root) over the 10 frames from each
-//   transition, divided by the same percentile over the database's clips played straight
+//   transition, divided by the same percentile over the database's locomotion clips (those the
+//   controller plays when no tag is requested: not "action", not "idle") played straight
 //   through at the same dt with linear interpolation between frames;
 // - search_us_mean: wall time per search; update_us_mean: wall time per update() (the only
 //   figures that vary from run to run).
@@ -79,10 +80,10 @@ struct EvaluationResult {
   std::vector<std::string> csv_rows;  // one per frame when keep_frames
 };
 
-// The database's own joint acceleration, 99th percentile (m/s^2): every clip played straight
-// through at dt with linear interpolation between frames (the baseline of
-// transition_accel_ratio).
-double database_acceleration_p99(const Database& db, float dt);
+// The database's own joint acceleration, 99th percentile (m/s^2): every clip that carries none
+// of `excluded_tags` played straight through at dt with linear interpolation between frames
+// (the baseline of transition_accel_ratio).
+double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags = 0);
 
 // Runs the script and measures it. Fails on invalid options or settings.
 Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabase> database,

@@ -58,6 +58,21 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
 void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
                             float dt);
 
+// One step of dt seconds of every critically damped spring with this halflife, computed once:
+// springs that share a halflife and a dt (the inertialization offsets of every joint) advance
+// with one exponential between them. A step with dt <= 0 or a non-finite halflife or dt is a
+// no-op, as for critical_spring_update.
+struct CriticalSpringStep {
+  float xx = 1.0f, xv = 0.0f, vx = 0.0f, vv = 1.0f;  // x' - goal = xx*(x - goal) + xv*v, ...
+  bool moves = false;                                // false: the step leaves springs as they are
+};
+CriticalSpringStep critical_spring_step(float halflife, float dt);
+
+// Advances a 3D spring by a precomputed step; the same result as critical_spring_update with
+// the step's halflife and dt.
+void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
+                           const CriticalSpringStep& step);
+
 // Advances a rotation spring toward goal by dt seconds along the shortest path. The state is
 // the rotation error e = angle*axis of rotation * inverse(goal) (world frame, |e| <= pi) and
 // angular_velocity = de/dt (rad/s, axis times rate), which is the true angular velocity
