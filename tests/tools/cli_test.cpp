@@ -87,11 +87,13 @@ TEST(Cli, BuildWritesALoadableDatabaseAndPrintsItsSummary) {
   }
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  EXPECT_EQ(db->clips.size(), 3u);
-  // The frames of the three sources, counted by the importer independently of the builder.
+  ASSERT_EQ(db->clips.size(), 4u);
+  EXPECT_EQ(db->clips[3].name, "idle");
+  // The frames of the three sources, counted by the importer independently of the builder,
+  // and the idle clip's.
   int frames = 0;
   for (const auto& entry : fs::directory_iterator(in)) frames += load_bvh(entry.path())->frame_count;
-  EXPECT_EQ(db->frame_count, frames);
+  EXPECT_EQ(db->frame_count, frames + 90);
 
   const CommandRun info = run_mm("info " + quoted(out));
   EXPECT_EQ(info.exit_code, 0) << info.output;
@@ -116,7 +118,7 @@ TEST(Cli, BuildRefusesABadFileNamingItAndSkipBadBuildsFromTheRest) {
   EXPECT_NE(skip.output.find("broken.bvh"), std::string::npos) << skip.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  EXPECT_EQ(db->clips.size(), 3u);
+  EXPECT_EQ(db->clips.size(), 4u);  // the three good files and the idle clip
 }
 
 TEST(Cli, ContactThresholdsAreConfigurable) {
