@@ -5,6 +5,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <mutex>
 #include <set>
@@ -16,6 +17,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/gltf.hpp"
+#include "mm/database/idle.hpp"
 #include "workers.hpp"
 
 namespace mm {
@@ -138,6 +140,56 @@ Result<std::vector<Clip>> import_file(const fs::path& path, const BuildOptions& 
   return clips;
 }
 
+// Sets db.tag_names (sorted) and every clip's tag bits from its tag list (one per clip).
+Status assign_tags(Database& db, const std::vector<std::vector<std::string>>& clip_tag_lists) {
+  std::set<std::string> tag_set;
+  for (const std::vector<std::string>& tags : clip_tag_lists)
+    tag_set.insert(tags.begin(), tags.end());
+  if (tag_set.size() > kMaxTags) {
+    std::string some;
+    for (const std::string& t : tag_set) some += (some.empty() ? "" : ", ") + t;
+    return Error{"build: " + std::to_string(tag_set.size()) + " distinct tags, at most " +
+                 std::to_string(kMaxTags) + " fit a database (" + some + ")"};
+  }
+  db.tag_names.assign(tag_set.begin(), tag_set.end());
+  for (size_t r = 0; r < db.clips.size(); ++r) {
+    db.clips[r].tags = 0;
+    for (const std::string& tag : clip_tag_lists[r]) {
+      const auto bit =
+          std::lower_bound(db.tag_names.begin(), db.tag_names.end(), tag) - db.tag_names.begin();
+      db.clips[r].tags |= uint64_t{1} << bit;
+    }
+  }
+  return Status::success();
+}
+
+// The frames of the idle clip options.idle_seconds asks for (0 for none), or why it cannot
+// have them. The options' rate and schema are already known to be valid.
+Result<int> idle_frame_count(const BuildOptions& options) {
+  const float seconds = options.idle_seconds;
+  if (!std::isfinite(seconds) || seconds < 0.0f || seconds > 60.0f) {
+    return Error{"build: the idle clip must last from 0 to 60 seconds (0: no idle clip), found " +
+                 std::to_string(seconds)};
+  }
+  if (seconds == 0.0f) return 0;
+  const int frames = static_cast<int>(std::lround(static_cast<double>(seconds) * options.rate));
+  // A frame is searchable only when every feature time lies inside its clip; an idle clip with
+  // no searchable frame could never be chosen by the search.
+  const FeatureFrameMargins margins = feature_frame_margins(options.schema, 1.0f / options.rate);
+  const int least = margins.before + margins.after + 1;
+  if (frames < least) {
+    char buffer[320];
+    std::snprintf(buffer, sizeof buffer,
+                  "build: an idle clip of %g s is %d frames at %g Hz, but the feature times need "
+                  "at least %d frames (%.3g s) for one of them to be searchable; ask for at "
+                  "least that, or 0 for no idle clip",
+                  static_cast<double>(seconds), frames, static_cast<double>(options.rate), least,
+                  least / static_cast<double>(options.rate));
+    return Error{buffer};
+  }
+  return frames;
+}
+
 std::string topology_difference(const Skeleton& a, const Skeleton& b) {
   if (a.joint_count() != b.joint_count()) {
     return std::to_string(b.joint_count()) + " joints instead of " +
@@ -160,7 +212,7 @@ std::string topology_difference(const Skeleton& a, const Skeleton& b) {
 // Phase 2 (in input order): refuse failures and foreign skeletons, lay out the clip ranges,
 //   tags and arrays of the database.
 // Phase 3 (parallel over clips): preprocess and extract raw features straight into the
-//   database's arrays at each clip's frames.
+//   database's arrays at each clip's frames; then the idle clip (one pass in frame order).
 // Phase 4: normalization statistics (one pass in frame order), normalization, validation.
 template <class Load>
 Result<Database> build(size_t input_count, const std::vector<std::string>& input_names,
@@ -176,6 +228,8 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
                  std::to_string(options.rate)};
   }
   if (Status s = options.schema.validate(); !s) return Error{"build: " + s.message()};
+  const Result<int> idle_frames = idle_frame_count(options);
+  if (!idle_frames) return Error{idle_frames.message()};
   if (input_count == 0) return Error{"build: no inputs"};
 
   BuildContext context{options, {}, {}, options.schema.dims()};
@@ -285,10 +339,9 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
     mirror_map = std::move(map).value();
   }
 
-  // Clip ranges (a mirrored copy right after its original) and their tags.
+  // Clip ranges (a mirrored copy right after its original, the idle clip last) and their tags.
   std::vector<ClipJob> jobs;
   std::vector<std::vector<std::string>> clip_tag_lists;
-  std::set<std::string> tag_set;
   size_t total_frames = 0;
   for (size_t i = 0; i < input_count; ++i) {
     if (!results[i].processed) continue;
@@ -309,24 +362,30 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
         jobs.push_back({i, c, mirrored, db.clips.size()});
         db.clips.push_back(std::move(range));
         clip_tag_lists.push_back(clip_tags(clip.name, mirrored, context.tag_rules));
-        tag_set.insert(clip_tag_lists.back().begin(), clip_tag_lists.back().end());
       }
     }
   }
-  if (tag_set.size() > kMaxTags) {
-    std::string some;
-    for (const std::string& t : tag_set) some += (some.empty() ? "" : ", ") + t;
-    return Error{"build: " + std::to_string(tag_set.size()) + " distinct tags, at most " +
-                 std::to_string(kMaxTags) + " fit a database (" + some + ")"};
-  }
-  db.tag_names.assign(tag_set.begin(), tag_set.end());
-  for (size_t r = 0; r < db.clips.size(); ++r) {
-    for (const std::string& tag : clip_tag_lists[r]) {
-      const auto bit =
-          std::lower_bound(db.tag_names.begin(), db.tag_names.end(), tag) - db.tag_names.begin();
-      db.clips[r].tags |= uint64_t{1} << bit;
+  // The idle clip's frames are reserved now so that the arrays are allocated once; which pose
+  // they hold is known only after phase 3 (it needs the contacts and velocities).
+  if (*idle_frames > 0) {
+    ClipRange range;
+    range.name = kIdleClipName;
+    range.start = static_cast<int>(total_frames);
+    range.end = range.start + *idle_frames;
+    total_frames += static_cast<size_t>(*idle_frames);
+    if (total_frames > kMaxDatabaseFrames) {
+      return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
+                   " frames with the idle clip, the most a database holds"};
     }
+    db.clips.push_back(std::move(range));
+    // Manifest rules match the name "idle" like any clip name.
+    std::vector<std::string> tags = clip_tags(kIdleClipName, false, context.tag_rules);
+    tags.emplace_back(kIdleTag);
+    std::sort(tags.begin(), tags.end());
+    tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+    clip_tag_lists.push_back(std::move(tags));
   }
+  if (Status s = assign_tags(db, clip_tag_lists); !s) return Error{s.message()};
 
   const int joints = db.joint_count();
   const size_t dims = static_cast<size_t>(context.dims);
@@ -410,6 +469,37 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
     if (!s) return Error{s.message()};
   }
   results.clear();  // the imported clips are no longer needed
+
+  // The idle clip: one pass in frame order over the finished clips, then a copy.
+  if (*idle_frames > 0) {
+    const ClipRange& idle = db.clips.back();
+    const IdleSourceSearch found = search_idle_source(db);
+    if (found.frame >= 0) {
+      fill_idle_clip(db, idle, found.frame);
+      extract_range_features(db, idle, *bones, scratch[0].features);
+      const ClipRange& source = db.clips[static_cast<size_t>(db.frame_clip[found.frame])];
+      rep.idle_frames = idle.frame_count();
+      rep.idle_source_clip = source.name;
+      rep.idle_source_frame = found.frame - source.start;
+    } else {
+      rep.warnings.push_back("no idle clip: " + idle_search_failure(found));
+      // The reserved frames are the last ones: give them back and drop the clip's tags.
+      total_frames -= static_cast<size_t>(idle.frame_count());
+      db.clips.pop_back();
+      clip_tag_lists.pop_back();
+      if (Status s = assign_tags(db, clip_tag_lists); !s) return Error{s.message()};
+      db.frame_count = static_cast<int>(total_frames);
+      const size_t kept = total_frames * static_cast<size_t>(joints);
+      db.local_positions.resize(kept);
+      db.local_rotations.resize(kept);
+      db.local_velocities.resize(kept);
+      db.local_angular_velocities.resize(kept);
+      db.features.resize(total_frames * dims);
+      db.frame_clip.resize(total_frames);
+      db.contacts.resize(total_frames * 2);
+      db.searchable.resize(total_frames);
+    }
+  }
 
   rep.process_seconds = seconds_since(phase_start);
   phase_start = Clock::now();

@@ -1,5 +1,6 @@
 // The database builder on real Bandai clips (two walks, a turn, a run and a wave), on bad
-// inputs, and end to end through the database file.
+// inputs, and end to end through the database file. The idle clip has its own tests
+// (idle_test.cpp); here it is accounted for where the default build makes one.
 
 #include <gtest/gtest.h>
 
@@ -13,6 +14,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/gltf.hpp"
+#include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
@@ -98,8 +100,9 @@ TEST(BuilderRealClips, FramesRangesAndSearchableCounts) {
   const Database& db = b.db;
   ASSERT_EQ(b.sources.size(), 5u);
   ASSERT_TRUE(db.validate()) << db.validate().message();
-  ASSERT_EQ(db.clips.size(), 5u);
-  EXPECT_EQ(b.report.clips, 5);
+  // The five clips, then the idle clip (3 s by default).
+  ASSERT_EQ(db.clips.size(), 6u);
+  EXPECT_EQ(b.report.clips, 6);
   EXPECT_EQ(b.report.inputs, 5);
   EXPECT_TRUE(b.report.refused.empty());
   EXPECT_FLOAT_EQ(db.frame_time, 1.0f / 30.0f);
@@ -122,6 +125,13 @@ TEST(BuilderRealClips, FramesRangesAndSearchableCounts) {
     expected_frames += range.frame_count();
     expected_searchable += range.frame_count() - 30;
   }
+  const ClipRange& idle = db.clips[5];
+  EXPECT_EQ(idle.name, "idle");
+  EXPECT_EQ(idle.start, expected_frames);
+  EXPECT_EQ(idle.frame_count(), 90);
+  EXPECT_EQ(b.report.idle_frames, 90);
+  expected_frames += 90;
+  expected_searchable += 90 - 30;
   EXPECT_EQ(db.frame_count, expected_frames);
   EXPECT_EQ(b.report.frames, expected_frames);
   EXPECT_EQ(b.report.searchable_frames, expected_searchable);
@@ -255,6 +265,7 @@ TEST(BuilderRealClips, MirroredBuildDoublesTheClipsAndMirrorsTheFeatures) {
   const std::vector<fs::path> paths = {test::clip_path(kClips[2]), test::clip_path(kClips[3])};
   BuildOptions options;
   options.mirror = true;
+  options.idle_seconds = 0.0f;  // the mirrored copies only
   BuildReport report;
   Result<Database> db = build_database(paths, options, &report);
   ASSERT_TRUE(db) << db.message();
@@ -296,7 +307,10 @@ TEST(BuilderRealClips, MirroredBuildDoublesTheClipsAndMirrorsTheFeatures) {
 }
 
 TEST(BuilderRealClips, OutputDoesNotDependOnTheThreadCount) {
+  // With mirrored copies and the idle clip, whose source frame is searched for after the
+  // parallel phase and whose features are normalized with the rest.
   std::vector<Database> dbs;
+  std::vector<BuildReport> reports;
   for (const int threads : {1, 2, 3}) {
     BuildOptions options;
     options.threads = threads;
@@ -305,12 +319,28 @@ TEST(BuilderRealClips, OutputDoesNotDependOnTheThreadCount) {
     Result<Database> db = build_database(clip_paths(), options, &report);
     ASSERT_TRUE(db) << db.message();
     EXPECT_EQ(report.threads, threads);
+    ASSERT_EQ(find_idle_clip(*db), static_cast<int>(db->clips.size()) - 1);
     dbs.push_back(std::move(db).value());
+    reports.push_back(report);
   }
   for (size_t i = 1; i < dbs.size(); ++i) {
     const Database& a = dbs[0];
     const Database& b = dbs[i];
     ASSERT_EQ(a.frame_count, b.frame_count);
+    EXPECT_EQ(reports[0].idle_source_clip, reports[i].idle_source_clip);
+    EXPECT_EQ(reports[0].idle_source_frame, reports[i].idle_source_frame);
+    ASSERT_EQ(a.clips.size(), b.clips.size());
+    for (size_t c = 0; c < a.clips.size(); ++c) {
+      EXPECT_EQ(a.clips[c].name, b.clips[c].name);
+      EXPECT_EQ(a.clips[c].start, b.clips[c].start);
+      EXPECT_EQ(a.clips[c].tags, b.clips[c].tags);
+    }
+    EXPECT_EQ(0, std::memcmp(a.local_velocities.data(), b.local_velocities.data(),
+                             a.local_velocities.size() * sizeof(glm::vec3)));
+    EXPECT_EQ(0, std::memcmp(a.local_angular_velocities.data(), b.local_angular_velocities.data(),
+                             a.local_angular_velocities.size() * sizeof(glm::vec3)));
+    EXPECT_EQ(a.searchable, b.searchable);
+    EXPECT_EQ(a.feature_offset, b.feature_offset);
     EXPECT_EQ(0, std::memcmp(a.features.data(), b.features.data(), a.features.size() * 4));
     EXPECT_EQ(0, std::memcmp(a.local_positions.data(), b.local_positions.data(),
                              a.local_positions.size() * sizeof(glm::vec3)));
@@ -338,6 +368,7 @@ TEST(BuilderBadInputs, BrokenFileIsNamedAndSkippedOnRequest) {
 
   BuildOptions skip;
   skip.skip_bad = true;
+  skip.idle_seconds = 0.0f;  // the clips of the good files only
   BuildReport report;
   db = build_database(inputs, skip, &report);
   ASSERT_TRUE(db) << db.message();
@@ -363,6 +394,7 @@ TEST(BuilderBadInputs, DifferentSkeletonIsRefused) {
 
   BuildOptions skip;
   skip.skip_bad = true;
+  skip.idle_seconds = 0.0f;  // the clips of the good files only
   BuildReport report;
   db = build_database(inputs, skip, &report);
   ASSERT_TRUE(db) << db.message();
@@ -496,8 +528,10 @@ TEST(BuilderOptions, ClipsTooShortToMatchAreReported) {
   // The normal-style set-1 dash has 20 frames, less than the 1 s the trajectory needs.
   const fs::path inputs[] = {test::clip_path("dataset-1_dash_normal_001"),
                              test::clip_path("dataset-1_walk_normal_001")};
+  BuildOptions options;
+  options.idle_seconds = 0.0f;  // its frames and any warning about it are not the subject here
   BuildReport report;
-  Result<Database> db = build_database(inputs, BuildOptions{}, &report);
+  Result<Database> db = build_database(inputs, options, &report);
   ASSERT_TRUE(db) << db.message();
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("dataset-1_dash_normal_001"), std::string::npos);

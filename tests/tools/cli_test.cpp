@@ -85,13 +85,20 @@ TEST(Cli, BuildWritesALoadableDatabaseAndPrintsItsSummary) {
   for (const char* field : {"clips:", "frames:", "joints:", "tags:", "features:", "file size:"}) {
     EXPECT_NE(build.output.find(field), std::string::npos) << field << "\n" << build.output;
   }
+  // The idle clip (3 s by default) and the frame it holds.
+  const size_t idle_line =
+      build.output.find("idle:        90 frames (3.0 s), clip 3, holding frame ");
+  ASSERT_NE(idle_line, std::string::npos) << build.output;
+  EXPECT_NE(build.output.find(" of dataset-2_", idle_line), std::string::npos) << build.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  EXPECT_EQ(db->clips.size(), 3u);
-  // The frames of the three sources, counted by the importer independently of the builder.
+  ASSERT_EQ(db->clips.size(), 4u);
+  EXPECT_EQ(db->clips[3].name, "idle");
+  // The frames of the three sources, counted by the importer independently of the builder,
+  // and the idle clip's.
   int frames = 0;
   for (const auto& entry : fs::directory_iterator(in)) frames += load_bvh(entry.path())->frame_count;
-  EXPECT_EQ(db->frame_count, frames);
+  EXPECT_EQ(db->frame_count, frames + 90);
 
   const CommandRun info = run_mm("info " + quoted(out));
   EXPECT_EQ(info.exit_code, 0) << info.output;
@@ -110,13 +117,58 @@ TEST(Cli, BuildRefusesABadFileNamingItAndSkipBadBuildsFromTheRest) {
   EXPECT_NE(strict.output.find("broken.bvh:4: expected"), std::string::npos) << strict.output;
   EXPECT_FALSE(fs::exists(out));
 
-  const CommandRun skip = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --skip-bad");
+  const CommandRun skip =
+      run_mm("build " + quoted(in) + " -o " + quoted(out) + " --skip-bad --idle 0");
   EXPECT_EQ(skip.exit_code, 0) << skip.output;
   EXPECT_NE(skip.output.find("refused 1"), std::string::npos) << skip.output;
   EXPECT_NE(skip.output.find("broken.bvh"), std::string::npos) << skip.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
   EXPECT_EQ(db->clips.size(), 3u);
+}
+
+TEST(Cli, IdleLengthIsAnOptionAndInfoShowsTheIdleClip) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  const fs::path out = dir / "db.mmdb";
+  EXPECT_NE(run_mm("build --help").output.find("--idle SECONDS"), std::string::npos);
+
+  const CommandRun none = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --idle 0");
+  ASSERT_EQ(none.exit_code, 0) << none.output;
+  EXPECT_NE(none.output.find("idle:        none"), std::string::npos) << none.output;
+  Result<Database> db = load_database(out);
+  ASSERT_TRUE(db.ok()) << db.message();
+  EXPECT_EQ(db->clips.size(), 3u);
+
+  const CommandRun two = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --idle 2");
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  EXPECT_NE(two.output.find("idle:        60 frames (2.0 s), clip 3, holding frame "),
+            std::string::npos)
+      << two.output;
+  const CommandRun info = run_mm("info " + quoted(out) + " --clips");
+  EXPECT_EQ(info.exit_code, 0) << info.output;
+  // The summary line (without the source frame, which the file does not record), the tag with
+  // its counts, and the clip in the list with its tag.
+  EXPECT_NE(info.output.find("idle:        60 frames (2.0 s), clip 3\n"), std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("  idle                         1 clips       60 frames"),
+            std::string::npos)
+      << info.output;
+  EXPECT_NE(info.output.find("     3      60 frames  idle"), std::string::npos) << info.output;
+
+  for (const char* bad : {"-1", "61", "nan", "abc"}) {
+    const CommandRun run =
+        run_mm("build " + quoted(in) + " -o " + quoted(dir / "bad.mmdb") + " --idle " + bad);
+    EXPECT_EQ(run.exit_code, 2) << bad << "\n" << run.output;
+    EXPECT_NE(run.output.find("--idle needs a number of seconds from 0 to 60"), std::string::npos)
+        << run.output;
+  }
+  // In range but too short for a searchable frame: the builder's message.
+  const CommandRun short_idle =
+      run_mm("build " + quoted(in) + " -o " + quoted(dir / "short.mmdb") + " --idle 0.5");
+  EXPECT_EQ(short_idle.exit_code, 1) << short_idle.output;
+  EXPECT_NE(short_idle.output.find("at least 31 frames"), std::string::npos) << short_idle.output;
+  EXPECT_FALSE(fs::exists(dir / "short.mmdb"));
 }
 
 TEST(Cli, ContactThresholdsAreConfigurable) {

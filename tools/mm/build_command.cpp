@@ -27,6 +27,9 @@ options:
   -o, --output FILE   the database file to write (required)
   --rate HZ           database frame rate (default 30)
   --mirror            also add a left/right mirrored copy of every clip (tagged "mirrored")
+  --idle SECONDS      length of the idle clip (default 3; 0: none): the calmest frame that
+                      stands on both feet, held still at the origin, as one more clip named
+                      and tagged "idle" (a little over 1 s at least, for the features)
   --tags FILE         tag manifest: lines "<glob> <tag> <tag> ..." matched against clip
                       names; '#' starts a comment (tags from Bandai file names are automatic)
   --skip-bad          build from the good files and list the refused ones, instead of failing
@@ -105,6 +108,13 @@ int run_build(const std::vector<std::string>& args) {
       options.rate = static_cast<float>(*rate);
     } else if (a == "--mirror") {
       options.mirror = true;
+    } else if (a == "--idle") {
+      const std::string* v = value();
+      const std::optional<double> seconds = v ? parse_number(*v) : std::nullopt;
+      if (!seconds || *seconds < 0.0 || *seconds > 60.0) {
+        return usage_error("--idle needs a number of seconds from 0 to 60 (0: no idle clip)");
+      }
+      options.idle_seconds = static_cast<float>(*seconds);
     } else if (a == "--tags") {
       const std::string* v = value();
       if (!v) return usage_error("--tags needs a file name");
@@ -223,7 +233,11 @@ int run_build(const std::vector<std::string>& args) {
     std::printf("wrote %s\n", output.c_str());
     std::printf("input:       %d files, %s read, %d refused\n", report.inputs,
                 human_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
-    print_database_summary(stdout, *db, ec ? 0 : static_cast<uint64_t>(size));
+    const std::string idle_source =
+        report.idle_frames > 0
+            ? "frame " + std::to_string(report.idle_source_frame) + " of " + report.idle_source_clip
+            : std::string();
+    print_database_summary(stdout, *db, ec ? 0 : static_cast<uint64_t>(size), idle_source);
     std::printf(
         "time:        %.2f s on %d threads (reading %.2f s, layout %.2f s, processing %.2f s, "
         "normalizing %.2f s, writing %.2f s)\n",

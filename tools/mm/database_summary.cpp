@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "mm/database/idle.hpp"
+
 namespace mm::cli {
 
 namespace {
@@ -66,7 +68,8 @@ std::string human_bytes(uint64_t bytes) {
   return buffer;
 }
 
-void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes) {
+void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
+                            const std::string& idle_source) {
   int mirrored = 0;
   for (const ClipRange& c : db.clips) mirrored += c.mirrored ? 1 : 0;
   const long long searchable = std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1});
@@ -78,6 +81,15 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes) 
                db.frame_count * static_cast<double>(db.frame_time) / 60.0);
   std::fprintf(out, "searchable:  %lld frames (%.1f %%)\n", searchable,
                db.frame_count ? 100.0 * searchable / db.frame_count : 0.0);
+  if (const int idle = find_idle_clip(db); idle >= 0) {
+    const ClipRange& clip = db.clips[static_cast<size_t>(idle)];
+    std::fprintf(out, "idle:        %d frames (%.1f s), clip %d", clip.frame_count(),
+                 clip.frame_count() * static_cast<double>(db.frame_time), idle);
+    if (!idle_source.empty()) std::fprintf(out, ", holding %s", idle_source.c_str());
+    std::fprintf(out, "\n");
+  } else {
+    std::fprintf(out, "idle:        none\n");
+  }
   std::fprintf(
       out, "joints:      %d (joint 0 '%s'); roles: hips %s, feet %s / %s, toes %s / %s, head %s\n",
       db.joint_count(), db.joint_count() ? db.skeleton.name(0).c_str() : "-",

@@ -11,10 +11,13 @@
 
 namespace mm::cli {
 
-// Prints clips (and mirrored copies), frames, duration, rate, joints and roles, tags with their
-// clip and frame counts, feature dimensions and channels, and searchable frames. `file_bytes`
-// (when > 0) is printed as the file size.
-void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes);
+// Prints clips (and mirrored copies), frames, duration, rate, searchable frames, the idle clip,
+// joints and roles, feature dimensions and channels, and tags with their clip and frame counts.
+// `file_bytes` (when > 0) is printed as the file size. `idle_source` (e.g. "frame 37 of
+// <clip>") says which frame the idle clip holds; the file does not record it, so only the
+// builder can say.
+void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
+                            const std::string& idle_source = {});
 
 // Prints one line per feature channel: name, kind, bone or times, columns, weight, and the
 // per-column mean and standard deviation (the normalization's offset and scale * weight).

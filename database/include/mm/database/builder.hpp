@@ -12,6 +12,12 @@
 // result. Every per-clip step is independent of the others and the statistics are summed in
 // frame order, so the output is byte-for-byte the same whatever the number of threads.
 //
+// The idle clip (idle.hpp): unless options.idle_seconds is 0, phase 2 also reserves one clip
+// named "idle" and tagged "idle" after every other clip, and between phases 3 and 4 it is
+// filled with the calmest frame that stands on both feet, held still, and its raw features are
+// extracted like any clip's, so phase 4 normalizes them with the rest. When no frame
+// qualifies the reserved frames are given back and a warning says why.
+//
 // Inputs are files or folders. Folders are scanned recursively for .bvh, .gltf and .glb files
 // (extensions compared case-insensitively), sorted by path; files given by name are taken in
 // the given order, whatever their extension (".gltf"/".glb" are read as glTF, anything else as
@@ -39,8 +45,13 @@ namespace mm {
 struct BuildOptions {
   // Database frames per second; every clip is resampled to it. Finite, in (0, 1000].
   float rate = 30.0f;
-  // Adds a mirrored copy of every clip (named "<name>_mirror", tagged "mirrored").
+  // Adds a mirrored copy of every clip (named "<name>_mirror", tagged "mirrored"). The idle
+  // clip is never mirrored.
   bool mirror = false;
+  // Length in seconds of the idle clip (see idle.hpp); 0 for none. Finite, in [0, 60], and
+  // when not 0 long enough for at least one of its frames to be searchable (the default
+  // schema looks 1 s ahead, so a little over 1 s).
+  float idle_seconds = 3.0f;
   // Left/right joint pairs that override the name-pattern detection when mirroring.
   std::vector<MirrorPair> mirror_pairs;
   // Optional tag manifest (see tags.hpp); empty for none.
@@ -76,7 +87,7 @@ struct RefusedInput {
 // What happened during a build.
 struct BuildReport {
   int inputs = 0;                     // files (or in-memory clips) offered
-  int clips = 0;                      // clips in the database (mirrored copies included)
+  int clips = 0;                      // clips in the database (mirrored copies and idle too)
   int frames = 0;                     // database frames
   int searchable_frames = 0;          // frames the search may return
   double duration_s = 0.0;            // frames / rate
@@ -87,7 +98,10 @@ struct BuildReport {
   double process_seconds = 0.0;       // phase 3: preprocessing and raw features
   double finish_seconds = 0.0;        // phase 4: normalization and the final validation
   double total_seconds = 0.0;         // wall time of the whole build
-  std::vector<std::string> warnings;  // e.g. feature channels that do not vary
+  int idle_frames = 0;                // frames of the idle clip, 0 when there is none
+  std::string idle_source_clip;       // the clip whose frame the idle clip holds
+  int idle_source_frame = -1;         // that frame, counted from the start of its clip
+  std::vector<std::string> warnings;  // e.g. feature channels that do not vary, no idle clip
   std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)
 };
 

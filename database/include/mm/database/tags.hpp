@@ -16,6 +16,9 @@
 // stem, or the glTF animation name) with '*' (any run of characters) and '?' (one character);
 // every matching line adds its tags. Tags are words of letters, digits and "_-.:+".
 //
+// The idle clip the builder synthesizes (idle.hpp) is named "idle": it gets the tag "idle" plus
+// those of the manifest lines whose glob matches "idle". It is never mirrored.
+//
 // Mirrored clips get the tags their original would get (name and manifest, matched on the
 // original name) with "left" and "right" swapped inside each tag ("walk-turn-left" becomes
 // "walk-turn-right"), plus "mirrored".
