@@ -137,6 +137,7 @@ Status ControllerSettings::validate() const {
       {"replan_velocity_change", replan_velocity_change, 0.0f, 100.0f},
       {"replan_facing_change", replan_facing_change, 0.0f, 10.0f},
       {"clip_end_lookahead", clip_end_lookahead, 0.0f, 10.0f},
+      {"transition_cooldown", transition_cooldown, 0.0f, 10.0f},
       {"inertialization_halflife", inertialization_halflife, 0.0f, 10.0f},
       {"adjustment_halflife", adjustment_halflife, 0.0f, 10.0f},
       {"adjustment_max_velocity_ratio", adjustment_max_velocity_ratio, 0.0f, 100.0f},
@@ -316,6 +317,7 @@ void Controller::update(float dt, const ControllerInput& input) {
 
   desired_motion(input);
   search_timer_ += dt;
+  since_transition_ += dt;
   if (should_search(input)) search(input);
   advance_playback(dt);
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
@@ -384,7 +386,14 @@ uint64_t Controller::resolve_tag(std::string_view tag) const {
 }
 
 bool Controller::should_search(const ControllerInput&) const {
-  if (force_search_ || search_timer_ >= settings_.search_interval) return true;
+  if (force_search_) return true;
+  // Periodic searches wait a little after a transition: the query keeps drifting while the
+  // simulation settles, and a jump every interval would make every transition chain into the
+  // next before its offsets have decayed.
+  if (search_timer_ >= settings_.search_interval &&
+      since_transition_ >= settings_.transition_cooldown) {
+    return true;
+  }
   if (tag_bits_ != tag_bits_at_search_ || stopping_ != stopping_at_search_) return true;
   if (glm::length(desired_velocity_ - desired_velocity_at_search_) >
       settings_.replan_velocity_change) {
@@ -405,14 +414,10 @@ bool Controller::should_search(const ControllerInput&) const {
 void Controller::build_query() {
   const Database& db = *db_;
   const size_t dims = static_cast<size_t>(db.feature_dims());
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
-  const float x = clip_time_ / db.frame_time;
-  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
-  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
-  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
-  const float* r0 = db.features.data() + static_cast<size_t>(clip.start + i0) * dims;
-  const float* r1 = db.features.data() + static_cast<size_t>(clip.start + i1) * dims;
-  for (size_t c = 0; c < dims; ++c) query_[c] = r0[c] + a * (r1[c] - r0[c]);
+  const PlaybackPoint at = playback_point();
+  const float* r0 = db.features.data() + static_cast<size_t>(at.frame0) * dims;
+  const float* r1 = db.features.data() + static_cast<size_t>(at.frame1) * dims;
+  for (size_t c = 0; c < dims; ++c) query_[c] = r0[c] + at.weight * (r1[c] - r0[c]);
 
   const Transform& root = globals_[0];
   const glm::quat inverse = glm::conjugate(root.rotation);
@@ -513,6 +518,7 @@ void Controller::transition_to(int frame) {
                            {other_, other_velocities_, other_angular_velocities_});
     ++debug_.transitions;
     debug_.transitioned = true;
+    since_transition_ = 0.0f;
   }
   std::swap(sampled_, other_);
   std::swap(sampled_velocities_, other_velocities_);
@@ -526,30 +532,50 @@ void Controller::advance_playback(float dt) {
   if (clip_time_ >= end) force_search_ = true;
 }
 
+Controller::PlaybackPoint Controller::playback_point() const {
+  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
+  const float x = clip_time_ / db_->frame_time;
+  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
+  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+  return {clip.start + i0, clip.start + i1, std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f)};
+}
+
+// One joint's local transform at a playback point: cubic Hermite through the two frames' values
+// and velocities (no velocity kink where one frame interval meets the next), or the chosen
+// two-point interpolation.
+Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const {
+  const Database& db = *db_;
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const size_t k0 = static_cast<size_t>(at.frame0) * joints + joint;
+  const size_t k1 = static_cast<size_t>(at.frame1) * joints + joint;
+  Transform t0, t1;
+  t0.rotation = db.local_rotations[k0];
+  t0.translation = db.local_positions[k0];
+  t1.rotation = db.local_rotations[k1];
+  t1.translation = db.local_positions[k1];
+  if (settings_.cubic_playback && at.frame1 != at.frame0) {
+    return transform_hermite(t0, db.local_velocities[k0], db.local_angular_velocities[k0], t1,
+                             db.local_velocities[k1], db.local_angular_velocities[k1],
+                             db.frame_time, at.weight);
+  }
+  return interpolate(t0, t1, at.weight, settings_.interpolation);
+}
+
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
 void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
                                  std::span<glm::vec3> angular_velocities) const {
   const Database& db = *db_;
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
-  const float x = clip_time_ / db.frame_time;
-  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
-  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
-  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
+  const PlaybackPoint at = playback_point();
   const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t k0 = static_cast<size_t>(clip.start + i0) * joints;
-  const size_t k1 = static_cast<size_t>(clip.start + i1) * joints;
+  const size_t k0 = static_cast<size_t>(at.frame0) * joints;
+  const size_t k1 = static_cast<size_t>(at.frame1) * joints;
   for (size_t j = 0; j < joints; ++j) {
-    Transform t0, t1;
-    t0.rotation = db.local_rotations[k0 + j];
-    t0.translation = db.local_positions[k0 + j];
-    t1.rotation = db.local_rotations[k1 + j];
-    t1.translation = db.local_positions[k1 + j];
-    local[j] = interpolate(t0, t1, a, settings_.interpolation);
-    velocities[j] = glm::mix(db.local_velocities[k0 + j], db.local_velocities[k1 + j], a);
-    angular_velocities[j] =
-        glm::mix(db.local_angular_velocities[k0 + j], db.local_angular_velocities[k1 + j], a);
+    local[j] = sample_joint(at, j);
+    velocities[j] = glm::mix(db.local_velocities[k0 + j], db.local_velocities[k1 + j], at.weight);
+    angular_velocities[j] = glm::mix(db.local_angular_velocities[k0 + j],
+                                     db.local_angular_velocities[k1 + j], at.weight);
   }
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
@@ -674,19 +700,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
   const glm::vec3 played_position = position - offsets_.positions[0];
   const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
   // The database root relative to the destination: M = inverse(destination) * root(t).
-  const Database& db = *db_;
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
-  const float x = clip_time_ / db.frame_time;
-  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
-  const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
-  const float a = std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f);
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  Transform t0, t1;
-  t0.rotation = db.local_rotations[static_cast<size_t>(clip.start + i0) * joints];
-  t0.translation = db.local_positions[static_cast<size_t>(clip.start + i0) * joints];
-  t1.rotation = db.local_rotations[static_cast<size_t>(clip.start + i1) * joints];
-  t1.translation = db.local_positions[static_cast<size_t>(clip.start + i1) * joints];
-  const Transform root = interpolate(t0, t1, a, settings_.interpolation);
+  const Transform root = sample_joint(playback_point(), 0);
   const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
   const glm::quat relative_rotation = inverse_destination * root.rotation;
   const glm::vec3 relative_position = inverse_destination * (root.translation - transition_dst_position_);

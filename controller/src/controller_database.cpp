@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "mm/controller/controller.hpp"
+#include "mm/database/idle.hpp"
 
 namespace mm {
 
@@ -99,7 +100,7 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   out->database_ = std::move(database);
   out->options_ = options;
   out->action_tags_ = tag_bit(db, "action");
-  out->idle_tags_ = tag_bit(db, "idle");
+  out->idle_tags_ = tag_bit(db, kIdleTag);
 
   const int excluded = static_cast<int>(std::lround(options.clip_end_exclusion / db.frame_time));
   out->candidates_.assign(db.searchable.begin(), db.searchable.end());

@@ -31,6 +31,7 @@ constexpr FloatField kFloatFields[] = {
     {"replan_velocity_change", &ControllerSettings::replan_velocity_change},
     {"replan_facing_change", &ControllerSettings::replan_facing_change},
     {"clip_end_lookahead", &ControllerSettings::clip_end_lookahead},
+    {"transition_cooldown", &ControllerSettings::transition_cooldown},
     {"inertialization_halflife", &ControllerSettings::inertialization_halflife},
     {"adjustment_halflife", &ControllerSettings::adjustment_halflife},
     {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio},
@@ -50,6 +51,7 @@ constexpr FlagField kFlagFields[] = {
     {"ik_enabled", &ControllerSettings::ik_enabled},
     {"foot_lock_enabled", &ControllerSettings::foot_lock_enabled},
     {"compute_skinning", &ControllerSettings::compute_skinning},
+    {"cubic_playback", &ControllerSettings::cubic_playback},
 };
 
 Error bad_value(std::string_view name, std::string_view value, const char* expected) {

@@ -212,6 +212,32 @@ Transform interpolate(const Transform& a, const Transform& b, float t,
   return transform_nlerp(a, b, t);
 }
 
+Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
+                            const glm::vec3& a_angular_velocity, const Transform& b,
+                            const glm::vec3& b_velocity, const glm::vec3& b_angular_velocity,
+                            float duration, float t) {
+  const float t2 = t * t;
+  const float t3 = t2 * t;
+  const float h00 = 2.0f * t3 - 3.0f * t2 + 1.0f;
+  const float h10 = t3 - 2.0f * t2 + t;
+  const float h01 = -2.0f * t3 + 3.0f * t2;
+  const float h11 = t3 - t2;
+  Transform out;
+  out.translation = h00 * a.translation + h10 * duration * a_velocity + h01 * b.translation +
+                    h11 * duration * b_velocity;
+  out.scale = glm::mix(a.scale, b.scale, t);
+  // Quaternion tangents: dq/dt = 0.5 * (0, w) * q, over the interval.
+  const glm::quat qa = a.rotation;
+  const float sign = glm::dot(a.rotation, b.rotation) < 0.0f ? -1.0f : 1.0f;
+  const glm::quat qb = sign * b.rotation;
+  const glm::quat ta = (0.5f * duration) * (glm::quat(0.0f, a_angular_velocity) * qa);
+  const glm::quat tb = (0.5f * duration) * (glm::quat(0.0f, b_angular_velocity) * qb);
+  const glm::quat q = h00 * qa + h10 * ta + h01 * qb + h11 * tb;
+  const float length = glm::length(q);
+  out.rotation = length > 1e-6f ? q / length : quat_nlerp(a.rotation, b.rotation, t);
+  return out;
+}
+
 void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time,
                  float time, InterpolationMethod method, WrapMode wrap, std::span<Transform> out) {
   assert(joint_count > 0 && frame_time > 0.0f);

@@ -145,9 +145,14 @@ struct ControllerSettings {
   // searches at once.
   float replan_velocity_change = 0.5f;
   float replan_facing_change = 0.35f;
+  // Periodic searches wait this long after a transition (s); sharp changes of the input and
+  // clip ends still search at once.
+  float transition_cooldown = 0.25f;
   // The playing clip is about to end when less than this remains (s): search at once.
   float clip_end_lookahead = 0.1f;
-  // Sampling between database frames.
+  // Sampling between database frames: cubic Hermite through each frame's value and velocity
+  // (smooth at the frames themselves), or else two-point interpolation by `interpolation`.
+  bool cubic_playback = true;
   InterpolationMethod interpolation = InterpolationMethod::Nlerp;
 
   // ---- Transitions.
@@ -287,6 +292,14 @@ class Controller {
   void search(const ControllerInput& input);
   void transition_to(int frame);
   void advance_playback(float dt);
+  // Where playback is: two database frames and the weight of the second.
+  struct PlaybackPoint {
+    int frame0 = 0;
+    int frame1 = 0;
+    float weight = 0.0f;
+  };
+  PlaybackPoint playback_point() const;
+  Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
   void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
                        std::span<glm::vec3> angular_velocities) const;
   void root_motion(float dt);
@@ -329,6 +342,7 @@ class Controller {
   bool stopping_ = false;  // stick released and slow: the idle clip only
   bool stopping_at_search_ = false;
   float search_timer_ = 0.0f;
+  float since_transition_ = 0.0f;
   bool force_search_ = true;
 
   // Playback: the clip and the time since its first frame.

@@ -131,6 +131,19 @@ Transform transform_sclerp(const Transform& a, const Transform& b, float t);
 // Interpolates a to b at t in [0, 1] with the chosen method.
 Transform interpolate(const Transform& a, const Transform& b, float t, InterpolationMethod method);
 
+// Cubic Hermite interpolation of a moving rigid transform between two samples `duration`
+// seconds apart, from their values and first derivatives: translation velocities (m/s) and
+// angular velocities (rad/s, parent frame, dq/dt = 0.5 * (0, w) * q). Translations follow the
+// cubic Hermite curve; rotations follow the Hermite curve of the quaternion's components (its
+// tangent 0.5 * (0, w) * q * duration), normalized, after aligning b with a's hemisphere. Exact
+// at t = 0 and 1; consecutive intervals sharing a sample meet with matching first derivatives,
+// so playback has no velocity kinks at the samples (linear interpolation has one at each).
+// Scale is interpolated linearly.
+Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
+                            const glm::vec3& a_angular_velocity, const Transform& b,
+                            const glm::vec3& b_velocity, const glm::vec3& b_angular_velocity,
+                            float duration, float t);
+
 // Samples a clip at `time` seconds into `out` (joint_count transforms). `frames` holds
 // frame_count * joint_count local transforms, frame-major; frame k is at time k * frame_time.
 // Times exactly on a keyframe copy it; between keyframes the two neighbours are interpolated.
