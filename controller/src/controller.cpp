@@ -70,7 +70,7 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 // Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
 // target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
 // kSoftReach of the leg's length are kept, longer ones approach the full length exponentially.
-constexpr float kSoftReach = 0.9f;
+constexpr float kSoftReach = 0.95f;
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
@@ -140,7 +140,10 @@ Status ControllerSettings::validate() const {
       {"transition_cooldown", transition_cooldown, 0.0f, 10.0f},
       {"inertialization_halflife", inertialization_halflife, 0.0f, 10.0f},
       {"adjustment_halflife", adjustment_halflife, 0.0f, 10.0f},
+      {"simulation_yield_halflife", simulation_yield_halflife, 0.0f, 100.0f},
       {"adjustment_max_velocity_ratio", adjustment_max_velocity_ratio, 0.0f, 100.0f},
+      {"adjustment_max_angular_velocity_ratio", adjustment_max_angular_velocity_ratio, 0.0f,
+       100.0f},
       {"clamp_max_distance", clamp_max_distance, 0.0f, 1e3f},
       {"clamp_max_angle", clamp_max_angle, 0.0f, 4.0f},
       {"foot_unlock_radius", foot_unlock_radius, 0.0f, 10.0f},
@@ -645,6 +648,13 @@ void Controller::synchronize(float dt) {
     case SyncMode::CharacterFollowsSimulation:
       break;
   }
+  // The simulation object gives way to the character a little (position only), so that the
+  // character needs less pulling: pulling a body away from a planted foot is what slides it.
+  if (settings_.simulation_yield_halflife > 0.0f) {
+    glm::vec3 toward = root.translation - sim_position_;
+    toward.y = 0.0f;
+    sim_position_ += toward * pull_fraction(settings_.simulation_yield_halflife, dt);
+  }
   // Pull the character toward the simulation, no faster than a share of its own motion.
   const glm::vec3 velocity = displayed_velocity_;
   const float speed = std::sqrt(velocity.x * velocity.x + velocity.z * velocity.z);
@@ -660,7 +670,7 @@ void Controller::synchronize(float dt) {
 
   const float root_yaw = yaw_of(root.rotation);
   float angle = wrap_angle(yaw_of(sim_rotation_) - root_yaw) * fraction;
-  const float max_angle = settings_.adjustment_max_velocity_ratio * turn_rate * dt;
+  const float max_angle = settings_.adjustment_max_angular_velocity_ratio * turn_rate * dt;
   angle = std::clamp(angle, -max_angle, max_angle);
   float yaw = root_yaw + angle;
 

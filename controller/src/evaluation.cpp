@@ -149,7 +149,8 @@ std::string csv_row(const FrameRecord& r, const glm::vec3* joints, size_t joint_
 
 }  // namespace
 
-double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags) {
+double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags,
+                                 bool cubic) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   std::vector<double> accelerations;
   std::vector<Transform> local(joints), global(joints);
@@ -168,8 +169,17 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
       const size_t k0 = static_cast<size_t>(clip.start + i0) * joints;
       const size_t k1 = static_cast<size_t>(clip.start + i1) * joints;
       for (size_t j = 0; j < joints; ++j) {
-        local[j].rotation = quat_nlerp(db.local_rotations[k0 + j], db.local_rotations[k1 + j], a);
-        local[j].translation = glm::mix(db.local_positions[k0 + j], db.local_positions[k1 + j], a);
+        Transform t0, t1;
+        t0.rotation = db.local_rotations[k0 + j];
+        t0.translation = db.local_positions[k0 + j];
+        t1.rotation = db.local_rotations[k1 + j];
+        t1.translation = db.local_positions[k1 + j];
+        local[j] = cubic && i1 != i0
+                       ? transform_hermite(t0, db.local_velocities[k0 + j],
+                                           db.local_angular_velocities[k0 + j], t1,
+                                           db.local_velocities[k1 + j],
+                                           db.local_angular_velocities[k1 + j], db.frame_time, a)
+                       : transform_nlerp(t0, t1, a);
       }
       forward_kinematics(db.skeleton.parents(), local, global);
       for (size_t j = 0; j < joints; ++j) {
@@ -288,6 +298,14 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
       database_acceleration_p99(db, dt, database->action_tags() | database->idle_tags());
   m.transition_accel_ratio =
       m.database_accel_p99 > 0.0 ? m.transition_accel_p99 / m.database_accel_p99 : 0.0;
+  m.database_accel_p99_same_sampling =
+      options.settings.cubic_playback
+          ? database_acceleration_p99(db, dt, database->action_tags() | database->idle_tags(), true)
+          : m.database_accel_p99;
+  m.transition_accel_ratio_same_sampling =
+      m.database_accel_p99_same_sampling > 0.0
+          ? m.transition_accel_p99 / m.database_accel_p99_same_sampling
+          : 0.0;
 
   result.csv_header = csv_header(db);
   if (options.keep_frames) {

@@ -132,7 +132,7 @@ struct ControllerSettings {
   // ---- Simulation object (halflives as in spring.hpp: a spring at rest closes half the
   // distance to its goal in one halflife).
   float simulation_velocity_halflife = 0.3f;  // s
-  float simulation_rotation_halflife = 0.2f;  // s
+  float simulation_rotation_halflife = 0.15f;  // s
 
   // ---- Matching.
   std::string search_method = "boxtree";  // a name from search_method_names()
@@ -161,9 +161,14 @@ struct ControllerSettings {
   // ---- Synchronization.
   SyncMode sync_mode = SyncMode::CharacterFollowsSimulation;
   float adjustment_halflife = 0.1f;  // s: how fast the character is pulled to the simulation
-  // The pull's speed is at most this ratio of the character's own speed (linear and angular),
-  // so a standing character is never slid.
-  float adjustment_max_velocity_ratio = 1.0f;
+  // With CharacterFollowsSimulation, the simulation object's position is also pulled toward the
+  // character with this halflife (s; 0: never), so that the character is pulled less.
+  float simulation_yield_halflife = 0.15f;
+  // The pull's speed is at most this ratio of the character's own speed, so a standing
+  // character is never slid; and its turning at most this ratio of the character's own turning.
+  // Pulling the body along slides a planted foot, turning it only twists the leg.
+  float adjustment_max_velocity_ratio = 0.3f;
+  float adjustment_max_angular_velocity_ratio = 2.0f;
   // The character never strays farther than this from the simulation (m, radians).
   float clamp_max_distance = 0.4f;
   float clamp_max_angle = 0.6f;

@@ -1,0 +1,203 @@
+// `mm eval` and `mm crowd-bench` as scripts use them: the metric keys, the dump's exact header,
+// determinism, refused scripts and usage errors, and the crowd's thread-count independence.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+#include <nlohmann/json.hpp>
+
+#include "mm/database/database_file.hpp"
+#include "test_support.hpp"
+
+namespace mm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandRun run_mm(const std::string& arguments) {
+  std::string command = "'";
+  command.append(MM_TOOL_PATH).append("' ").append(arguments).append(" 2>&1");
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// A small real database (walks, turns, runs, a wave and the idle clip), built once.
+const fs::path& small_database() {
+  static const fs::path path = [] {
+    const fs::path dir = fs::path(MM_BINARY_DIR) / "test-scratch" / "controller-cli";
+    fs::create_directories(dir);
+    std::string files;
+    for (const char* stem :
+         {"dataset-2_walk_normal_001", "dataset-2_walk_normal_002", "dataset-2_walk_normal_003",
+          "dataset-2_walk-turn-left_normal_001", "dataset-2_walk-turn-right_normal_001",
+          "dataset-2_run_normal_001", "dataset-2_run_normal_002",
+          "dataset-2_wave-left-hand_normal_001"}) {
+      files.append("'").append(test::clip_path(stem).string()).append("' ");
+    }
+    const fs::path db = dir / "small.mmdb";
+    const CommandRun run = run_mm("build " + files + "-o '" + db.string() + "' --quiet");
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return db;
+  }();
+  return path;
+}
+
+fs::path write_script(const fs::path& dir, const std::string& name, const std::string& text) {
+  const fs::path path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* const kScript =
+    "# walk, turn, run, stop\n"
+    "0 0 1 0 0\n"
+    "2 1 0 0 0\n"
+    "4 0 1 0 0 run\n"
+    "6 0 0 0 0\n";
+
+std::string eval_arguments(const fs::path& script, const std::string& extra) {
+  return "eval --db '" + small_database().string() + "' --script '" + script.string() + "' " + extra;
+}
+
+TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  const fs::path json_path = dir / "out.json";
+  const CommandRun run = run_mm(eval_arguments(script, "--json '" + json_path.string() + "'"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
+  for (const char* key :
+       {"foot_skate_cm_s_mean", "foot_skate_cm_s_p95", "root_sim_distance_cm_mean",
+        "root_sim_distance_cm_max", "facing_error_deg_mean", "speed_response_s",
+        "heading_response_s", "stand_root_speed_cm_s_mean", "stand_foot_speed_cm_s_mean",
+        "transitions_per_s", "transition_accel_ratio", "search_us_mean", "update_us_mean"}) {
+    ASSERT_TRUE(json.contains(key)) << key;
+    EXPECT_TRUE(json[key].is_number()) << key;
+    EXPECT_GE(json[key].get<double>(), 0.0) << key;
+    // The terminal shows the same figures under the same names.
+    EXPECT_NE(run.output.find(key), std::string::npos) << key;
+  }
+  EXPECT_LE(json["foot_skate_cm_s_mean"].get<double>(), json["foot_skate_cm_s_p95"].get<double>() + 1e-9);
+  EXPECT_LE(json["root_sim_distance_cm_mean"].get<double>(),
+            json["root_sim_distance_cm_max"].get<double>() + 1e-9);
+  // The script's last line is at 6 s, and the run goes on 2 s past it: 8 s at 60 Hz. The stick
+  // is released for the last 2 s.
+  EXPECT_EQ(json["frames"].get<int>(), 480);
+  EXPECT_GT(json["stand_frames"].get<int>(), 60);
+  EXPECT_GT(json["transitions_per_s"].get<double>(), 0.0);
+}
+
+TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  nlohmann::json runs[2];
+  std::string dumps[2];
+  for (int i = 0; i < 2; ++i) {
+    const fs::path json = dir / ("run" + std::to_string(i) + ".json");
+    const fs::path dump = dir / ("run" + std::to_string(i) + ".csv");
+    const CommandRun run = run_mm(eval_arguments(
+        script, "--dt 0.02 --json '" + json.string() + "' --dump '" + dump.string() + "'"));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    runs[i] = nlohmann::json::parse(read_text(json));
+    dumps[i] = read_text(dump);
+  }
+  EXPECT_EQ(dumps[0], dumps[1]);
+  // Wall-clock timings are the only figures that may differ.
+  for (nlohmann::json& j : runs) {
+    j.erase("search_us_mean");
+    j.erase("update_us_mean");
+  }
+  EXPECT_EQ(runs[0], runs[1]);
+
+  Result<Database> db = load_database(small_database());
+  ASSERT_TRUE(db.ok()) << db.message();
+  std::string header =
+      "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,desired_yaw_deg,"
+      "transition,contact_l,contact_r";
+  for (const std::string& joint : db->skeleton.names()) {
+    header.append(",").append(joint).append("_x,").append(joint).append("_y,").append(joint).append("_z");
+  }
+  std::istringstream lines(dumps[0]);
+  std::string first;
+  std::getline(lines, first);
+  EXPECT_EQ(first, header);
+  int rows = 0;
+  for (std::string line; std::getline(lines, line);) {
+    ++rows;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), std::count(header.begin(), header.end(), ','));
+  }
+  EXPECT_EQ(rows, 400);  // 8 s at dt 0.02
+}
+
+TEST(ControllerCli, EvalRefusesABadScriptLineByFileAndLine) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "bad.txt", "0 0 1 0 0\n1 0 1\n");
+  const CommandRun run = run_mm(eval_arguments(script, ""));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("bad.txt:2:"), std::string::npos) << run.output;
+}
+
+TEST(ControllerCli, EvalUsageErrorsExitWith2) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  for (const std::string& arguments :
+       {std::string("eval --script '") + script.string() + "'", eval_arguments(script, "--ik maybe"),
+        eval_arguments(script, "--dt 0"), eval_arguments(script, "--set warp_speed=9"),
+        eval_arguments(script, "--set inertialization_halflife=-1")}) {
+    const CommandRun run = run_mm(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+  }
+  const CommandRun missing = run_mm(eval_arguments(dir / "none.txt", ""));
+  EXPECT_EQ(missing.exit_code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("none.txt"), std::string::npos) << missing.output;
+}
+
+TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path json_path = dir / "crowd.json";
+  const CommandRun run = run_mm("crowd-bench --db '" + small_database().string() +
+                                "' --characters 24 --seconds 1 --json '" + json_path.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("final positions identical"), std::string::npos) << run.output;
+  const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
+  for (const char* key : {"update_us_mean", "update_us_p99", "search_share",
+                          "max_characters_60hz_1_thread", "max_characters_60hz_2_threads"}) {
+    ASSERT_TRUE(json.contains(key)) << key;
+    EXPECT_GT(json[key].get<double>(), 0.0) << key;
+  }
+  EXPECT_LE(json["search_share"].get<double>(), 1.0);
+  EXPECT_LE(json["update_us_mean"].get<double>(), json["update_us_p99"].get<double>());
+  EXPECT_TRUE(json["same_result_every_thread_count"].get<bool>());
+
+  const CommandRun bad = run_mm("crowd-bench --db '" + small_database().string() + "' --seconds 1");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+}
+
+}  // namespace
+}  // namespace mm
