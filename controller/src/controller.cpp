@@ -180,37 +180,51 @@ Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> 
   c.shared_ = std::move(database);
   c.db_ = &c.shared_->database();
   if (Status s = c.set_settings(settings); !s) return Error{s.message()};
-  const Database& db = *c.db_;
-  const int joints = db.joint_count();
+  if (Status s = c.resolve_schema(); !s) return Error{s.message()};
+  if (Status s = c.resolve_joints(); !s) return Error{s.message()};
+  c.size_buffers();
+  c.start_standing();
+  return c;
+}
 
-  // Trajectory channels: their times and where their columns are.
-  for (size_t i = 0; i < db.schema.channels.size(); ++i) {
-    const FeatureChannel& channel = db.schema.channels[i];
+// The trajectory channels' times and where their columns are.
+Status Controller::resolve_schema() {
+  const FeatureSchema& schema = db_->schema;
+  if (schema.channels.size() > static_cast<size_t>(kMaxDebugChannels)) {
+    return Error{"controller: the schema has more than " + std::to_string(kMaxDebugChannels) +
+                 " channels"};
+  }
+  for (size_t i = 0; i < schema.channels.size(); ++i) {
+    const FeatureChannel& channel = schema.channels[i];
     const bool direction = channel.kind == FeatureKind::TrajectoryDirection;
     if (channel.kind != FeatureKind::TrajectoryPosition && !direction) continue;
-    int column = db.schema.offset(static_cast<int>(i));
+    int column = schema.offset(static_cast<int>(i));
     for (float t : channel.times) {
-      auto it = std::find(c.trajectory_times_.begin(), c.trajectory_times_.end(), t);
-      if (it == c.trajectory_times_.end()) {
-        if (c.trajectory_times_.size() >= ControllerDebug::kMaxTrajectoryPoints) {
+      auto it = std::find(trajectory_times_.begin(), trajectory_times_.end(), t);
+      if (it == trajectory_times_.end()) {
+        if (trajectory_times_.size() >= ControllerDebug::kMaxTrajectoryPoints) {
           return Error{"controller: the schema has more than " +
                        std::to_string(ControllerDebug::kMaxTrajectoryPoints) +
                        " distinct trajectory times"};
         }
-        c.trajectory_times_.push_back(t);
-        it = c.trajectory_times_.end() - 1;
+        trajectory_times_.push_back(t);
+        it = trajectory_times_.end() - 1;
       }
-      c.trajectory_columns_.push_back(
-          {column, static_cast<int>(it - c.trajectory_times_.begin()), direction});
+      trajectory_columns_.push_back({column, static_cast<int>(it - trajectory_times_.begin()),
+                                     direction});
       column += 2;
     }
   }
-  if (db.schema.channels.size() > static_cast<size_t>(kMaxDebugChannels)) {
-    return Error{"controller: the schema has more than " + std::to_string(kMaxDebugChannels) +
-                 " channels"};
-  }
+  debug_.channel_count = static_cast<int>(schema.channels.size());
+  debug_.trajectory_count = static_cast<int>(trajectory_times_.size());
+  std::copy(trajectory_times_.begin(), trajectory_times_.end(), debug_.trajectory_times);
+  return Status::success();
+}
 
-  // Legs: upper leg, lower leg, foot, toe (the toe may be missing: then the foot is held).
+// The legs (upper leg, lower leg, foot, toe; without a toe the foot is held) and the source
+// roots to fold (see sample_playback).
+Status Controller::resolve_joints() {
+  const Database& db = *db_;
   const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
   const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
   for (int side = 0; side < 2; ++side) {
@@ -222,53 +236,58 @@ Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> 
                    "' does not hang from a two-bone leg"};
     }
     const int toe = toes[side] >= 0 && db.skeleton.parent(toes[side]) == foot ? toes[side] : -1;
-    c.leg_joints_[side] = {hip, knee, foot, toe};
+    leg_joints_[side] = {hip, knee, foot, toe};
   }
-
-  for (int j = 1; j < joints; ++j) {
+  for (int j = 1; j < db.joint_count(); ++j) {
     if (db.skeleton.parent(j) == 0 && db.skeleton.subtree_size(j) > 1 && j != db.roles.hips) {
-      c.folded_joints_.push_back(j);
+      folded_joints_.push_back(j);
     }
   }
-  const size_t n = static_cast<size_t>(joints);
-  c.offsets_.resize(joints);
-  for (auto* v : {&c.sampled_, &c.other_, &c.locals_, &c.globals_}) v->resize(n);
-  for (auto* v : {&c.sampled_velocities_, &c.sampled_angular_velocities_, &c.other_velocities_,
-                  &c.other_angular_velocities_}) {
+  return Status::success();
+}
+
+// Every per-joint buffer update() uses, and the inverse bind matrices of the rest pose.
+void Controller::size_buffers() {
+  const Database& db = *db_;
+  const size_t n = static_cast<size_t>(db.joint_count());
+  offsets_.resize(db.joint_count());
+  for (auto* v : {&sampled_, &other_, &locals_, &globals_}) v->resize(n);
+  for (auto* v : {&sampled_velocities_, &sampled_angular_velocities_, &other_velocities_,
+                  &other_angular_velocities_}) {
     v->assign(n, glm::vec3(0.0f));
   }
-  c.skinning_.assign(n, glm::mat4(1.0f));
-  c.query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
+  skinning_.assign(n, glm::mat4(1.0f));
+  query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
   std::vector<Transform> bind(n), inverse_bind(n);
   forward_kinematics(db.skeleton.parents(), db.skeleton.rest(), bind);
   inverse_bind_transforms(bind, inverse_bind);
-  c.inverse_bind_.resize(n);
-  for (size_t j = 0; j < n; ++j) c.inverse_bind_[j] = to_matrix(inverse_bind[j]);
-  c.debug_.channel_count = static_cast<int>(db.schema.channels.size());
-  c.debug_.trajectory_count = static_cast<int>(c.trajectory_times_.size());
-  std::copy(c.trajectory_times_.begin(), c.trajectory_times_.end(), c.debug_.trajectory_times);
+  inverse_bind_.resize(n);
+  for (size_t j = 0; j < n; ++j) inverse_bind_[j] = to_matrix(inverse_bind[j]);
+}
 
-  // Start on the idle clip when there is one, else on the first candidate.
-  const std::span<const uint8_t> candidates = c.shared_->candidates();
+// At the origin facing +Z, on the idle clip when there is one, else on the first candidate.
+void Controller::start_standing() {
+  const std::span<const uint8_t> candidates = shared_->candidates();
   int start = -1;
-  for (const ClipRange& clip : db.clips) {
-    if (!(clip.tags & c.shared_->idle_tags())) continue;
+  for (const ClipRange& clip : db_->clips) {
+    if (!(clip.tags & shared_->idle_tags())) continue;
     for (int f = clip.start; f < clip.end && start < 0; ++f) {
       if (candidates[static_cast<size_t>(f)]) start = f;
     }
   }
-  if (start < 0) start = static_cast<int>(std::find(candidates.begin(), candidates.end(), 1) -
-                                          candidates.begin());
-  c.teleport(glm::vec3(0.0f), 0.0f);
-  c.transition_to(start);
-  c.offsets_.clear();
-  std::copy(c.sampled_.begin(), c.sampled_.end(), c.locals_.begin());
-  c.displayed_velocity_ = c.sampled_velocities_[0];
-  c.predict();
-  c.finish_pose();
-  c.foot_lock(0.0f);
-  mm::skinning_matrices(c.globals_, c.inverse_bind_, c.skinning_);
-  return c;
+  if (start < 0) {
+    start = static_cast<int>(std::find(candidates.begin(), candidates.end(), 1) -
+                             candidates.begin());
+  }
+  teleport(glm::vec3(0.0f), 0.0f);
+  transition_to(start);
+  offsets_.clear();
+  std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
+  displayed_velocity_ = sampled_velocities_[0];
+  predict();
+  finish_pose();
+  foot_lock(0.0f);
+  mm::skinning_matrices(globals_, inverse_bind_, skinning_);
 }
 
 Status Controller::set_settings(const ControllerSettings& settings) {

@@ -288,7 +288,10 @@ class Controller {
 
  private:
   Controller() = default;
-  struct Impl;
+  Status resolve_schema();
+  Status resolve_joints();
+  void size_buffers();
+  void start_standing();
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void predict();
