@@ -70,7 +70,7 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 // Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
 // target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
 // kSoftReach of the leg's length are kept, longer ones approach the full length exponentially.
-constexpr float kSoftReach = 0.95f;
+constexpr float kSoftReach = 0.96f;
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
