@@ -16,6 +16,7 @@
 #include "mm/database/gltf.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
+#include "database_helpers.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -57,22 +58,7 @@ const Built& built() {
   return b;
 }
 
-bool has_tag(const Database& db, const ClipRange& clip, const std::string& tag) {
-  const std::string names[] = {tag};
-  const uint64_t mask = db.tag_mask(names);
-  return mask != 0 && (clip.tags & mask) == mask;
-}
-
-std::vector<Transform> db_globals(const Database& db, int frame) {
-  const int joints = db.joint_count();
-  std::vector<Transform> local(joints), global(joints);
-  for (int j = 0; j < joints; ++j) {
-    local[j].translation = db.local_positions[static_cast<size_t>(frame) * joints + j];
-    local[j].rotation = db.local_rotations[static_cast<size_t>(frame) * joints + j];
-  }
-  forward_kinematics(db.skeleton.parents(), local, global);
-  return global;
-}
+using test::has_tag;
 
 std::vector<Transform> source_globals(const Clip& clip, int frame) {
   std::vector<Transform> global(clip.joint_count());
@@ -159,7 +145,7 @@ TEST(BuilderRealClips, SkeletonRolesAndSimulationRootOnTheGround) {
   for (size_t c = 0; c < 5; ++c) {
     for (int f = 0; f < b.sources[c].frame_count; f += 17) {
       const std::vector<Transform> s = source_globals(b.sources[c], f);
-      const std::vector<Transform> d = db_globals(db, db.clips[c].start + f);
+      const std::vector<Transform> d = test::frame_globals(db, db.clips[c].start + f);
       for (int j = 0; j < 22; ++j) {
         EXPECT_NEAR(glm::distance(s[j].translation, d[j + 1].translation), 0.0f, 1e-4f);
       }

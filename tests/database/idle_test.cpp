@@ -18,6 +18,7 @@
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
+#include "database_helpers.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -229,22 +230,8 @@ const Built& built() {
   return b;
 }
 
-bool has_tag(const Database& db, const ClipRange& clip, const std::string& tag) {
-  const std::string names[] = {tag};
-  const uint64_t mask = db.tag_mask(names);
-  return mask != 0 && (clip.tags & mask) == mask;
-}
-
-std::vector<Transform> globals(const Database& db, int frame) {
-  const int joints = db.joint_count();
-  std::vector<Transform> local(joints), global(joints);
-  for (int j = 0; j < joints; ++j) {
-    local[j].translation = db.local_positions[static_cast<size_t>(frame) * joints + j];
-    local[j].rotation = db.local_rotations[static_cast<size_t>(frame) * joints + j];
-  }
-  forward_kinematics(db.skeleton.parents(), local, global);
-  return global;
-}
+using test::has_tag;
+constexpr auto globals = test::frame_globals;
 
 // The database frame the report names.
 int reported_source_frame(const Database& db, const BuildReport& report) {

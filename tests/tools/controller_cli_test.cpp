@@ -3,17 +3,16 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 #include <nlohmann/json.hpp>
 
 #include "mm/database/database_file.hpp"
+#include "run_tool.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -21,24 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CommandRun run_mm(const std::string& arguments) {
-  std::string command = "'";
-  command.append(MM_TOOL_PATH).append("' ").append(arguments).append(" 2>&1");
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using test::CommandRun;
+using test::run_mm;
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "controller_options.hpp"
 #include "database_summary.hpp"
 #include "mm/controller/evaluation.hpp"
-#include "mm/database/database_file.hpp"
 
 namespace mm::cli {
 namespace {
@@ -78,12 +78,7 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       if (!v || (*v != "on" && *v != "off")) return usage_error("--ik needs on or off");
       out.options.settings.ik_enabled = *v == "on";
     } else if (a == "--set") {
-      const std::string* v = value();
-      const size_t equals = v ? v->find('=') : std::string::npos;
-      if (equals == std::string::npos) return usage_error("--set needs NAME=VALUE");
-      if (Status s = set_controller_setting(out.options.settings, v->substr(0, equals),
-                                            v->substr(equals + 1));
-          !s) {
+      if (Status s = apply_set_option(value(), out.options.settings); !s) {
         return usage_error(s.message());
       }
     } else {
@@ -174,13 +169,8 @@ int run_eval(const std::vector<std::string>& args) {
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
   arguments.options.keep_frames = !arguments.dump_path.empty();
 
-  Result<Database> loaded = load_database(arguments.db);
-  if (!loaded) {
-    std::fprintf(stderr, "mm eval: %s\n", loaded.message().c_str());
-    return 1;
-  }
-  Result<std::shared_ptr<const ControllerDatabase>> shared = ControllerDatabase::create(
-      std::make_shared<const Database>(std::move(loaded).value()));
+  Result<std::shared_ptr<const ControllerDatabase>> shared =
+      load_controller_database(arguments.db);
   if (!shared) {
     std::fprintf(stderr, "mm eval: %s\n", shared.message().c_str());
     return 1;
