@@ -340,7 +340,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   desired_motion(input);
   search_timer_ += dt;
   since_transition_ += dt;
-  if (should_search(input)) search(input);
+  if (should_search()) search();
   advance_playback(dt);
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
   inertialize_update(offsets_,
@@ -407,7 +407,7 @@ uint64_t Controller::resolve_tag(std::string_view tag) const {
   return bits;
 }
 
-bool Controller::should_search(const ControllerInput&) const {
+bool Controller::should_search() const {
   if (force_search_) return true;
   // Periodic searches wait a little after a transition: the query keeps drifting while the
   // simulation settles, and a jump every interval would make every transition chain into the
@@ -456,35 +456,10 @@ void Controller::build_query() {
   }
 }
 
-void Controller::search(const ControllerInput&) {
+void Controller::search() {
   const auto start = std::chrono::steady_clock::now();
   build_query();
-  const Database& db = *db_;
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
-  const int frame = std::clamp(clip.start + static_cast<int>(std::floor(clip_time_ / db.frame_time)),
-                               clip.start, clip.end - 1);
-  SearchConstraints constraints;
-  constraints.current_frame = frame;
-  constraints.window_frames = static_cast<int>(std::lround(settings_.ignore_window / db.frame_time));
-  constraints.transition_cost = settings_.transition_cost;
-
-  SearchResult best;
-  if (tag_bits_ != 0) {
-    // Any of the requested tags will do: one search per tag, the cheapest wins.
-    for (int bit = 0; bit < 64; ++bit) {
-      if (!(tag_bits_ & (uint64_t{1} << bit))) continue;
-      constraints.include_tags = uint64_t{1} << bit;
-      const SearchResult r = searcher_->search(query_, constraints);
-      if (r.frame >= 0 && (r.cost < best.cost || (r.cost == best.cost && r.continuation))) best = r;
-    }
-  } else if (stopping_) {
-    constraints.include_tags = shared_->idle_tags();
-    best = searcher_->search(query_, constraints);
-  } else {
-    constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
-    best = searcher_->search(query_, constraints);
-  }
-
+  const SearchResult best = search_candidates();
   if (best.frame >= 0 && !best.continuation) transition_to(best.frame);
 
   force_search_ = false;
@@ -493,7 +468,45 @@ void Controller::search(const ControllerInput&) {
   desired_rotation_at_search_ = desired_rotation_;
   tag_bits_at_search_ = tag_bits_;
   stopping_at_search_ = stopping_;
+  record_search(best);
+  debug_.search_seconds =
+      std::chrono::duration<float>(std::chrono::steady_clock::now() - start).count();
+}
 
+// The best frame for the query among the candidates the moment allows: clips carrying a
+// requested tag, the idle clip while stopping, locomotion otherwise.
+SearchResult Controller::search_candidates() const {
+  const Database& db = *db_;
+  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  SearchConstraints constraints;
+  constraints.current_frame = std::clamp(
+      clip.start + static_cast<int>(std::floor(clip_time_ / db.frame_time)), clip.start,
+      clip.end - 1);
+  constraints.window_frames =
+      static_cast<int>(std::lround(settings_.ignore_window / db.frame_time));
+  constraints.transition_cost = settings_.transition_cost;
+  if (tag_bits_ == 0) {
+    if (stopping_) {
+      constraints.include_tags = shared_->idle_tags();
+    } else {
+      constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
+    }
+    return searcher_->search(query_, constraints);
+  }
+  // Any of the requested tags will do: one search per tag, the cheapest wins.
+  SearchResult best;
+  for (int bit = 0; bit < 64; ++bit) {
+    if (!(tag_bits_ & (uint64_t{1} << bit))) continue;
+    constraints.include_tags = uint64_t{1} << bit;
+    const SearchResult r = searcher_->search(query_, constraints);
+    if (r.frame >= 0 && (r.cost < best.cost || (r.cost == best.cost && r.continuation))) best = r;
+  }
+  return best;
+}
+
+// The search's answer in the debug state: the query, the cost and its per-channel breakdown.
+void Controller::record_search(const SearchResult& best) {
+  const Database& db = *db_;
   ++debug_.searches;
   debug_.searched = true;
   debug_.last_best_frame = best.frame;
@@ -501,20 +514,18 @@ void Controller::search(const ControllerInput&) {
   const int shown = std::min(static_cast<int>(query_.size()), ControllerDebug::kMaxQueryDims);
   debug_.query_dims = shown;
   std::copy(query_.begin(), query_.begin() + shown, debug_.last_query);
-  if (best.frame >= 0) {
-    const float* row = db.features.data() + static_cast<size_t>(best.frame) * query_.size();
-    for (size_t ch = 0; ch < db.schema.channels.size(); ++ch) {
-      const int first = db.schema.offset(static_cast<int>(ch));
-      const int count = db.schema.channels[ch].dims();
-      float sum = 0.0f;
-      for (int k = first; k < first + count; ++k) {
-        const float d = query_[static_cast<size_t>(k)] - row[k];
-        sum += d * d;
-      }
-      debug_.last_channel_costs[ch] = sum;
+  if (best.frame < 0) return;
+  const float* row = db.features.data() + static_cast<size_t>(best.frame) * query_.size();
+  for (size_t ch = 0; ch < db.schema.channels.size(); ++ch) {
+    const int first = db.schema.offset(static_cast<int>(ch));
+    const int count = db.schema.channels[ch].dims();
+    float sum = 0.0f;
+    for (int k = first; k < first + count; ++k) {
+      const float d = query_[static_cast<size_t>(k)] - row[k];
+      sum += d * d;
     }
+    debug_.last_channel_costs[ch] = sum;
   }
-  debug_.search_seconds = std::chrono::duration<float>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Jumps to a database frame. The outgoing pose is what plays now (sampled_); the incoming one is

@@ -295,9 +295,11 @@ class Controller {
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void predict();
-  bool should_search(const ControllerInput& input) const;
+  bool should_search() const;
   void build_query();
-  void search(const ControllerInput& input);
+  void search();
+  SearchResult search_candidates() const;
+  void record_search(const SearchResult& best);
   void transition_to(int frame);
   void advance_playback(float dt);
   // Where playback is: two database frames and the weight of the second.
