@@ -21,6 +21,12 @@ namespace {
 const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
 // A foot released during a contact locks again once its easing offset is this small (m).
 constexpr float kRelockOffset = 0.01f;
+// Standing, a held toe farther than this (m) from where the idle pose puts it steps there.
+constexpr float kSettleDistance = 0.08f;
+// A settling step lifts the toe by this share of the distance still to go, at most kStepHeight
+// (m): it rises as it leaves and lands as it arrives.
+constexpr float kStepLift = 0.5f;
+constexpr float kStepHeight = 0.08f;
 const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
 
 bool finite(const glm::vec3& v) {
@@ -781,73 +787,95 @@ void Controller::finish_pose() {
 // clamped. A lock ends when the contact ends or the animation drags the toe beyond the unlock
 // radius; the foot then eases back onto the animation through a decaying offset.
 void Controller::foot_lock(float dt) {
-  const std::span<const int> parents = db_->skeleton.parents();
+  // Standing on the idle clip, feet still held where the last steps left them take a step
+  // each, one at a time, into the idle pose.
+  const bool settling =
+      stopping_ && (db_->clips[static_cast<size_t>(clip_)].tags & shared_->idle_tags()) != 0;
   for (int side = 0; side < 2; ++side) {
     const std::vector<int>& leg = leg_joints_[side];
-    const int hip = leg[0], knee = leg[1], foot = leg[2], toe = leg[3];
-    const int effector = toe >= 0 ? toe : foot;
+    const int effector = leg[3] >= 0 ? leg[3] : leg[2];
     const glm::vec3 animated = globals_[static_cast<size_t>(effector)].translation;
-    FootLock& f = feet_[side];
-    const bool contact = debug_.contact[side];
     if (!settings_.ik_enabled || !settings_.foot_lock_enabled) {
-      f = FootLock{};
+      feet_[side] = FootLock{};
       debug_.locked[side] = false;
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
-    const glm::vec3 animated_velocity =
-        f.has_previous && dt > 0.0f ? (animated - f.previous_animated) / dt : glm::vec3(0.0f);
-    f.previous_animated = animated;
-    if (!f.has_previous) {
-      f.target = animated;
-      f.has_previous = true;
-    }
-    // The target is the lock point or the animated toe, plus an offset that decays after a
-    // release and keeps the target's position and velocity continuous there. A lock starts
-    // where the toe is, at once: easing it to rest would be a slide on the ground.
-    if (contact && !f.locked && (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
-      // A lock starts with a contact, or once a foot released during one (dragged away) has
-      // eased back onto the animation.
-      f.locked = true;
-      f.position = f.target;
-      f.offset = f.offset_velocity = glm::vec3(0.0f);
-    } else if (f.locked) {
-      glm::vec3 drag = animated - f.position;
-      drag.y = 0.0f;
-      if (!contact || glm::length(drag) > settings_.foot_unlock_radius) {
-        f.locked = false;
-        f.offset = f.target - animated;
-        f.offset_velocity = glm::vec3(0.0f);
-      }
-    }
-    f.previous_contact = contact;
-    critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
-                           settings_.foot_lock_release_halflife, dt);
-    const glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
-    f.target = target;
-    f.target_velocity = (f.locked ? glm::vec3(0.0f) : animated_velocity) + f.offset_velocity;
-    debug_.locked[side] = f.locked;
-    debug_.lock_position[side] = f.position;
+    const glm::vec3 target = foot_target(side, animated, settling, dt);
+    debug_.locked[side] = feet_[side].locked;
+    debug_.lock_position[side] = feet_[side].position;
     debug_.ik_target[side] = target;
-    if (glm::length(target - animated) < 1e-5f) continue;
-
-    // Reach: the ankle goes where the animated foot rotation puts it above the target toe.
-    const glm::quat foot_rotation = globals_[static_cast<size_t>(foot)].rotation;
-    const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
-    glm::vec3 ankle_target = target - (animated - globals_[static_cast<size_t>(foot)].translation);
-    ankle_target = hip_position + soft_reach(ankle_target - hip_position, leg_length(side));
-    // The knee bends toward where it points now; a nearly straight leg has no such direction
-    // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
-    // so the character's forward breaks the tie.
-    const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
-                           0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
-                           kKneeForwardBias * (globals_[0].rotation * kForward);
-    apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
-    locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
-        glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
-    refresh_subtree(foot);
-    restore_leg_lengths(side, target);
+    // A stepping foot is in the air, whatever the playing frame says.
+    debug_.contact[side] = debug_.contact[side] && !feet_[side].stepping;
+    if (glm::length(target - animated) >= 1e-5f) reach(side, animated, target);
   }
+}
+
+// Where one foot's toe goes this update: the lock point, or the animated toe plus an offset
+// that decays after a release and keeps the target continuous there. A lock starts where the
+// toe is, at once (easing it to rest would be a slide on the ground), when a contact begins or
+// once a foot released during one has eased back onto the animation.
+glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool settling, float dt) {
+  FootLock& f = feet_[side];
+  const bool contact = debug_.contact[side];
+  const glm::vec3 animated_velocity =
+      f.has_previous && dt > 0.0f ? (animated - f.previous_animated) / dt : glm::vec3(0.0f);
+  f.previous_animated = animated;
+  if (!f.has_previous) {
+    f.target = animated;
+    f.has_previous = true;
+  }
+  if (contact && !f.locked && !f.stepping &&
+      (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
+    f.locked = true;
+    f.position = f.target;
+    f.offset = f.offset_velocity = glm::vec3(0.0f);
+  } else if (f.locked) {
+    glm::vec3 drag = animated - f.position;
+    drag.y = 0.0f;
+    const bool step = settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
+    if (!contact || glm::length(drag) > settings_.foot_unlock_radius || step) {
+      f.locked = false;
+      f.stepping = step;
+      f.offset = f.target - animated;
+      f.offset_velocity = glm::vec3(0.0f);
+    }
+  }
+  f.previous_contact = contact;
+  critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
+                         settings_.foot_lock_release_halflife, dt);
+  glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
+  f.target = target;
+  f.target_velocity = (f.locked ? glm::vec3(0.0f) : animated_velocity) + f.offset_velocity;
+  if (f.stepping) {
+    // The foot rises with the distance it still has to go and lands as it arrives.
+    target.y += std::min(kStepHeight, kStepLift * std::hypot(f.offset.x, f.offset.z));
+    if (glm::length(f.offset) < kRelockOffset) f.stepping = false;
+  }
+  return target;
+}
+
+// Two-bone IK of one leg toward a toe target, then the bone lengths restored.
+void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& target) {
+  const std::span<const int> parents = db_->skeleton.parents();
+  const std::vector<int>& leg = leg_joints_[side];
+  const int hip = leg[0], knee = leg[1], foot = leg[2];
+  // Reach: the ankle goes where the animated foot rotation puts it above the target toe.
+  const glm::quat foot_rotation = globals_[static_cast<size_t>(foot)].rotation;
+  const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
+  glm::vec3 ankle_target = target - (animated - globals_[static_cast<size_t>(foot)].translation);
+  ankle_target = hip_position + soft_reach(ankle_target - hip_position, leg_length(side));
+  // The knee bends toward where it points now; a nearly straight leg has no such direction
+  // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
+  // so the character's forward breaks the tie.
+  const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
+                         0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
+                         kKneeForwardBias * (globals_[0].rotation * kForward);
+  apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
+  locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
+      glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
+  refresh_subtree(foot);
+  restore_leg_lengths(side, target);
 }
 
 // Distance-constraint relaxation over the leg's joints (hip pinned, the held toe pinned), then

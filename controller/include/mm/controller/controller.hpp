@@ -244,7 +244,7 @@ struct ControllerDebug {
   float last_query[kMaxQueryDims] = {};  // normalized; the first kMaxQueryDims columns
 
   // Feet: 0 left, 1 right.
-  bool contact[2] = {false, false};     // the database's contact of the playing frame
+  bool contact[2] = {false, false};     // the playing frame's contact, false while stepping
   bool locked[2] = {false, false};      // the toe is held by the foot lock
   glm::vec3 lock_position[2] = {};      // where a locked toe is held
   glm::vec3 ik_target[2] = {};          // where IK put the toe (equals the animation when free)
@@ -316,6 +316,8 @@ class Controller {
   void synchronize(float dt);
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
+  glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
+  void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side, const glm::vec3& target);
   void refresh_subtree(int joint);
   float leg_length(int side) const;  // upper plus lower leg (m)  // globals of a joint and its descendants from the locals
@@ -392,6 +394,7 @@ class Controller {
     glm::vec3 previous_animated{0.0f};  // the animated toe last update
     bool has_previous = false;
     bool previous_contact = false;
+    bool stepping = false;  // released to step into the idle pose: in the air until it lands
   };
   FootLock feet_[2];
 
