@@ -127,7 +127,7 @@ struct ControllerSettings {
   float stick_deadzone = 0.2f;
   // Stopping: when the stick is released and the simulation object is slower than this (m/s),
   // only the database's idle clip is matched (the data has no stops of its own).
-  float stop_speed = 0.5f;
+  float stop_speed = 0.8f;
 
   // ---- Simulation object (halflives as in spring.hpp: a spring at rest closes half the
   // distance to its goal in one halflife).
