@@ -833,10 +833,12 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   } else if (f.locked) {
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
-    const bool step = settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
-    if (!contact || glm::length(drag) > settings_.foot_unlock_radius || step) {
+    const bool settle = settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
+    const bool dragged = glm::length(drag) > settings_.foot_unlock_radius;
+    if (!contact || dragged || settle) {
+      // A foot that has to move while its frame says "contact" steps there rather than slides.
       f.locked = false;
-      f.stepping = step;
+      f.stepping = contact && (settle || dragged);
       f.offset = f.target - animated;
       f.offset_velocity = glm::vec3(0.0f);
     }
