@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -30,10 +31,12 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
-// A small real database (walks, turns, runs, a wave and the idle clip), built once.
+// A small real database (walks, turns, runs, a wave and the idle clip), built once per test
+// program. ctest runs every test as its own process, in parallel: each gets its own folder.
 const fs::path& small_database() {
   static const fs::path path = [] {
-    const fs::path dir = fs::path(MM_BINARY_DIR) / "test-scratch" / "controller-cli";
+    const fs::path dir = fs::path(MM_BINARY_DIR) / "test-scratch" /
+                         ("controller-cli-" + std::to_string(getpid()));
     fs::create_directories(dir);
     std::string files;
     for (const char* stem :
@@ -43,6 +46,14 @@ const fs::path& small_database() {
           "dataset-2_wave-left-hand_normal_001"}) {
       files.append("'").append(test::clip_path(stem).string()).append("' ");
     }
+    // Removed when the test program exits.
+    static const struct Cleanup {
+      fs::path dir;
+      ~Cleanup() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+      }
+    } cleanup{dir};
     const fs::path db = dir / "small.mmdb";
     const CommandRun run = run_mm("build " + files + "-o '" + db.string() + "' --quiet");
     EXPECT_EQ(run.exit_code, 0) << run.output;
