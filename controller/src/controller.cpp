@@ -27,6 +27,9 @@ constexpr float kSettleDistance = 0.08f;
 // (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 0.5f;
 constexpr float kStepHeight = 0.08f;
+// A held toe farther than this share of the leg's length from the hip (through the animated
+// foot) steps rather than being dragged: past full length, since soft reach still bends it.
+constexpr float kStepReach = 1.03f;
 const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
 
 bool finite(const glm::vec3& v) {
@@ -834,7 +837,13 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
     const bool settle = settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
-    const bool dragged = glm::length(drag) > settings_.foot_unlock_radius;
+    // Beyond the leg's reach (softened, see soft_reach) the held toe would be dragged along the
+    // ground anyway.
+    const std::vector<int>& leg = leg_joints_[side];
+    const glm::vec3 ankle = globals_[static_cast<size_t>(leg[2])].translation;
+    const glm::vec3 hip = globals_[static_cast<size_t>(leg[0])].translation;
+    const bool out_of_reach = glm::length(f.position - (animated - ankle) - hip) > kStepReach * leg_length(side);
+    const bool dragged = glm::length(drag) > settings_.foot_unlock_radius || out_of_reach;
     if (!contact || dragged || settle) {
       // A foot that has to move while its frame says "contact" steps there rather than slides.
       f.locked = false;

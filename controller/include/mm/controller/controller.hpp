@@ -176,7 +176,8 @@ struct ControllerSettings {
   // ---- Foot locking and IK.
   bool ik_enabled = true;        // false: the animation's feet as they are
   bool foot_lock_enabled = true; // hold a foot's toe where it landed while in contact
-  // A locked toe is released when the animation drags it farther than this (m).
+  // A locked toe is released when the animation drags it farther than this (m), or out of the
+  // leg's reach; during a contact it then steps (lifted) to the animation.
   float foot_unlock_radius = 0.5f;
   // A released foot eases back onto the animation with this halflife (s).
   float foot_lock_release_halflife = 0.1f;
