@@ -27,6 +27,8 @@ constexpr float kSettleDistance = 0.08f;
 // (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 0.5f;
 constexpr float kStepHeight = 0.08f;
+// Halflife (s) of the lift's spring: short beside a step, long beside a frame.
+constexpr float kLiftHalflife = 0.06f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
 // foot) steps rather than being dragged: past full length, since soft reach still bends it.
 constexpr float kStepReach = 1.03f;
@@ -858,10 +860,14 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
   f.target = target;
   f.target_velocity = (f.locked ? glm::vec3(0.0f) : animated_velocity) + f.offset_velocity;
-  if (f.stepping) {
-    // The foot rises with the distance it still has to go and lands as it arrives.
-    target.y += std::min(kStepHeight, kStepLift * std::hypot(f.offset.x, f.offset.z));
-    if (glm::length(f.offset) < kRelockOffset) f.stepping = false;
+  // A stepping foot rises with the distance it still has to go and lands as it arrives; the
+  // lift itself follows that height on a spring, so the foot leaves the ground smoothly.
+  const float lift_goal =
+      f.stepping ? std::min(kStepHeight, kStepLift * std::hypot(f.offset.x, f.offset.z)) : 0.0f;
+  critical_spring_update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
+  target.y += f.lift;
+  if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset) {
+    f.stepping = false;
   }
   return target;
 }

@@ -395,7 +395,9 @@ class Controller {
     glm::vec3 previous_animated{0.0f};  // the animated toe last update
     bool has_previous = false;
     bool previous_contact = false;
-    bool stepping = false;  // released to step into the idle pose: in the air until it lands
+    bool stepping = false;  // released during a contact: stepping, in the air until it lands
+    float lift = 0.0f;      // the step's height above the target (m), and its rate
+    float lift_velocity = 0.0f;
   };
   FootLock feet_[2];
 
