@@ -892,14 +892,15 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
       glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
   refresh_subtree(foot);
-  restore_leg_lengths(side, target);
+  restore_leg_lengths(side);
 }
 
-// Distance-constraint relaxation over the leg's joints (hip pinned, the held toe pinned), then
-// each bone turned to point at its relaxed child. After an exact two-bone solve the constraints
-// already hold and nothing moves; when the solve was clamped at full reach the knee and ankle
-// share the shortfall instead of the toe leaving the ground target alone.
-void Controller::restore_leg_lengths(int side, const glm::vec3& target) {
+// Distance-constraint relaxation over the leg's joints with the hip pinned, then each bone
+// turned to point at its relaxed child: the leg keeps the bone lengths of the pose being played
+// (actors differ, so not the skeleton's rest lengths). After an exact two-bone solve the
+// constraints already hold and nothing moves; it is the safety net for a solve that could not
+// keep them (a degenerate or clamped chain).
+void Controller::restore_leg_lengths(int side) {
   const std::vector<int>& leg = leg_joints_[side];
   const int count = leg[3] >= 0 ? 4 : 3;
   const std::span<const int> parents = db_->skeleton.parents();
@@ -907,13 +908,12 @@ void Controller::restore_leg_lengths(int side, const glm::vec3& target) {
   DistanceConstraint constraints[3];
   for (int i = 0; i < count; ++i) points[i] = globals_[static_cast<size_t>(leg[i])].translation;
   for (int i = 0; i + 1 < count; ++i) {
-    const float rest = glm::length(db_->skeleton.rest(leg[i + 1]).translation);
+    const float rest = glm::length(locals_[static_cast<size_t>(leg[i + 1])].translation);
     constraints[i] = {i, i + 1, rest, i == 0 ? 0.0f : 1.0f, 1.0f};
   }
   const float before = max_distance_constraint_error({points, static_cast<size_t>(count)},
                                                      {constraints, static_cast<size_t>(count - 1)});
   if (before < 1e-4f || settings_.bone_length_iterations == 0) return;
-  (void)target;
   relax_distance_constraints({points, static_cast<size_t>(count)},
                              {constraints, static_cast<size_t>(count - 1)},
                              settings_.bone_length_iterations);
@@ -933,10 +933,11 @@ void Controller::restore_leg_lengths(int side, const glm::vec3& target) {
   }
 }
 
+// The leg's length in the pose being played (actors' legs differ between takes).
 float Controller::leg_length(int side) const {
   const std::vector<int>& leg = leg_joints_[side];
-  return glm::length(db_->skeleton.rest(leg[1]).translation) +
-         glm::length(db_->skeleton.rest(leg[2]).translation);
+  return glm::length(locals_[static_cast<size_t>(leg[1])].translation) +
+         glm::length(locals_[static_cast<size_t>(leg[2])].translation);
 }
 
 void Controller::refresh_subtree(int joint) {

@@ -286,6 +286,78 @@ TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
   EXPECT_GT(horizontal_speed(c.root_transform().translation, before_last, kDt), 0.3f);
 }
 
+// Over a walk with turns: the mean horizontal speed of a toe on frames where the controller
+// holds it locked (now and the frame before), and the largest change of a leg bone's length.
+struct LockRun {
+  double locked_toe_speed = 0.0;
+  int locked_frames = 0;
+  double contact_toe_speed = 0.0;  // the same over frames in contact (the skating measure)
+  float bone_length_error = 0.0f;
+};
+
+LockRun locked_toes(const ControllerSettings& settings) {
+  Controller c = make(settings);
+  const Database& db = c.controller_database().database();
+  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
+  LockRun run;
+  double sum = 0.0, contact_sum = 0.0;
+  int contact_frames = 0;
+  glm::vec3 previous[2];
+  bool was_locked[2] = {false, false};
+  bool was_in_contact[2] = {false, false};
+  for (int i = 0; i < 900; ++i) {
+    c.update(kDt, push_toward(static_cast<float>((i / 150) * 60)));
+    const std::span<const Transform> g = c.global_transforms();
+    for (int side = 0; side < 2; ++side) {
+      const glm::vec3 toe = g[static_cast<size_t>(toes[side])].translation;
+      if (was_locked[side] && c.debug().locked[side]) {
+        sum += horizontal_speed(toe, previous[side], kDt);
+        ++run.locked_frames;
+      }
+      if (was_in_contact[side] && c.debug().contact[side]) {
+        contact_sum += horizontal_speed(toe, previous[side], kDt);
+        ++contact_frames;
+      }
+      previous[side] = toe;
+      // Upper and lower leg keep the lengths of the pose being played.
+      const int foot = feet[side];
+      const int knee = db.skeleton.parent(foot);
+      const int hip = db.skeleton.parent(knee);
+      const std::span<const Transform> l = c.local_transforms();
+      const float upper = glm::length(g[static_cast<size_t>(knee)].translation -
+                                      g[static_cast<size_t>(hip)].translation);
+      const float lower = glm::length(g[static_cast<size_t>(foot)].translation -
+                                      g[static_cast<size_t>(knee)].translation);
+      run.bone_length_error =
+          std::max({run.bone_length_error,
+                    std::abs(upper - glm::length(l[static_cast<size_t>(knee)].translation)),
+                    std::abs(lower - glm::length(l[static_cast<size_t>(foot)].translation))});
+    }
+    for (int side = 0; side < 2; ++side) {
+      was_locked[side] = c.debug().locked[side];
+      was_in_contact[side] = c.debug().contact[side];
+    }
+  }
+  run.locked_toe_speed = run.locked_frames ? sum / run.locked_frames : 0.0;
+  run.contact_toe_speed = contact_frames ? contact_sum / contact_frames : 0.0;
+  return run;
+}
+
+TEST(ControllerTest, LockedFeetStayPutAndLegsKeepTheirLength) {
+  const LockRun locked = locked_toes(ControllerSettings{});
+  EXPECT_GT(locked.locked_frames, 300);
+  EXPECT_LT(locked.locked_toe_speed, 0.01);  // m/s
+  EXPECT_LT(locked.contact_toe_speed, 0.02);
+  EXPECT_LT(locked.bone_length_error, 1e-4f);
+  // The same run with IK off: the animation's own toes slide in contact, so the test can tell.
+  ControllerSettings off;
+  off.ik_enabled = false;
+  const LockRun free = locked_toes(off);
+  EXPECT_EQ(free.locked_frames, 0);
+  EXPECT_GT(free.contact_toe_speed, 0.05);
+}
+
 TEST(ControllerTest, TagRequestPlaysTaggedClipsThenLocomotionResumes) {
   Controller c = make();
   const auto shared = normal_controller_database();

@@ -319,9 +319,9 @@ class Controller {
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
-  void restore_leg_lengths(int side, const glm::vec3& target);
+  void restore_leg_lengths(int side);
   void refresh_subtree(int joint);
-  float leg_length(int side) const;  // upper plus lower leg (m)  // globals of a joint and its descendants from the locals
+  float leg_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of a joint and its descendants from the locals
   void finish_pose();
   uint64_t resolve_tag(std::string_view tag) const;
 
