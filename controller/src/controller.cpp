@@ -23,7 +23,7 @@ const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
 constexpr float kRelockOffset = 0.01f;
 // Standing, a held toe farther than this (m) from where the idle pose puts it steps there.
 constexpr float kSettleDistance = 0.08f;
-// A settling step lifts the toe by this share of the distance still to go, at most kStepHeight
+// A step lifts the toe by this share of the distance it still has to go, at most kStepHeight
 // (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 0.5f;
 constexpr float kStepHeight = 0.08f;
