@@ -7,12 +7,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "mm/database/feature_extraction.hpp"
 #include "mm/runtime/constraints.hpp"
 #include "mm/runtime/ik.hpp"
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
+#include "playback.hpp"
 
 namespace mm {
 
@@ -44,19 +44,6 @@ bool finite(const glm::quat& q) {
 }
 
 glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
-
-// The yaw (radians, about +Y) of a rotation's forward axis: atan2(forward.x, forward.z).
-float yaw_of(const glm::quat& q) {
-  const glm::vec3 f = q * kForward;
-  return std::atan2(f.x, f.z);
-}
-
-// The angle in (-pi, pi] equal to `a` modulo 2 pi.
-float wrap_angle(float a) {
-  a = std::fmod(a + glm::pi<float>(), glm::two_pi<float>());
-  if (a < 0.0f) a += glm::two_pi<float>();
-  return a - glm::pi<float>();
-}
 
 // A stick with non-finite axes zeroed, scaled back onto the unit disc, and zero inside the
 // dead zone (outside it the magnitude is rescaled so it still reaches 1).
@@ -296,9 +283,7 @@ void Controller::start_standing() {
   std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
   displayed_velocity_ = sampled_velocities_[0];
   predict();
-  finish_pose();
-  foot_lock(0.0f);
-  mm::skinning_matrices(globals_, inverse_bind_, skinning_);
+  refresh_outputs(0.0f);
 }
 
 Status Controller::set_settings(const ControllerSettings& settings) {
@@ -329,10 +314,12 @@ void Controller::teleport(const glm::vec3& position, float yaw) {
   offsets_.clear();
   for (FootLock& f : feet_) f = FootLock{};
   if (clip_ >= 0) {
+    // Without offsets the displayed pose is the played one, then placed.
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
+    std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
     move_root(sim_position_, rotation);
     predict();
-    finish_pose();
+    refresh_outputs(0.0f);
   } else {
     transition_src_position_ = sim_position_;
     transition_src_rotation_ = rotation;
@@ -366,6 +353,12 @@ void Controller::update(float dt, const ControllerInput& input) {
   simulate(dt);
   synchronize(dt);
   predict();
+  refresh_outputs(dt);
+}
+
+// Forward kinematics, the feet, the skinning matrices: everything read back after an update
+// (or a teleport or adjustment) from the local pose.
+void Controller::refresh_outputs(float dt) {
   finish_pose();
   foot_lock(dt);
   if (settings_.compute_skinning) mm::skinning_matrices(globals_, inverse_bind_, skinning_);
@@ -436,9 +429,7 @@ bool Controller::should_search() const {
       settings_.replan_facing_change) {
     return true;
   }
-  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
-  const float remaining = static_cast<float>(clip.frame_count() - 1) * db_->frame_time - clip_time_;
-  return remaining < settings_.clip_end_lookahead;
+  return clip_duration() - clip_time_ < settings_.clip_end_lookahead;
 }
 
 // The query: the playing frame's own pose features (interpolated between its two frames), with
@@ -488,11 +479,8 @@ void Controller::search() {
 // requested tag, the idle clip while stopping, locomotion otherwise.
 SearchResult Controller::search_candidates() const {
   const Database& db = *db_;
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
   SearchConstraints constraints;
-  constraints.current_frame = std::clamp(
-      clip.start + static_cast<int>(std::floor(clip_time_ / db.frame_time)), clip.start,
-      clip.end - 1);
+  constraints.current_frame = playback_point().frame0;
   constraints.window_frames =
       static_cast<int>(std::lround(settings_.ignore_window / db.frame_time));
   constraints.transition_cost = settings_.transition_cost;
@@ -569,9 +557,14 @@ void Controller::transition_to(int frame) {
   std::swap(sampled_angular_velocities_, other_angular_velocities_);
 }
 
-void Controller::advance_playback(float dt) {
+// Seconds from the playing clip's first frame to its last.
+float Controller::clip_duration() const {
   const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
-  const float end = static_cast<float>(clip.frame_count() - 1) * db_->frame_time;
+  return static_cast<float>(clip.frame_count() - 1) * db_->frame_time;
+}
+
+void Controller::advance_playback(float dt) {
+  const float end = clip_duration();
   clip_time_ = std::min(clip_time_ + dt, end);
   if (clip_time_ >= end) force_search_ = true;
 }
@@ -588,21 +581,8 @@ Controller::PlaybackPoint Controller::playback_point() const {
 // and velocities (no velocity kink where one frame interval meets the next), or the chosen
 // two-point interpolation.
 Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const {
-  const Database& db = *db_;
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t k0 = static_cast<size_t>(at.frame0) * joints + joint;
-  const size_t k1 = static_cast<size_t>(at.frame1) * joints + joint;
-  Transform t0, t1;
-  t0.rotation = db.local_rotations[k0];
-  t0.translation = db.local_positions[k0];
-  t1.rotation = db.local_rotations[k1];
-  t1.translation = db.local_positions[k1];
-  if (settings_.cubic_playback && at.frame1 != at.frame0) {
-    return transform_hermite(t0, db.local_velocities[k0], db.local_angular_velocities[k0], t1,
-                             db.local_velocities[k1], db.local_angular_velocities[k1],
-                             db.frame_time, at.weight);
-  }
-  return interpolate(t0, t1, at.weight, settings_.interpolation);
+  return detail::sample_database_joint(*db_, at.frame0, at.frame1, at.weight, joint,
+                                       settings_.cubic_playback, settings_.interpolation);
 }
 
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root
@@ -684,7 +664,7 @@ void Controller::synchronize(float dt) {
       return;
     case SyncMode::SimulationFollowsCharacter:
       sim_position_ = glm::vec3(root.translation.x, 0.0f, root.translation.z);
-      sim_rotation_ = yaw_rotation(yaw_of(root.rotation));
+      sim_rotation_ = yaw_rotation(quat_yaw(root.rotation));
       return;
     case SyncMode::CharacterFollowsSimulation:
       break;
@@ -709,8 +689,8 @@ void Controller::synchronize(float dt) {
   if (glm::length(step) > max_step) step *= max_step / glm::length(step);
   glm::vec3 position = root.translation + step;
 
-  const float root_yaw = yaw_of(root.rotation);
-  float angle = wrap_angle(yaw_of(sim_rotation_) - root_yaw) * fraction;
+  const float root_yaw = quat_yaw(root.rotation);
+  float angle = wrap_angle(quat_yaw(sim_rotation_) - root_yaw) * fraction;
   const float max_angle = settings_.adjustment_max_angular_velocity_ratio * turn_rate * dt;
   angle = std::clamp(angle, -max_angle, max_angle);
   float yaw = root_yaw + angle;
@@ -722,9 +702,9 @@ void Controller::synchronize(float dt) {
   if (distance > settings_.clamp_max_distance) {
     position = sim_position_ + away * (settings_.clamp_max_distance / distance);
   }
-  const float yaw_error = wrap_angle(yaw - yaw_of(sim_rotation_));
+  const float yaw_error = wrap_angle(yaw - quat_yaw(sim_rotation_));
   if (std::abs(yaw_error) > settings_.clamp_max_angle) {
-    yaw = yaw_of(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
+    yaw = quat_yaw(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
   }
   position.y = root.translation.y;
   if (position == root.translation && yaw == root_yaw) return;
@@ -739,9 +719,7 @@ void Controller::adjust_root(const glm::vec3& position, const glm::quat& rotatio
   move_root(position, glm::normalize(rotation));
   // The feet go with the body: held toes would otherwise pull the legs back.
   for (FootLock& f : feet_) f = FootLock{};
-  finish_pose();
-  foot_lock(0.0f);
-  if (settings_.compute_skinning) mm::skinning_matrices(globals_, inverse_bind_, skinning_);
+  refresh_outputs(0.0f);
 }
 
 void Controller::move_root(const glm::vec3& position, const glm::quat& rotation) {
@@ -823,12 +801,9 @@ void Controller::foot_lock(float dt) {
 glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool settling, float dt) {
   FootLock& f = feet_[side];
   const bool contact = debug_.contact[side];
-  const glm::vec3 animated_velocity =
-      f.has_previous && dt > 0.0f ? (animated - f.previous_animated) / dt : glm::vec3(0.0f);
-  f.previous_animated = animated;
-  if (!f.has_previous) {
+  if (!f.has_target) {
     f.target = animated;
-    f.has_previous = true;
+    f.has_target = true;
   }
   if (contact && !f.locked && !f.stepping &&
       (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
@@ -859,7 +834,6 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
                          settings_.foot_lock_release_halflife, dt);
   glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
   f.target = target;
-  f.target_velocity = (f.locked ? glm::vec3(0.0f) : animated_velocity) + f.offset_velocity;
   // A stepping foot rises with the distance it still has to go and lands as it arrives; the
   // lift itself follows that height on a spring, so the foot leaves the ground smoothly.
   const float lift_goal =

@@ -9,23 +9,11 @@
 
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
+#include "playback.hpp"
 
 namespace mm {
 
 namespace {
-
-const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
-
-float yaw_of(const glm::quat& q) {
-  const glm::vec3 f = q * kForward;
-  return std::atan2(f.x, f.z);
-}
-
-float yaw_difference(float a, float b) {
-  float d = std::fmod(a - b + glm::pi<float>(), glm::two_pi<float>());
-  if (d < 0.0f) d += glm::two_pi<float>();
-  return d - glm::pi<float>();
-}
 
 float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
   return std::hypot(a.x - b.x, a.z - b.z);
@@ -100,14 +88,14 @@ void measure_responses(const std::vector<FrameRecord>& frames, float dt, Evaluat
         speed_start = -1;
       }
     }
-    if (std::abs(yaw_difference(r.desired_yaw, frames[f - 1].desired_yaw)) >= kHeadingEventAngle) {
+    if (std::abs(wrap_angle(r.desired_yaw - frames[f - 1].desired_yaw)) >= kHeadingEventAngle) {
       if (heading_start >= 0) ++m.heading_events;
       heading_start = static_cast<int>(f);
       heading_to = r.desired_yaw;
     }
     if (heading_start >= 0) {
       heading_to = r.desired_yaw;  // a turn that keeps going is followed to its end
-      if (std::abs(yaw_difference(r.root_yaw, heading_to)) <= glm::radians(10.0f)) {
+      if (std::abs(wrap_angle(r.root_yaw - heading_to)) <= glm::radians(10.0f)) {
         heading_times.push_back((static_cast<double>(f) - heading_start) * dt);
         ++m.heading_events;
         heading_start = -1;
@@ -166,20 +154,9 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
       const int i0 = std::min(static_cast<int>(std::floor(x)), clip.frame_count() - 1);
       const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
       const float a = x - static_cast<float>(i0);
-      const size_t k0 = static_cast<size_t>(clip.start + i0) * joints;
-      const size_t k1 = static_cast<size_t>(clip.start + i1) * joints;
       for (size_t j = 0; j < joints; ++j) {
-        Transform t0, t1;
-        t0.rotation = db.local_rotations[k0 + j];
-        t0.translation = db.local_positions[k0 + j];
-        t1.rotation = db.local_rotations[k1 + j];
-        t1.translation = db.local_positions[k1 + j];
-        local[j] = cubic && i1 != i0
-                       ? transform_hermite(t0, db.local_velocities[k0 + j],
-                                           db.local_angular_velocities[k0 + j], t1,
-                                           db.local_velocities[k1 + j],
-                                           db.local_angular_velocities[k1 + j], db.frame_time, a)
-                       : transform_nlerp(t0, t1, a);
+        local[j] = detail::sample_database_joint(db, clip.start + i0, clip.start + i1, a, j,
+                                                 cubic, InterpolationMethod::Nlerp);
       }
       forward_kinematics(db.skeleton.parents(), local, global);
       for (size_t j = 0; j < joints; ++j) {
@@ -225,11 +202,11 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     FrameRecord& r = frames[f];
     r.t = t;
     r.sim_position = d.simulation_position;
-    r.sim_yaw = yaw_of(d.simulation_rotation);
+    r.sim_yaw = quat_yaw(d.simulation_rotation);
     r.root_position = controller.root_transform().translation;
-    r.root_yaw = yaw_of(controller.root_transform().rotation);
+    r.root_yaw = quat_yaw(controller.root_transform().rotation);
     r.desired_velocity = d.desired_velocity;
-    r.desired_yaw = yaw_of(d.desired_rotation);
+    r.desired_yaw = quat_yaw(d.desired_rotation);
     r.transition = d.transitioned;
     r.contact[0] = d.contact[0];
     r.contact[1] = d.contact[1];
@@ -252,7 +229,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   for (size_t f = 0; f < frame_count; ++f) {
     const FrameRecord& r = frames[f];
     distance.push_back(100.0 * horizontal_distance(r.root_position, r.sim_position));
-    facing.push_back(std::abs(glm::degrees(yaw_difference(r.root_yaw, r.sim_yaw))));
+    facing.push_back(std::abs(glm::degrees(wrap_angle(r.root_yaw - r.sim_yaw))));
     updates.push_back(r.update_seconds * 1e6);
     if (r.searched) searches.push_back(r.search_seconds * 1e6);
     transitions += r.transition ? 1 : 0;

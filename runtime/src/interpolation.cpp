@@ -212,6 +212,17 @@ Transform interpolate(const Transform& a, const Transform& b, float t,
   return transform_nlerp(a, b, t);
 }
 
+float quat_yaw(const glm::quat& q) {
+  const glm::vec3 forward = q * glm::vec3(0.0f, 0.0f, 1.0f);
+  return std::atan2(forward.x, forward.z);
+}
+
+float wrap_angle(float angle) {
+  float a = std::fmod(angle + glm::pi<float>(), glm::two_pi<float>());
+  if (a < 0.0f) a += glm::two_pi<float>();
+  return a - glm::pi<float>();
+}
+
 Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
                             const glm::vec3& a_angular_velocity, const Transform& b,
                             const glm::vec3& b_velocity, const glm::vec3& b_angular_velocity,

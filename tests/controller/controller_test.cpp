@@ -36,17 +36,6 @@ bool finite_pose(const Controller& c) {
   return true;
 }
 
-float yaw_of(const glm::quat& q) {
-  const glm::vec3 f = q * glm::vec3(0.0f, 0.0f, 1.0f);
-  return std::atan2(f.x, f.z);
-}
-
-float yaw_difference(float a, float b) {
-  float d = std::fmod(a - b + glm::pi<float>(), glm::two_pi<float>());
-  if (d < 0.0f) d += glm::two_pi<float>();
-  return d - glm::pi<float>();
-}
-
 TEST(ControllerSettingsTest, EveryInvalidFieldIsNamed) {
   ControllerSettings s;
   EXPECT_TRUE(s.validate().ok());
@@ -227,7 +216,8 @@ TEST(ControllerTest, RootAdjustmentKeepsTransitionSourceAndDestinationConsistent
   EXPECT_LT(quat_angle_between(adjusted.root_transform().rotation, requested_rotation), 1e-4f);
 
   // Every later frame: the adjusted root moves exactly as the twin's, turned by the adjustment.
-  const float turn = yaw_difference(yaw_of(requested_rotation), yaw_of(twin.root_transform().rotation));
+  const float turn =
+      wrap_angle(quat_yaw(requested_rotation) - quat_yaw(twin.root_transform().rotation));
   const glm::quat turn_rotation = glm::angleAxis(turn, glm::vec3(0.0f, 1.0f, 0.0f));
   const glm::vec3 twin_start = twin.root_transform().translation;
   for (int i = 0; i < 20; ++i) {
@@ -236,8 +226,8 @@ TEST(ControllerTest, RootAdjustmentKeepsTransitionSourceAndDestinationConsistent
     ASSERT_FALSE(adjusted.debug().searched);
     const glm::vec3 expected = requested + turn_rotation * (twin.root_transform().translation - twin_start);
     EXPECT_LT(glm::length(adjusted.root_transform().translation - expected), 1e-4f) << i;
-    EXPECT_NEAR(yaw_difference(yaw_of(adjusted.root_transform().rotation),
-                               yaw_of(twin.root_transform().rotation)),
+    EXPECT_NEAR(wrap_angle(quat_yaw(adjusted.root_transform().rotation) -
+                           quat_yaw(twin.root_transform().rotation)),
                 turn, 1e-4f);
   }
 }

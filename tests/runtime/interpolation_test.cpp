@@ -495,5 +495,72 @@ TEST(SamplePose, SingleFrameClip) {
   }
 }
 
+// ---- Heading -----------------------------------------------------------------------------
+
+TEST(QuatYaw, HeadingOfYawRotationsAndWrapping) {
+  for (float yaw : {0.0f, 0.5f, -1.2f, 3.0f, -3.0f}) {
+    EXPECT_NEAR(quat_yaw(glm::angleAxis(yaw, kUp)), yaw, 1e-5f) << yaw;
+  }
+  // A pitch or roll on top of the yaw does not change where the forward axis points on the
+  // ground, as long as it does not tip it past vertical.
+  const glm::quat tilted = glm::angleAxis(0.7f, kUp) * glm::angleAxis(0.3f, glm::vec3(1, 0, 0));
+  EXPECT_NEAR(quat_yaw(tilted), 0.7f, 1e-5f);
+  EXPECT_NEAR(wrap_angle(2.0f * kPi + 0.25f), 0.25f, 1e-5f);
+  EXPECT_NEAR(wrap_angle(-2.0f * kPi - 0.25f), -0.25f, 1e-5f);
+  EXPECT_NEAR(wrap_angle(3.0f * kPi / 2.0f), -kPi / 2.0f, 1e-5f);
+  for (float a : {-100.0f, -4.0f, 0.0f, 3.1f, 7.0f, 1e4f}) {
+    const float w = wrap_angle(a);
+    EXPECT_GE(w, -kPi);
+    EXPECT_LT(w, kPi);
+    EXPECT_NEAR(std::remainder(a - w, 2.0f * kPi), 0.0f, 1e-2f) << a;
+  }
+}
+
+// ---- Cubic Hermite -----------------------------------------------------------------------
+
+TEST(TransformHermite, ExactAtTheEndsAndFollowsTheDerivatives) {
+  Transform a, b;
+  a.rotation = glm::angleAxis(0.3f, glm::normalize(glm::vec3(1, 2, 0)));
+  a.translation = glm::vec3(0.1f, 0.9f, -0.2f);
+  const glm::vec3 va(1.0f, 0.2f, 0.0f), wa(0.0f, 2.0f, 0.5f);
+  const glm::vec3 wb(0.3f, -1.0f, 0.0f), vb(0.8f, -0.1f, 0.3f);
+  const float duration = 1.0f / 30.0f;
+  // b is where a moves in one interval at its own rates, so the curve is nearly that motion.
+  b.rotation = glm::normalize(quat_from_scaled_angle_axis(wa * duration) * a.rotation);
+  b.translation = a.translation + va * duration;
+  // b's sign flipped must give the same curve (q and -q are one rotation).
+  Transform b_flipped = b;
+  b_flipped.rotation = -b.rotation;
+  EXPECT_TRUE(same_rotation(transform_hermite(a, va, wa, b, vb, wb, duration, 0.0f).rotation,
+                            a.rotation, 1e-6f));
+  EXPECT_TRUE(same_rotation(transform_hermite(a, va, wa, b, vb, wb, duration, 1.0f).rotation,
+                            b.rotation, 1e-6f));
+  EXPECT_TRUE(near_vec3(transform_hermite(a, va, wa, b, vb, wb, duration, 1.0f).translation,
+                        b.translation, 1e-6f));
+  for (float t : {0.25f, 0.5f, 0.75f}) {
+    EXPECT_TRUE(same_rotation(transform_hermite(a, va, wa, b, vb, wb, duration, t).rotation,
+                              transform_hermite(a, va, wa, b_flipped, vb, wb, duration, t).rotation,
+                              1e-6f));
+  }
+  // The translation's derivative at the start is the given velocity (not the chord's).
+  const float h = 1e-3f;
+  const glm::vec3 slope = (transform_hermite(a, va, wa, b, vb, wb, duration, h).translation -
+                           a.translation) / (h * duration);
+  EXPECT_TRUE(near_vec3(slope, va, 2e-2f));
+  // The rotation's rate at the start is the given angular velocity.
+  const glm::quat early = transform_hermite(a, va, wa, b, vb, wb, duration, h).rotation;
+  const glm::vec3 rate = quat_to_scaled_angle_axis(early * glm::conjugate(a.rotation)) /
+                         (h * duration);
+  EXPECT_TRUE(near_vec3(rate, wa, 2e-2f));
+  // Linear interpolation would have the chord's slope instead: the test tells them apart when
+  // the velocity is not the chord's.
+  Transform c = b;
+  c.translation = a.translation + glm::vec3(0.0f, 0.0f, 0.05f);
+  const glm::vec3 other = (transform_hermite(a, va, wa, c, vb, wb, duration, h).translation -
+                           a.translation) / (h * duration);
+  EXPECT_TRUE(near_vec3(other, va, 2e-2f));
+  EXPECT_FALSE(near_vec3(other, (c.translation - a.translation) / duration, 0.1f));
+}
+
 }  // namespace
 }  // namespace mm

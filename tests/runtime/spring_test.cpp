@@ -369,5 +369,34 @@ TEST(SpringCharacter, PredictMatchesRk4AndRepeatedUpdates) {
   EXPECT_TRUE(near_vec3(pa[3], sa, 1e-4f));
 }
 
+TEST(CriticalSpring, PrecomputedStepEqualsTheUpdate) {
+  for (float halflife : {0.0f, 0.05f, 0.3f, 2.0f}) {
+    for (float dt : {1.0f / 144.0f, 1.0f / 30.0f, 0.5f}) {
+      const CriticalSpringStep step = critical_spring_step(halflife, dt);
+      glm::vec3 x1(0.3f, -1.0f, 2.0f), v1(4.0f, 0.5f, -0.2f), x2 = x1, v2 = v1;
+      const glm::vec3 goal(1.0f, 0.0f, -1.0f);
+      critical_spring_update(x1, v1, goal, halflife, dt);
+      critical_spring_apply(x2, v2, goal, step);
+      EXPECT_EQ(x1, x2) << halflife << " " << dt;
+      EXPECT_EQ(v1, v2) << halflife << " " << dt;
+      EXPECT_NE(x1, glm::vec3(0.3f, -1.0f, 2.0f));  // it did move
+    }
+  }
+  // Steps that must not move: dt <= 0, non-finite dt or halflife; and a non-finite goal.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (const CriticalSpringStep& step :
+       {critical_spring_step(0.1f, 0.0f), critical_spring_step(0.1f, -1.0f),
+        critical_spring_step(nan, 0.1f), critical_spring_step(0.1f, nan)}) {
+    EXPECT_FALSE(step.moves);
+    glm::vec3 x(1.0f), v(2.0f);
+    critical_spring_apply(x, v, glm::vec3(0.0f), step);
+    EXPECT_EQ(x, glm::vec3(1.0f));
+    EXPECT_EQ(v, glm::vec3(2.0f));
+  }
+  glm::vec3 x(1.0f), v(2.0f);
+  critical_spring_apply(x, v, glm::vec3(nan), critical_spring_step(0.1f, 0.1f));
+  EXPECT_EQ(x, glm::vec3(1.0f));
+}
+
 }  // namespace
 }  // namespace mm

@@ -302,6 +302,7 @@ class Controller {
   SearchResult search_candidates() const;
   void record_search(const SearchResult& best);
   void transition_to(int frame);
+  float clip_duration() const;
   void advance_playback(float dt);
   // Where playback is: two database frames and the weight of the second.
   struct PlaybackPoint {
@@ -323,6 +324,7 @@ class Controller {
   void refresh_subtree(int joint);
   float leg_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of a joint and its descendants from the locals
   void finish_pose();
+  void refresh_outputs(float dt);
   uint64_t resolve_tag(std::string_view tag) const;
 
   std::shared_ptr<const ControllerDatabase> shared_;
@@ -390,10 +392,8 @@ class Controller {
     glm::vec3 position{0.0f};        // the held toe position
     glm::vec3 offset{0.0f};          // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
-    glm::vec3 target{0.0f};          // the toe's target last update, and its velocity
-    glm::vec3 target_velocity{0.0f};
-    glm::vec3 previous_animated{0.0f};  // the animated toe last update
-    bool has_previous = false;
+    glm::vec3 target{0.0f};          // the toe's target last update (without a step's lift)
+    bool has_target = false;
     bool previous_contact = false;
     bool stepping = false;  // released during a contact: stepping, in the air until it lands
     float lift = 0.0f;      // the step's height above the target (m), and its rate

@@ -44,6 +44,13 @@ glm::quat quat_from_scaled_angle_axis(const glm::vec3& scaled_angle_axis);
 // The angle in radians, in [0, pi], of the shortest rotation taking a to b.
 float quat_angle_between(const glm::quat& a, const glm::quat& b);
 
+// The heading of a rotation: the yaw (radians, about +Y) of where it takes the forward axis +Z,
+// atan2(forward.x, forward.z). A forward axis along +Y or -Y gives 0.
+float quat_yaw(const glm::quat& q);
+
+// The angle in [-pi, pi) equal to `angle` modulo 2 pi (a non-finite angle stays non-finite).
+float wrap_angle(float angle);
+
 // The shortest rotation taking direction `from` to direction `to` (neither needs unit length).
 // Opposite directions give a half turn about an axis perpendicular to `from`; a zero vector
 // gives identity.
