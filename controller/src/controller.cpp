@@ -111,64 +111,6 @@ bool parse_sync_mode(std::string_view name, SyncMode& mode) {
   return false;
 }
 
-Status ControllerSettings::validate() const {
-  struct Field {
-    const char* name;
-    float value;
-    float min;
-    float max;
-  };
-  const Field fields[] = {
-      {"walk_speed_forward", walk_speed_forward, 0.0f, 20.0f},
-      {"walk_speed_sideways", walk_speed_sideways, 0.0f, 20.0f},
-      {"walk_speed_backward", walk_speed_backward, 0.0f, 20.0f},
-      {"run_speed_forward", run_speed_forward, 0.0f, 20.0f},
-      {"run_speed_sideways", run_speed_sideways, 0.0f, 20.0f},
-      {"run_speed_backward", run_speed_backward, 0.0f, 20.0f},
-      {"stick_deadzone", stick_deadzone, 0.0f, 0.9f},
-      {"stop_speed", stop_speed, 0.0f, 20.0f},
-      {"simulation_velocity_halflife", simulation_velocity_halflife, 0.0f, 10.0f},
-      {"simulation_rotation_halflife", simulation_rotation_halflife, 0.0f, 10.0f},
-      {"search_interval", search_interval, 0.0f, 10.0f},
-      {"transition_cost", transition_cost, 0.0f, 1e6f},
-      {"ignore_window", ignore_window, 0.0f, 10.0f},
-      {"replan_velocity_change", replan_velocity_change, 0.0f, 100.0f},
-      {"replan_facing_change", replan_facing_change, 0.0f, 10.0f},
-      {"clip_end_lookahead", clip_end_lookahead, 0.0f, 10.0f},
-      {"transition_cooldown", transition_cooldown, 0.0f, 10.0f},
-      {"inertialization_halflife", inertialization_halflife, 0.0f, 10.0f},
-      {"adjustment_halflife", adjustment_halflife, 0.0f, 10.0f},
-      {"simulation_yield_halflife", simulation_yield_halflife, 0.0f, 100.0f},
-      {"adjustment_max_velocity_ratio", adjustment_max_velocity_ratio, 0.0f, 100.0f},
-      {"adjustment_max_angular_velocity_ratio", adjustment_max_angular_velocity_ratio, 0.0f,
-       100.0f},
-      {"clamp_max_distance", clamp_max_distance, 0.0f, 1e3f},
-      {"clamp_max_angle", clamp_max_angle, 0.0f, 4.0f},
-      {"foot_unlock_radius", foot_unlock_radius, 0.0f, 10.0f},
-      {"foot_lock_release_halflife", foot_lock_release_halflife, 0.0f, 10.0f},
-      {"max_dt", max_dt, 1e-4f, 10.0f},
-  };
-  for (const Field& f : fields) {
-    if (!std::isfinite(f.value) || f.value < f.min || f.value > f.max) {
-      return Error{std::string("controller settings: ") + f.name + " must be a number in [" +
-                   std::to_string(f.min) + ", " + std::to_string(f.max) + "], found " +
-                   std::to_string(f.value)};
-    }
-  }
-  if (bone_length_iterations < 0 || bone_length_iterations > 100) {
-    return Error{"controller settings: bone_length_iterations must be in [0, 100], found " +
-                 std::to_string(bone_length_iterations)};
-  }
-  const auto names = search_method_names();
-  if (std::find(names.begin(), names.end(), search_method) == names.end()) {
-    std::string list;
-    for (std::string_view n : names) list.append(list.empty() ? "" : ", ").append(n);
-    return Error{"controller settings: unknown search method '" + search_method + "' (one of " +
-                 list + ")"};
-  }
-  return Status::success();
-}
-
 // ---- Creation --------------------------------------------------------------------------------
 
 Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> database,

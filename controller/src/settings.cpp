@@ -1,6 +1,9 @@
-// Settings by name, for command lines (mm eval --set) and live tuning panels.
+// Settings by name, for command lines (mm eval --set) and live tuning panels, and their
+// validation: both read one table of the fields.
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <string>
 
 #include "mm/controller/controller.hpp"
@@ -9,40 +12,46 @@ namespace mm {
 
 namespace {
 
+// Every float setting once: its name, where it lives and the range validate() accepts.
 struct FloatField {
   const char* name;
   float ControllerSettings::*member;
+  float min;
+  float max;
 };
 
 constexpr FloatField kFloatFields[] = {
-    {"walk_speed_forward", &ControllerSettings::walk_speed_forward},
-    {"walk_speed_sideways", &ControllerSettings::walk_speed_sideways},
-    {"walk_speed_backward", &ControllerSettings::walk_speed_backward},
-    {"run_speed_forward", &ControllerSettings::run_speed_forward},
-    {"run_speed_sideways", &ControllerSettings::run_speed_sideways},
-    {"run_speed_backward", &ControllerSettings::run_speed_backward},
-    {"stick_deadzone", &ControllerSettings::stick_deadzone},
-    {"stop_speed", &ControllerSettings::stop_speed},
-    {"simulation_velocity_halflife", &ControllerSettings::simulation_velocity_halflife},
-    {"simulation_rotation_halflife", &ControllerSettings::simulation_rotation_halflife},
-    {"search_interval", &ControllerSettings::search_interval},
-    {"transition_cost", &ControllerSettings::transition_cost},
-    {"ignore_window", &ControllerSettings::ignore_window},
-    {"replan_velocity_change", &ControllerSettings::replan_velocity_change},
-    {"replan_facing_change", &ControllerSettings::replan_facing_change},
-    {"clip_end_lookahead", &ControllerSettings::clip_end_lookahead},
-    {"transition_cooldown", &ControllerSettings::transition_cooldown},
-    {"inertialization_halflife", &ControllerSettings::inertialization_halflife},
-    {"adjustment_halflife", &ControllerSettings::adjustment_halflife},
-    {"simulation_yield_halflife", &ControllerSettings::simulation_yield_halflife},
-    {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio},
+    {"walk_speed_forward", &ControllerSettings::walk_speed_forward, 0.0f, 20.0f},
+    {"walk_speed_sideways", &ControllerSettings::walk_speed_sideways, 0.0f, 20.0f},
+    {"walk_speed_backward", &ControllerSettings::walk_speed_backward, 0.0f, 20.0f},
+    {"run_speed_forward", &ControllerSettings::run_speed_forward, 0.0f, 20.0f},
+    {"run_speed_sideways", &ControllerSettings::run_speed_sideways, 0.0f, 20.0f},
+    {"run_speed_backward", &ControllerSettings::run_speed_backward, 0.0f, 20.0f},
+    {"stick_deadzone", &ControllerSettings::stick_deadzone, 0.0f, 0.9f},
+    {"stop_speed", &ControllerSettings::stop_speed, 0.0f, 20.0f},
+    {"simulation_velocity_halflife", &ControllerSettings::simulation_velocity_halflife, 0.0f,
+     10.0f},
+    {"simulation_rotation_halflife", &ControllerSettings::simulation_rotation_halflife, 0.0f,
+     10.0f},
+    {"search_interval", &ControllerSettings::search_interval, 0.0f, 10.0f},
+    {"transition_cost", &ControllerSettings::transition_cost, 0.0f, 1e6f},
+    {"ignore_window", &ControllerSettings::ignore_window, 0.0f, 10.0f},
+    {"replan_velocity_change", &ControllerSettings::replan_velocity_change, 0.0f, 100.0f},
+    {"replan_facing_change", &ControllerSettings::replan_facing_change, 0.0f, 10.0f},
+    {"clip_end_lookahead", &ControllerSettings::clip_end_lookahead, 0.0f, 10.0f},
+    {"transition_cooldown", &ControllerSettings::transition_cooldown, 0.0f, 10.0f},
+    {"inertialization_halflife", &ControllerSettings::inertialization_halflife, 0.0f, 10.0f},
+    {"adjustment_halflife", &ControllerSettings::adjustment_halflife, 0.0f, 10.0f},
+    {"simulation_yield_halflife", &ControllerSettings::simulation_yield_halflife, 0.0f, 100.0f},
+    {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio, 0.0f,
+     100.0f},
     {"adjustment_max_angular_velocity_ratio",
-     &ControllerSettings::adjustment_max_angular_velocity_ratio},
-    {"clamp_max_distance", &ControllerSettings::clamp_max_distance},
-    {"clamp_max_angle", &ControllerSettings::clamp_max_angle},
-    {"foot_unlock_radius", &ControllerSettings::foot_unlock_radius},
-    {"foot_lock_release_halflife", &ControllerSettings::foot_lock_release_halflife},
-    {"max_dt", &ControllerSettings::max_dt},
+     &ControllerSettings::adjustment_max_angular_velocity_ratio, 0.0f, 100.0f},
+    {"clamp_max_distance", &ControllerSettings::clamp_max_distance, 0.0f, 1e3f},
+    {"clamp_max_angle", &ControllerSettings::clamp_max_angle, 0.0f, 4.0f},
+    {"foot_unlock_radius", &ControllerSettings::foot_unlock_radius, 0.0f, 10.0f},
+    {"foot_lock_release_halflife", &ControllerSettings::foot_lock_release_halflife, 0.0f, 10.0f},
+    {"max_dt", &ControllerSettings::max_dt, 1e-4f, 10.0f},
 };
 
 struct FlagField {
@@ -63,6 +72,29 @@ Error bad_value(std::string_view name, std::string_view value, const char* expec
 }
 
 }  // namespace
+
+Status ControllerSettings::validate() const {
+  for (const FloatField& f : kFloatFields) {
+    const float value = this->*f.member;
+    if (!std::isfinite(value) || value < f.min || value > f.max) {
+      return Error{std::string("controller settings: ") + f.name + " must be a number in [" +
+                   std::to_string(f.min) + ", " + std::to_string(f.max) + "], found " +
+                   std::to_string(value)};
+    }
+  }
+  if (bone_length_iterations < 0 || bone_length_iterations > 100) {
+    return Error{"controller settings: bone_length_iterations must be in [0, 100], found " +
+                 std::to_string(bone_length_iterations)};
+  }
+  const auto names = search_method_names();
+  if (std::find(names.begin(), names.end(), search_method) == names.end()) {
+    std::string list;
+    for (std::string_view n : names) list.append(list.empty() ? "" : ", ").append(n);
+    return Error{"controller settings: unknown search method '" + search_method + "' (one of " +
+                 list + ")"};
+  }
+  return Status::success();
+}
 
 Status set_controller_setting(ControllerSettings& settings, std::string_view name,
                               std::string_view value) {
