@@ -189,6 +189,49 @@ void sample_field(Grid& grid, std::span<const Capsule> capsules, float blend) {
   }
 }
 
+// A grid face whose corners alternate inside/outside around it (the surface grazing the face,
+// cutting it twice) would make the edge between its two cells shared by four quads. Moving the
+// corner nearest the surface across it, to just on the other side, leaves two crossings; a
+// flip can make a neighbouring face ambiguous, so passes repeat until none is left (bounded,
+// in case flips chase each other). The vertices are projected onto the true surface later,
+// so the shape does not change, only which cells it is taken to pass through.
+void resolve_ambiguous_faces(Grid& grid) {
+  const glm::ivec3 n = grid.points;
+  for (int pass = 0; pass < 16; ++pass) {
+    int flips = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      glm::ivec3 eu(0), ev(0);
+      eu[(axis + 1) % 3] = 1;
+      ev[(axis + 2) % 3] = 1;
+      const glm::ivec3 end = n - eu - ev;
+      for (int k = 0; k < end.z; ++k) {
+        for (int j = 0; j < end.y; ++j) {
+          for (int i = 0; i < end.x; ++i) {
+            const glm::ivec3 p(i, j, k);
+            const std::array<size_t, 4> c = {grid.index(p.x, p.y, p.z),
+                                             grid.index(p.x + eu.x, p.y + eu.y, p.z + eu.z),
+                                             grid.index(p.x + eu.x + ev.x, p.y + eu.y + ev.y,
+                                                        p.z + eu.z + ev.z),
+                                             grid.index(p.x + ev.x, p.y + ev.y, p.z + ev.z)};
+            std::array<float, 4> f;
+            for (size_t q = 0; q < 4; ++q) f[q] = grid.field[c[q]];
+            const bool a = f[0] < 0.0f, b = f[1] < 0.0f;
+            if (a == b || (f[2] < 0.0f) != a || (f[3] < 0.0f) != b) continue;
+            size_t nearest = 0;
+            for (size_t q = 1; q < 4; ++q) {
+              if (std::abs(f[q]) < std::abs(f[nearest])) nearest = q;
+            }
+            float& value = grid.field[c[nearest]];
+            value = value < 0.0f ? 0.0f : -1e-6f * grid.voxel;
+            ++flips;
+          }
+        }
+      }
+    }
+    if (flips == 0) return;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Surface nets
 
@@ -343,6 +386,7 @@ Result<TriangleMesh> generate_body_mesh(std::span<const BoneSegment> segments,
   const std::vector<Capsule> capsules = prepare_all(segments);
   const float blend = options.blend_radius;
   sample_field(*grid, capsules, blend);
+  resolve_ambiguous_faces(*grid);
 
   TriangleMesh mesh;
   const NetVertices net = place_vertices(*grid, capsules, blend, mesh);

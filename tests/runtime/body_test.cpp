@@ -122,6 +122,24 @@ TEST(BodyMesh, OverlappingCapsulesMergeIntoOneComponentAndSeparateOnesDoNot) {
   EXPECT_EQ(test::connected_components(*two), 2);
 }
 
+// Oblique thin capsules at many sub-voxel offsets: wherever the surface grazes a grid face
+// (cutting it twice), the mesh must still share every edge between exactly two triangles.
+TEST(BodyMesh, StaysClosedWhereTheSurfaceGrazesGridFaces) {
+  BodyMeshOptions options;
+  options.voxel_size = 0.012f;
+  for (int i = 0; i < 24; ++i) {
+    const float f = static_cast<float>(i);
+    const glm::vec3 offset(0.0031f * f, 0.0017f * f, 0.0023f * f);
+    const glm::vec3 dir = glm::normalize(glm::vec3(1.0f, 0.3f + 0.05f * f, 0.1f * std::sin(f)));
+    const BoneSegment bone = segment(offset, offset + 0.4f * dir, 0.03f, 0.02f);
+    Result<TriangleMesh> mesh = generate_body_mesh({&bone, 1}, options);
+    ASSERT_TRUE(mesh.ok()) << mesh.message();
+    const test::EdgeReport edges = test::edge_report(*mesh);
+    EXPECT_EQ(edges.edges_not_shared_by_two, 0u) << "capsule " << i;
+    EXPECT_EQ(edges.directed_edges_repeated, 0u) << "capsule " << i;
+  }
+}
+
 TEST(BodyMesh, IsDeterministic) {
   const std::vector<BoneSegment> limb = {segment({0, 0, 0}, {0, 0.3f, 0.05f}, 0.06f, 0.04f),
                                          segment({0, 0.3f, 0.05f}, {0.15f, 0.4f, 0}, 0.04f, 0.03f)};

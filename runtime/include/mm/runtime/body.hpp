@@ -16,9 +16,11 @@
 // cubes: no 256-case tables, about half the vertices for the same grid, and no sliver
 // triangles, which the cotangent Laplacian of heat-diffusion weights would suffer from.
 // Because the grid extends beyond the surface on every side, every crossed edge has its four
-// cells and the mesh is closed; a face whose four corners alternate inside/outside (a feature
-// thinner than a voxel) can make one edge shared by four triangles, so keep voxels smaller
-// than the thinnest capsule.
+// cells and the mesh is closed. A grid face whose four corners alternate inside/outside (the
+// surface grazing it) would make one edge shared by four triangles; such faces are resolved
+// before meshing by moving their corner nearest the surface to its other side, so every edge
+// is shared by exactly two triangles. Features thinner than a voxel may still vanish or break:
+// keep voxels smaller than the thinnest capsule.
 //
 // Normals are the normalized gradient of the signed distance (central differences), pointing
 // out; triangles wind counter-clockwise seen from outside. Units: metres, like everything else.
