@@ -10,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <limits>
 #include <sstream>
@@ -166,12 +167,23 @@ float read_component(const unsigned char* p, int component_type) {
   }
 }
 
-// Reads every element of an accessor as floats (count * components values), after checking
-// the index, type, component type and that every byte read lies inside its buffer.
-// allow_normalized_integers admits the normalized BYTE/SHORT encodings glTF allows for
-// rotations. `what` says what the accessor is for, for the error message.
-Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index, int expected_type,
-                                         bool allow_normalized_integers, const std::string& what) {
+// Where an accessor's elements lie, after checking the index, type, component type and that
+// every byte read lies inside its buffer. `component_ok` says which component types (and
+// normalized flags) the caller accepts, `expected` names them for the message; `what` says
+// what the accessor is for.
+struct AccessorData {
+  const unsigned char* base = nullptr;  // first element; null when the accessor is all zeros
+  size_t stride = 0;                    // bytes between elements
+  size_t count = 0;
+  size_t components = 0;
+  int component_type = 0;
+  std::string where;  // "<what>: accessor <index>", for messages about elements
+};
+
+template <class ComponentOk>
+Result<AccessorData> locate_accessor(const tinygltf::Model& model, int index, int expected_type,
+                                     ComponentOk component_ok, const std::string& expected,
+                                     const std::string& what) {
   const std::string where = what + ": accessor " + std::to_string(index);
   if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) {
     return Error{what + ": accessor index " + std::to_string(index) +
@@ -185,14 +197,9 @@ Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index
                  type_name(expected_type)};
   }
   const int ct = accessor.componentType;
-  const bool integer_ok = allow_normalized_integers && accessor.normalized &&
-                          ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT && component_size(ct) > 0;
-  if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT && !integer_ok) {
+  if (component_size(ct) == 0 || !component_ok(ct, accessor.normalized)) {
     return Error{where + " has component type " + component_name(ct) +
-                 (accessor.normalized ? " (normalized)" : "") + ", expected FLOAT" +
-                 (allow_normalized_integers
-                      ? " or normalized BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT"
-                      : "")};
+                 (accessor.normalized ? " (normalized)" : "") + ", expected " + expected};
   }
   if (accessor.count == 0) return Error{where + " has no elements (count is 0)"};
   const size_t components = static_cast<size_t>(components_in_type(accessor.type));
@@ -206,7 +213,7 @@ Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index
                    " elements, more than the " + std::to_string(kMaxZeroAccessorElements) +
                    " allowed"};
     }
-    return std::vector<float>(count * components, 0.0f);
+    return AccessorData{nullptr, 0, count, components, ct, where};
   }
 
   if (static_cast<size_t>(accessor.bufferView) >= model.bufferViews.size()) {
@@ -241,17 +248,73 @@ Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index
                  ") from byte offset " + std::to_string(accessor.byteOffset) + " do not fit in " +
                  view_label + " (" + std::to_string(length) + " bytes)"};
   }
-  // Only now, with every element known to lie inside the buffer, is the size trusted.
-  std::vector<float> values(count * components);
-  const unsigned char* base = data.data() + view.byteOffset + accessor.byteOffset;
-  const size_t csize = static_cast<size_t>(component_size(ct));
-  for (size_t i = 0; i < count; ++i) {
-    for (size_t c = 0; c < components; ++c) {
-      const float v = read_component(base + i * stride + c * csize, ct);
+  return AccessorData{data.data() + view.byteOffset + accessor.byteOffset, stride, count,
+                      components, ct, where};
+}
+
+// Reads every element of an accessor as floats (count * components values); integer
+// components use the glTF "normalized" mapping. allow_normalized_integers admits the
+// normalized BYTE/SHORT encodings glTF allows for rotations and weights.
+Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index, int expected_type,
+                                         bool allow_normalized_integers, const std::string& what) {
+  auto ok = [&](int ct, bool normalized) {
+    return ct == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+           (allow_normalized_integers && normalized && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+  };
+  auto located = locate_accessor(
+      model, index, expected_type, ok,
+      allow_normalized_integers
+          ? "FLOAT or normalized BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT"
+          : "FLOAT",
+      what);
+  if (!located) return located.error();
+  const AccessorData& a = *located;
+  std::vector<float> values(a.count * a.components, 0.0f);
+  if (!a.base) return values;
+  const size_t csize = static_cast<size_t>(component_size(a.component_type));
+  for (size_t i = 0; i < a.count; ++i) {
+    for (size_t c = 0; c < a.components; ++c) {
+      const float v = read_component(a.base + i * a.stride + c * csize, a.component_type);
       if (!std::isfinite(v)) {
-        return Error{where + ": element " + std::to_string(i) + " is not finite"};
+        return Error{a.where + ": element " + std::to_string(i) + " is not finite"};
       }
-      values[i * components + c] = v;
+      values[i * a.components + c] = v;
+    }
+  }
+  return values;
+}
+
+// Reads an accessor of unsigned integers (indices, joint numbers) as they are stored, not
+// normalized; `component_types` lists the accepted ones and `expected` names them.
+Result<std::vector<uint32_t>> read_integer_accessor(const tinygltf::Model& model, int index,
+                                                    int expected_type,
+                                                    std::initializer_list<int> component_types,
+                                                    const std::string& expected,
+                                                    const std::string& what) {
+  auto ok = [&](int ct, bool normalized) {
+    return !normalized && std::find(component_types.begin(), component_types.end(), ct) !=
+                              component_types.end();
+  };
+  auto located = locate_accessor(model, index, expected_type, ok, expected, what);
+  if (!located) return located.error();
+  const AccessorData& a = *located;
+  std::vector<uint32_t> values(a.count * a.components, 0u);
+  if (!a.base) return values;
+  const size_t csize = static_cast<size_t>(component_size(a.component_type));
+  for (size_t i = 0; i < a.count; ++i) {
+    for (size_t c = 0; c < a.components; ++c) {
+      const unsigned char* p = a.base + i * a.stride + c * csize;
+      uint32_t v = 0;
+      if (csize == 1) {
+        v = *p;
+      } else if (csize == 2) {
+        uint16_t u;
+        std::memcpy(&u, p, sizeof u);
+        v = u;
+      } else {
+        std::memcpy(&v, p, sizeof v);
+      }
+      values[i * a.components + c] = v;
     }
   }
   return values;
@@ -403,6 +466,28 @@ glm::vec4 sample(const Track& track, double t) {
   return glm::vec4(p);
 }
 
+// A matrix split into translation, rotation and scale (a mirror keeps the rotation proper and
+// makes the x scale negative); `where` names the matrix in the error.
+Result<Transform> decompose(const glm::dmat4& m, const std::string& where) {
+  glm::dmat3 basis(m);
+  glm::dvec3 scale(glm::length(basis[0]), glm::length(basis[1]), glm::length(basis[2]));
+  if (glm::determinant(basis) < 0.0) scale.x = -scale.x;  // a mirror: keep the rotation proper
+  if (!(std::abs(scale.x) > 1e-12 && scale.y > 1e-12 && scale.z > 1e-12) ||
+      !std::isfinite(glm::determinant(m))) {
+    return Error{where +
+                 ": matrix is degenerate or not finite; it cannot be split into "
+                 "translation, rotation and scale"};
+  }
+  basis[0] /= scale.x;
+  basis[1] /= scale.y;
+  basis[2] /= scale.z;
+  Transform t;
+  t.translation = glm::vec3(m[3]);
+  t.rotation = glm::normalize(glm::quat(glm::quat_cast(basis)));
+  t.scale = glm::vec3(scale);
+  return t;
+}
+
 // The node's rest transform from its TRS or its matrix (decomposed into TRS).
 Result<Transform> node_rest(const tinygltf::Model& model, int index) {
   const tinygltf::Node& node = model.nodes[static_cast<size_t>(index)];
@@ -417,21 +502,9 @@ Result<Transform> node_rest(const tinygltf::Model& model, int index) {
     for (int c = 0; c < 4; ++c) {
       for (int r = 0; r < 4; ++r) m[c][r] = node.matrix[static_cast<size_t>(c * 4 + r)];
     }
-    glm::dmat3 basis(m);
-    glm::dvec3 scale(glm::length(basis[0]), glm::length(basis[1]), glm::length(basis[2]));
-    if (glm::determinant(basis) < 0.0) scale.x = -scale.x;  // a mirror: keep the rotation proper
-    if (!(std::abs(scale.x) > 1e-12 && scale.y > 1e-12 && scale.z > 1e-12) ||
-        !std::isfinite(glm::determinant(m))) {
-      return Error{where +
-                   ": matrix is degenerate or not finite; it cannot be split into "
-                   "translation, rotation and scale"};
-    }
-    basis[0] /= scale.x;
-    basis[1] /= scale.y;
-    basis[2] /= scale.z;
-    t.translation = glm::vec3(m[3]);
-    t.rotation = glm::normalize(glm::quat(glm::quat_cast(basis)));
-    t.scale = glm::vec3(scale);
+    auto split = decompose(m, where);
+    if (!split) return split.error();
+    t = *split;
   } else {
     auto read = [&](const std::vector<double>& v, size_t n, const char* what,
                     float* out) -> Status {
@@ -687,6 +760,179 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
   return result;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Skinned mesh import
+
+// The first node (in node order) that carries a mesh skinned with `skin_index`.
+Result<int> skinned_mesh_node(const tinygltf::Model& model, int skin_index) {
+  for (size_t n = 0; n < model.nodes.size(); ++n) {
+    const tinygltf::Node& node = model.nodes[n];
+    if (node.skin != skin_index || node.mesh < 0) continue;
+    if (static_cast<size_t>(node.mesh) >= model.meshes.size()) {
+      return Error{node_label(model, static_cast<int>(n)) + " refers to mesh " +
+                   std::to_string(node.mesh) + ", out of range (the file has " +
+                   std::to_string(model.meshes.size()) + " meshes)"};
+    }
+    return static_cast<int>(n);
+  }
+  return Error{"no mesh is skinned with skin " + std::to_string(skin_index) +
+               " (no node has both \"skin\": " + std::to_string(skin_index) + " and a \"mesh\")"};
+}
+
+// The index of a primitive attribute, or an error naming it when it is required and absent.
+Result<int> attribute(const tinygltf::Primitive& primitive, const std::string& name,
+                      const std::string& label, bool required) {
+  const auto it = primitive.attributes.find(name);
+  if (it != primitive.attributes.end()) return it->second;
+  if (required) return Error{label + " has no " + name + " attribute"};
+  return -1;
+}
+
+std::vector<glm::vec3> as_vec3s(const std::vector<float>& values) {
+  std::vector<glm::vec3> out(values.size() / 3);
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
+  }
+  return out;
+}
+
+// POSITION, NORMAL and the triangles of a primitive, every count and index checked.
+Result<TriangleMesh> read_triangles(const tinygltf::Model& model,
+                                    const tinygltf::Primitive& primitive,
+                                    const std::string& label) {
+  if (primitive.mode != -1 && primitive.mode != TINYGLTF_MODE_TRIANGLES) {
+    return Error{label + " has mode " + std::to_string(primitive.mode) +
+                 "; only triangles (mode 4) are read"};
+  }
+  auto position = attribute(primitive, "POSITION", label, true);
+  if (!position) return position.error();
+  auto positions = read_accessor(model, *position, TINYGLTF_TYPE_VEC3, false, label + " POSITION");
+  if (!positions) return positions.error();
+  TriangleMesh mesh;
+  mesh.positions = as_vec3s(*positions);
+  const size_t n = mesh.positions.size();
+  auto normal = attribute(primitive, "NORMAL", label, false);
+  if (*normal >= 0) {
+    auto normals = read_accessor(model, *normal, TINYGLTF_TYPE_VEC3, false, label + " NORMAL");
+    if (!normals) return normals.error();
+    mesh.normals = as_vec3s(*normals);
+    if (mesh.normals.size() != n) {
+      return Error{label + " has " + std::to_string(n) + " positions but " +
+                   std::to_string(mesh.normals.size()) + " normals"};
+    }
+  }
+  if (primitive.indices >= 0) {
+    auto indices = read_integer_accessor(
+        model, primitive.indices, TINYGLTF_TYPE_SCALAR,
+        {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+        "UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT", label + " indices");
+    if (!indices) return indices.error();
+    mesh.indices = std::move(*indices);
+  } else {
+    mesh.indices.resize(n);
+    for (size_t i = 0; i < n; ++i) mesh.indices[i] = static_cast<uint32_t>(i);
+  }
+  if (mesh.indices.size() % 3 != 0) {
+    return Error{label + " has " + std::to_string(mesh.indices.size()) +
+                 " indices, not a whole number of triangles"};
+  }
+  for (size_t i = 0; i < mesh.indices.size(); ++i) {
+    if (mesh.indices[i] >= n) {
+      return Error{label + " index " + std::to_string(i) + " is vertex " +
+                   std::to_string(mesh.indices[i]) + ", out of range (" + std::to_string(n) +
+                   " vertices)"};
+    }
+  }
+  return mesh;
+}
+
+// JOINTS_0 and WEIGHTS_0 as influences on skeleton joints: a skin joint number k becomes the
+// skeleton joint of node skin.joints[k]. Weights are checked and normalized.
+Result<std::vector<VertexInfluences>> read_influences(const tinygltf::Model& model,
+                                                      const tinygltf::Primitive& primitive,
+                                                      size_t vertex_count,
+                                                      const tinygltf::Skin& skin,
+                                                      const SkeletonLayout& layout,
+                                                      const std::string& label) {
+  if (primitive.attributes.count("JOINTS_1") || primitive.attributes.count("WEIGHTS_1")) {
+    return Error{label + " has JOINTS_1/WEIGHTS_1: more than four influences per vertex are "
+                         "not supported"};
+  }
+  auto joints_index = attribute(primitive, "JOINTS_0", label, true);
+  if (!joints_index) return joints_index.error();
+  auto weights_index = attribute(primitive, "WEIGHTS_0", label, true);
+  if (!weights_index) return weights_index.error();
+  auto joints = read_integer_accessor(
+      model, *joints_index, TINYGLTF_TYPE_VEC4,
+      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+      "UNSIGNED_BYTE or UNSIGNED_SHORT", label + " JOINTS_0");
+  if (!joints) return joints.error();
+  auto weights = read_accessor(model, *weights_index, TINYGLTF_TYPE_VEC4, true, label + " WEIGHTS_0");
+  if (!weights) return weights.error();
+  if (joints->size() != vertex_count * 4 || weights->size() != vertex_count * 4) {
+    return Error{label + " has " + std::to_string(vertex_count) + " positions but " +
+                 std::to_string(joints->size() / 4) + " JOINTS_0 and " +
+                 std::to_string(weights->size() / 4) + " WEIGHTS_0 elements"};
+  }
+  std::vector<VertexInfluences> influences(vertex_count);
+  for (size_t v = 0; v < vertex_count; ++v) {
+    float sum = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      const size_t i = v * 4 + static_cast<size_t>(k);
+      const float w = (*weights)[i];
+      if (w < 0.0f) {
+        return Error{label + " vertex " + std::to_string(v) + " has negative weight " + number(w)};
+      }
+      if (w == 0.0f) continue;
+      const uint32_t joint = (*joints)[i];
+      if (joint >= skin.joints.size()) {
+        return Error{label + " vertex " + std::to_string(v) + " is weighted to joint " +
+                     std::to_string(joint) + ", out of range (the skin has " +
+                     std::to_string(skin.joints.size()) + " joints)"};
+      }
+      influences[v].joints[k] = layout.slot_of_node[static_cast<size_t>(skin.joints[joint])];
+      influences[v].weights[k] = w;
+      sum += w;
+    }
+    if (!(sum > 0.0f)) return Error{label + " vertex " + std::to_string(v) + " has no weight"};
+    influences[v].weights /= sum;
+  }
+  return influences;
+}
+
+Result<SkinnedMesh> read_skinned_mesh(const tinygltf::Model& model, int skin_index,
+                                      const SkeletonResult& skeleton) {
+  auto node = skinned_mesh_node(model, skin_index);
+  if (!node) return node.error();
+  const int mesh_index = model.nodes[static_cast<size_t>(*node)].mesh;
+  const tinygltf::Mesh& gltf_mesh = model.meshes[static_cast<size_t>(mesh_index)];
+  const std::string label = "mesh " + std::to_string(mesh_index) + quoted_name(gltf_mesh.name) +
+                            " primitive 0";
+  if (gltf_mesh.primitives.empty()) {
+    return Error{"mesh " + std::to_string(mesh_index) + quoted_name(gltf_mesh.name) +
+                 " has no primitives"};
+  }
+  const tinygltf::Primitive& primitive = gltf_mesh.primitives[0];
+  SkinnedMesh out;
+  auto mesh = read_triangles(model, primitive, label);
+  if (!mesh) return mesh.error();
+  out.mesh = std::move(*mesh);
+  auto influences = read_influences(model, primitive, out.mesh.positions.size(),
+                                    model.skins[static_cast<size_t>(skin_index)], skeleton.layout,
+                                    label);
+  if (!influences) return influences.error();
+  out.influences = std::move(*influences);
+  for (size_t j = 0; j < skeleton.inverse_bind_matrices.size(); ++j) {
+    auto bind = decompose(glm::inverse(glm::dmat4(skeleton.inverse_bind_matrices[j])),
+                          "inverse bind matrix of joint '" +
+                              skeleton.skeleton.name(static_cast<int>(j)) + "'");
+    if (!bind) return bind.error();
+    out.bind_global.push_back(*bind);
+  }
+  return out;
+}
+
 // Reads one channel's sampler into a track, validating types, counts and key times.
 Result<Track> read_track(const tinygltf::Model& model, const tinygltf::AnimationSampler& sampler,
                          Path path, const std::string& what) {
@@ -906,6 +1152,11 @@ Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
     if (!clip) return clip.error();
     if (animates) asset.clips.push_back(std::move(*clip));
   }
+  if (options.read_skinned_mesh) {
+    auto mesh = read_skinned_mesh(model, options.skin, *skeleton);
+    if (!mesh) return mesh.error();
+    asset.skinned_mesh = std::move(*mesh);
+  }
   asset.skeleton = std::move(skeleton->skeleton);
   asset.inverse_bind_matrices = std::move(skeleton->inverse_bind_matrices);
   return asset;
@@ -965,8 +1216,123 @@ Status write_file(const std::filesystem::path& out, const std::string& content) 
   return Status::success();
 }
 
+// The body's consistency with the skeleton, before anything is written.
+Status check_body(const SkinnedMesh& body, size_t joints) {
+  const TriangleMesh& mesh = body.mesh;
+  const size_t vertices = mesh.positions.size();
+  if (body.bind_global.size() != joints) {
+    return Error{"the body has " + std::to_string(body.bind_global.size()) +
+                 " bind transforms for " + std::to_string(joints) + " joints"};
+  }
+  if (joints > 65536) return Error{"JOINTS_0 as UNSIGNED_SHORT cannot address " + std::to_string(joints) + " joints"};
+  if (vertices == 0 || mesh.indices.empty()) return Error{"the body mesh is empty"};
+  if (body.influences.size() != vertices || (!mesh.normals.empty() && mesh.normals.size() != vertices)) {
+    return Error{"the body has " + std::to_string(vertices) + " vertices but " +
+                 std::to_string(body.influences.size()) + " influences and " +
+                 std::to_string(mesh.normals.size()) + " normals"};
+  }
+  if (mesh.indices.size() % 3 != 0) return Error{"the body's index count is not a multiple of 3"};
+  for (uint32_t i : mesh.indices) {
+    if (i >= vertices) return Error{"the body's index " + std::to_string(i) + " is out of range"};
+  }
+  for (size_t v = 0; v < vertices; ++v) {
+    const VertexInfluences& in = body.influences[v];
+    float sum = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+      const float w = in.weights[k];
+      if (!(w >= 0.0f) || !std::isfinite(w)) {
+        return Error{"body vertex " + std::to_string(v) + " has weight " + number(w)};
+      }
+      if (w > 0.0f && (in.joints[k] < 0 || static_cast<size_t>(in.joints[k]) >= joints)) {
+        return Error{"body vertex " + std::to_string(v) + " is weighted to joint " +
+                     std::to_string(in.joints[k]) + ", out of range"};
+      }
+      sum += w;
+    }
+    if (!(sum > 0.0f)) return Error{"body vertex " + std::to_string(v) + " has no weight"};
+    if (!finite(mesh.positions[v]) || (!mesh.normals.empty() && !finite(mesh.normals[v]))) {
+      return Error{"body vertex " + std::to_string(v) + " is not finite"};
+    }
+  }
+  return Status::success();
+}
+
+// The one-triangle primitive save_gltf writes without a body: 1 cm, weighted fully to joint
+// 0, so importers that only build armatures for skinned meshes still see the skin.
+tinygltf::Primitive anchor_primitive(BufferWriter& writer, const glm::vec3& anchor) {
+  const float positions[9] = {anchor.x, anchor.y, anchor.z,         anchor.x + 0.01f, anchor.y,
+                              anchor.z, anchor.x, anchor.y + 0.01f, anchor.z};
+  const uint8_t joint_indices[12] = {};
+  const float weights[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  std::vector<double> pmin(3), pmax(3);
+  for (int c = 0; c < 3; ++c) {
+    pmin[static_cast<size_t>(c)] = std::min({positions[c], positions[3 + c], positions[6 + c]});
+    pmax[static_cast<size_t>(c)] = std::max({positions[c], positions[3 + c], positions[6 + c]});
+  }
+  tinygltf::Primitive primitive;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  primitive.attributes["POSITION"] =
+      writer.add(positions, sizeof positions, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 3,
+                 TINYGLTF_TARGET_ARRAY_BUFFER, pmin, pmax);
+  primitive.attributes["JOINTS_0"] =
+      writer.add(joint_indices, sizeof joint_indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                 TINYGLTF_TYPE_VEC4, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
+  primitive.attributes["WEIGHTS_0"] =
+      writer.add(weights, sizeof weights, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, 3,
+                 TINYGLTF_TARGET_ARRAY_BUFFER);
+  return primitive;
+}
+
+// The body's primitive (check_body has accepted it): weights normalized, unused slots joint 0.
+tinygltf::Primitive body_primitive(BufferWriter& writer, const SkinnedMesh& body) {
+  const TriangleMesh& mesh = body.mesh;
+  const size_t n = mesh.positions.size();
+  std::vector<double> pmin(3, std::numeric_limits<double>::max());
+  std::vector<double> pmax(3, -std::numeric_limits<double>::max());
+  for (const glm::vec3& p : mesh.positions) {
+    for (int c = 0; c < 3; ++c) {
+      pmin[static_cast<size_t>(c)] = std::min(pmin[static_cast<size_t>(c)], double{p[c]});
+      pmax[static_cast<size_t>(c)] = std::max(pmax[static_cast<size_t>(c)], double{p[c]});
+    }
+  }
+  std::vector<uint16_t> joints(n * 4, 0);
+  std::vector<float> weights(n * 4, 0.0f);
+  for (size_t v = 0; v < n; ++v) {
+    const VertexInfluences& in = body.influences[v];
+    const float sum = in.weights.x + in.weights.y + in.weights.z + in.weights.w;
+    for (int k = 0; k < 4; ++k) {
+      if (!(in.weights[k] > 0.0f)) continue;
+      joints[v * 4 + static_cast<size_t>(k)] = static_cast<uint16_t>(in.joints[k]);
+      weights[v * 4 + static_cast<size_t>(k)] = in.weights[k] / sum;
+    }
+  }
+  tinygltf::Primitive primitive;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  primitive.attributes["POSITION"] =
+      writer.add(mesh.positions.data(), n * sizeof(glm::vec3), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                 TINYGLTF_TYPE_VEC3, n, TINYGLTF_TARGET_ARRAY_BUFFER, pmin, pmax);
+  if (!mesh.normals.empty()) {
+    primitive.attributes["NORMAL"] =
+        writer.add(mesh.normals.data(), n * sizeof(glm::vec3), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                   TINYGLTF_TYPE_VEC3, n, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  primitive.attributes["JOINTS_0"] =
+      writer.add(joints.data(), joints.size() * sizeof(uint16_t),
+                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n,
+                 TINYGLTF_TARGET_ARRAY_BUFFER);
+  primitive.attributes["WEIGHTS_0"] =
+      writer.add(weights.data(), weights.size() * sizeof(float), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                 TINYGLTF_TYPE_VEC4, n, TINYGLTF_TARGET_ARRAY_BUFFER);
+  primitive.indices = writer.add(mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t),
+                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                 mesh.indices.size(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  return primitive;
+}
+
+// `body` may be null: the skeleton's rest pose is the bind pose and an anchor triangle the mesh.
 Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
-                  float frame_time, std::string_view name, const std::filesystem::path& out) {
+                  float frame_time, std::string_view name, const SkinnedMesh* body,
+                  const std::filesystem::path& out) {
   const std::string where = out.string() + ": ";
   std::string ext = out.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -987,6 +1353,9 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
     return Error{where + "expected " + std::to_string(frames_n * joints) + " transforms (" +
                  std::to_string(frame_count) + " frames x " + std::to_string(joints) +
                  " joints), got " + std::to_string(frames.size())};
+  }
+  if (body) {
+    if (Status b = check_body(*body, joints); !b) return Error{where + b.message()};
   }
   auto check = [&](const Transform& t, const std::string& what) -> Status {
     const float n = glm::length(t.rotation);
@@ -1014,12 +1383,25 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
   model.asset.generator = "mm motion matching: mm::save_gltf";
   BufferWriter writer(model);
 
-  // Joint nodes with their rest TRS, children listed by their parents.
+  // The bind pose: the body's, else the rest pose; as globals and as the nodes' locals.
+  std::vector<Transform> globals(joints);
+  std::vector<Transform> bind_local(skeleton.rest());
+  if (body) {
+    globals = body->bind_global;
+    for (size_t j = 0; j < joints; ++j) {
+      const int p = skeleton.parent(static_cast<int>(j));
+      bind_local[j] = p < 0 ? globals[j] : compose(inverse(globals[static_cast<size_t>(p)]), globals[j]);
+    }
+  } else {
+    forward_kinematics(skeleton.parents(), skeleton.rest(), globals);
+  }
+
+  // Joint nodes with their bind TRS, children listed by their parents.
   model.nodes.resize(joints);
   std::vector<int> roots;
   for (size_t j = 0; j < joints; ++j) {
     tinygltf::Node& node = model.nodes[j];
-    const Transform& r = skeleton.rest(static_cast<int>(j));
+    const Transform& r = bind_local[j];
     const glm::quat q = glm::normalize(r.rotation);
     node.name = skeleton.name(static_cast<int>(j));
     node.translation = {r.translation.x, r.translation.y, r.translation.z};
@@ -1033,9 +1415,7 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
     }
   }
 
-  // Skin: every joint, bound in the rest pose.
-  std::vector<Transform> globals(joints);
-  forward_kinematics(skeleton.parents(), skeleton.rest(), globals);
+  // Skin: every joint, bound in the bind pose.
   std::vector<float> inverse_binds(joints * 16);
   for (size_t j = 0; j < joints; ++j) {
     const glm::mat4 m = glm::inverse(to_matrix(globals[j]));
@@ -1050,35 +1430,14 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
   if (roots.size() == 1) skin.skeleton = roots.front();
   model.skins.push_back(std::move(skin));
 
-  // A 1 cm triangle weighted fully to joint 0, so importers that only build armatures for
-  // skinned meshes still see the skin.
-  const glm::vec3 anchor = globals[0].translation;
-  const float positions[9] = {anchor.x, anchor.y, anchor.z,         anchor.x + 0.01f, anchor.y,
-                              anchor.z, anchor.x, anchor.y + 0.01f, anchor.z};
-  const uint8_t joint_indices[12] = {};
-  const float weights[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-  std::vector<double> pmin(3), pmax(3);
-  for (int c = 0; c < 3; ++c) {
-    pmin[static_cast<size_t>(c)] = std::min({positions[c], positions[3 + c], positions[6 + c]});
-    pmax[static_cast<size_t>(c)] = std::max({positions[c], positions[3 + c], positions[6 + c]});
-  }
-  tinygltf::Primitive primitive;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  primitive.attributes["POSITION"] =
-      writer.add(positions, sizeof positions, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 3,
-                 TINYGLTF_TARGET_ARRAY_BUFFER, pmin, pmax);
-  primitive.attributes["JOINTS_0"] =
-      writer.add(joint_indices, sizeof joint_indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
-                 TINYGLTF_TYPE_VEC4, 3, TINYGLTF_TARGET_ARRAY_BUFFER);
-  primitive.attributes["WEIGHTS_0"] =
-      writer.add(weights, sizeof weights, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, 3,
-                 TINYGLTF_TARGET_ARRAY_BUFFER);
+  tinygltf::Primitive primitive =
+      body ? body_primitive(writer, *body) : anchor_primitive(writer, globals[0].translation);
   tinygltf::Mesh mesh;
-  mesh.name = std::string(name) + "_skin_anchor";
+  mesh.name = std::string(name) + (body ? "_body" : "_skin_anchor");
   mesh.primitives.push_back(std::move(primitive));
   model.meshes.push_back(std::move(mesh));
   tinygltf::Node mesh_node;
-  mesh_node.name = std::string(name) + "_skin_anchor";
+  mesh_node.name = model.meshes.back().name;
   mesh_node.mesh = 0;
   mesh_node.skin = 0;
   model.nodes.push_back(std::move(mesh_node));
@@ -1133,7 +1492,7 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
     }
     add_channel(j, "rotation", values, TINYGLTF_TYPE_VEC4);
 
-    const glm::vec3 rest_scale = skeleton.rest(static_cast<int>(j)).scale;
+    const glm::vec3 rest_scale = bind_local[j].scale;
     bool scale_moves = false;
     for (size_t f = 0; f < frames_n && !scale_moves; ++f) {
       scale_moves = frames[f * joints + j].scale != rest_scale;
@@ -1185,7 +1544,17 @@ Result<GltfAsset> load_gltf(const std::filesystem::path& path, const GltfImportO
 Status save_gltf(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
                  float frame_time, std::string_view name, const std::filesystem::path& out) {
   try {
-    return save_model(skeleton, frames, frame_count, frame_time, name, out);
+    return save_model(skeleton, frames, frame_count, frame_time, name, nullptr, out);
+  } catch (const std::exception& e) {
+    return Error{out.string() + ": failed to write glTF: " + e.what()};
+  }
+}
+
+Status save_skinned_gltf(const Skeleton& skeleton, const SkinnedMesh& body,
+                         std::span<const Transform> frames, int frame_count, float frame_time,
+                         std::string_view name, const std::filesystem::path& out) {
+  try {
+    return save_model(skeleton, frames, frame_count, frame_time, name, &body, out);
   } catch (const std::exception& e) {
     return Error{out.string() + ": failed to write glTF: " + e.what()};
   }

@@ -29,6 +29,16 @@
 // - Everything is validated (indices, accessor types and bounds, counts, finite values,
 //   increasing key times, the GLB container); an error names the file and what is wrong.
 //   Sparse accessors and images are not read (images are skipped, never decoded).
+// - Skinned mesh (only with GltfImportOptions::read_skinned_mesh): the first primitive of the
+//   mesh of the first node (in node order) skinned with the chosen skin. Triangles only
+//   (mode 4), indexed (UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT) or not; POSITION
+//   (FLOAT VEC3), JOINTS_0 (UNSIGNED_BYTE or UNSIGNED_SHORT VEC4) and WEIGHTS_0 (FLOAT or
+//   normalized UNSIGNED_BYTE/UNSIGNED_SHORT VEC4) are required, NORMAL (FLOAT VEC3) is read
+//   when present; more than four influences (JOINTS_1) are refused. JOINTS_0 values index the
+//   skin's joints and are mapped to skeleton joint indices; weights must be >= 0 with a
+//   positive sum and are normalized to sum 1; a slot with weight 0 is stored as joint 0. The
+//   bind pose of every skeleton joint is the inverse of its inverse bind matrix. The node's
+//   own transform is ignored, as glTF specifies for skinned meshes.
 //
 // Export (save_gltf) writes a pose sequence and its skeleton as a file Blender and other
 // importers open as an animated armature: one node per joint with its rest TRS, a skin over
@@ -37,10 +47,16 @@
 // importer sees the skin, and one animation with a LINEAR translation and rotation channel per
 // joint (and a scale channel for joints whose scale leaves the rest scale), one key per frame.
 // ".glb" writes a binary file; ".gltf" writes one JSON file with the buffer embedded as base64.
+// save_skinned_gltf writes the same with a real body instead of the anchor triangle: the
+// joint nodes' rest TRS are the body's bind pose (so importers show the armature in it), the
+// inverse bind matrices are the inverses of the body's bind_global, and one mesh primitive
+// holds POSITION, NORMAL (when the mesh has normals), JOINTS_0 (UNSIGNED_SHORT), WEIGHTS_0
+// (FLOAT, normalized to sum 1) and UNSIGNED_INT indices, on a node bound to the skin.
 //
 // Units as everywhere in the project: metres, seconds, Y up, right-handed.
 
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -48,6 +64,7 @@
 #include <glm/glm.hpp>
 
 #include "mm/database/clip.hpp"
+#include "mm/runtime/mesh.hpp"
 #include "mm/runtime/result.hpp"
 #include "mm/runtime/skeleton.hpp"
 #include "mm/runtime/transform.hpp"
@@ -60,6 +77,9 @@ struct GltfImportOptions {
   float sample_rate = 30.0f;
   // Index of the skin (in the file's "skins" array) that defines the skeleton.
   int skin = 0;
+  // Also read the mesh skinned with that skin into GltfAsset::skinned_mesh; a file without
+  // one, or whose mesh is malformed, is then refused. Off, meshes are not looked at.
+  bool read_skinned_mesh = false;
 };
 
 // What a glTF file holds for us: one skeleton and its animations.
@@ -70,6 +90,9 @@ struct GltfAsset {
   std::vector<glm::mat4> inverse_bind_matrices;
   // One clip per animation that moves the skeleton, in file order, sharing `skeleton`.
   std::vector<Clip> clips;
+  // With GltfImportOptions::read_skinned_mesh: the skinned mesh, its influences as skeleton
+  // joint indices, and bind_global per skeleton joint (the inverse of inverse_bind_matrices).
+  std::optional<SkinnedMesh> skinned_mesh;
 };
 
 // Reads a .gltf or .glb file (recognized by its content: binary files start with "glTF").
@@ -91,5 +114,13 @@ Status save_gltf(const Clip& clip, const std::filesystem::path& out);
 // `name`. The format follows the extension of `out` as above.
 Status save_gltf(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
                  float frame_time, std::string_view name, const std::filesystem::path& out);
+
+// Writes a pose sequence (as the save_gltf above) together with a skinned body: `body` has one
+// bind_global per skeleton joint and one influence per vertex with joints in range. The body
+// is checked (sizes, indices, finite values, weights >= 0 with a positive sum) before anything
+// is written.
+Status save_skinned_gltf(const Skeleton& skeleton, const SkinnedMesh& body,
+                         std::span<const Transform> frames, int frame_count, float frame_time,
+                         std::string_view name, const std::filesystem::path& out);
 
 }  // namespace mm
