@@ -204,6 +204,48 @@ TEST(Cli, ExportWritesAGlbThatImportsWithTheClipsFramesAndJoints) {
   EXPECT_EQ(run_mm("export " + quoted(dir / "missing.bvh") + " -o " + quoted(out)).exit_code, 1);
 }
 
+// `mm export --body`: the database clip with the generated body, reloadable as a skinned mesh
+// over every joint; the weight method is chosen by name; a BVH input or an unknown method is
+// a usage error.
+TEST(Cli, ExportBodyWritesASkinnedCharacterWithTheClip) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path db = dir / "db.mmdb";
+  const CommandRun build =
+      run_mm("build " + quoted(folder_with_real_clips(dir)) + " -o " + quoted(db));
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  const fs::path out = dir / "walk_body.glb";
+  const CommandRun run =
+      run_mm("export " + quoted(db) + " --clip dataset-2_walk_normal_001 --body " +
+             "--weights distance -o " + quoted(out));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("distance weights"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("with the body"), std::string::npos) << run.output;
+  GltfImportOptions options;
+  options.read_skinned_mesh = true;
+  Result<GltfAsset> asset = load_gltf(out, options);
+  ASSERT_TRUE(asset.ok()) << asset.message();
+  ASSERT_TRUE(asset->skinned_mesh.has_value());
+  EXPECT_GT(asset->skinned_mesh->mesh.vertex_count(), 5000u);
+  EXPECT_EQ(asset->skinned_mesh->bind_global.size(),
+            static_cast<size_t>(asset->skeleton.joint_count()));
+  ASSERT_EQ(asset->clips.size(), 1u);
+  EXPECT_EQ(asset->clips[0].name, "dataset-2_walk_normal_001");
+
+  const CommandRun help = run_mm("export --help");
+  EXPECT_NE(help.output.find("--body"), std::string::npos);
+  EXPECT_NE(help.output.find("--weights METHOD"), std::string::npos);
+  const CommandRun bad_method =
+      run_mm("export " + quoted(db) + " --body --weights magic -o " + quoted(out));
+  EXPECT_EQ(bad_method.exit_code, 2);
+  EXPECT_NE(bad_method.output.find("--weights needs distance, envelope, heat or geodesic"),
+            std::string::npos)
+      << bad_method.output;
+  const CommandRun bvh = run_mm("export " + quoted(test::clip_path("dataset-2_walk_normal_001")) +
+                                " --body -o " + quoted(out));
+  EXPECT_EQ(bvh.exit_code, 2);
+  EXPECT_NE(bvh.output.find("--body needs a database (.mmdb)"), std::string::npos) << bvh.output;
+}
+
 // search-bench on generated data: every method and the FLANN reference in the JSON with the
 // documented fields; the exact methods match brute on every query; the reference row only
 // when nothing plays (it cannot apply the rules).

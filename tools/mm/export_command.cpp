@@ -10,6 +10,7 @@
 #include "command.hpp"
 #include "database_summary.hpp"
 #include "mm/database/bvh.hpp"
+#include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/gltf.hpp"
 
@@ -26,10 +27,18 @@ the buffer embedded. From a database the clip is rebuilt from its stored per-fra
 positions and rotations at the database rate, joint 0 (the simulation root) included as an
 ordinary root joint.
 
+With --body (database input only) the file also holds the character's generated body: a
+surface around the bones in an A-pose bind pose, skinned with the chosen weights, so the
+clip plays on a character in Blender or any glTF viewer (and mm-viewer --body loads it).
+
 options:
   -o, --output FILE   the .glb or .gltf file to write (required)
   --clip NAME|INDEX   which clip (default 0): an index, or a clip / animation name
   --scale S           BVH units to metres (default 0.01: centimetres)
+  --body              write the generated, skinned body with the clip (database input)
+  --weights METHOD    the body's skinning weights: distance, envelope, heat (default) or
+                      geodesic
+  --voxel METRES      the body surface's grid spacing (default 0.012; smaller: more vertices)
   -h, --help          this text
 
 exit status: 0 written, 1 bad input or clip not found, 2 bad usage
@@ -68,8 +77,7 @@ Result<size_t> select_clip(const std::string& selector, const std::vector<std::s
 }
 
 // A database clip as a pose sequence: the stored local positions and rotations, unit scale.
-Status export_database_clip(const Database& db, size_t clip, const fs::path& out) {
-  const ClipRange& range = db.clips[clip];
+std::vector<Transform> database_clip_frames(const Database& db, const ClipRange& range) {
   const int joints = db.joint_count();
   std::vector<Transform> frames(static_cast<size_t>(range.frame_count()) * joints);
   for (int f = 0; f < range.frame_count(); ++f) {
@@ -80,12 +88,37 @@ Status export_database_clip(const Database& db, size_t clip, const fs::path& out
       t.rotation = db.local_rotations[from];
     }
   }
+  return frames;
+}
+
+Status export_database_clip(const Database& db, size_t clip, const fs::path& out) {
+  const ClipRange& range = db.clips[clip];
+  const std::vector<Transform> frames = database_clip_frames(db, range);
   return save_gltf(db.skeleton, frames, range.frame_count(), db.frame_time, range.name, out);
+}
+
+// The clip with the generated body; says what was made and how long it took on stdout.
+Status export_database_body(const Database& db, size_t clip, const CharacterBodyOptions& options,
+                            const fs::path& out) {
+  Result<CharacterBody> body = build_character_body(db, options);
+  if (!body) return Error{body.message()};
+  const TriangleMesh& mesh = body->skinned.mesh;
+  std::printf(
+      "body: %zu vertices, %zu triangles around %zu bone segments; surface %.2f s, "
+      "%s weights %.2f s\n",
+      mesh.vertex_count(), mesh.triangle_count(), body->segments.size(), body->mesh_seconds,
+      std::string(weight_method_name(options.weights.method)).c_str(), body->weight_seconds);
+  const ClipRange& range = db.clips[clip];
+  const std::vector<Transform> frames = database_clip_frames(db, range);
+  return save_skinned_gltf(db.skeleton, body->skinned, frames, range.frame_count(), db.frame_time,
+                           range.name, out);
 }
 
 int run_export(const std::vector<std::string>& args) {
   std::string input, output, clip_selector;
   BvhOptions bvh;
+  bool with_body = false;
+  CharacterBodyOptions body;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
@@ -105,6 +138,18 @@ int run_export(const std::vector<std::string>& args) {
       const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
       if (!s || *s <= 0.0) return usage_error("--scale needs a positive number");
       bvh.scale = static_cast<float>(*s);
+    } else if (a == "--body") {
+      with_body = true;
+    } else if (a == "--weights") {
+      const std::string* v = value();
+      const std::optional<WeightMethod> method = v ? parse_weight_method(*v) : std::nullopt;
+      if (!method) return usage_error("--weights needs distance, envelope, heat or geodesic");
+      body.weights.method = *method;
+    } else if (a == "--voxel") {
+      const std::string* v = value();
+      const std::optional<double> size = v ? parse_number(*v) : std::nullopt;
+      if (!size || !(*size > 0.0)) return usage_error("--voxel needs a positive number of metres");
+      body.mesh.voxel_size = static_cast<float>(*size);
     } else if (!a.empty() && a[0] == '-') {
       return usage_error("unknown option '" + a + "'");
     } else if (input.empty()) {
@@ -121,6 +166,9 @@ int run_export(const std::vector<std::string>& args) {
   }
 
   const std::string in_ext = lower_extension(input);
+  if (with_body && in_ext != ".mmdb") {
+    return usage_error("--body needs a database (.mmdb): the body is posed from its idle pose");
+  }
   Status written;
   std::string what;
   if (in_ext == ".mmdb") {
@@ -136,9 +184,11 @@ int run_export(const std::vector<std::string>& args) {
       std::fprintf(stderr, "mm export: %s\n", clip.message().c_str());
       return 1;
     }
-    written = export_database_clip(*db, *clip, output);
+    written = with_body ? export_database_body(*db, *clip, body, output)
+                        : export_database_clip(*db, *clip, output);
     what = "'" + names[*clip] + "', " + std::to_string(db->clips[*clip].frame_count()) +
-           " frames, " + std::to_string(db->joint_count()) + " joints";
+           " frames, " + std::to_string(db->joint_count()) + " joints" +
+           (with_body ? ", with the body" : "");
   } else if (in_ext == ".gltf" || in_ext == ".glb") {
     Result<GltfAsset> asset = load_gltf(input);
     if (!asset) {
