@@ -45,7 +45,9 @@ std::vector<int> chain_below(const Skeleton& skeleton, int ancestor, int joint) 
   return chain;
 }
 
-glm::vec3 horizontal(const glm::vec3& v) { return {v.x, 0.0f, v.z}; }
+glm::vec3 horizontal(const glm::vec3& v) {
+  return {v.x, 0.0f, v.z};
+}
 
 glm::vec3 unit_or(const glm::vec3& v, const glm::vec3& fallback) {
   const float len = glm::length(v);
@@ -182,7 +184,8 @@ float lowest_foot_height(const std::vector<Transform>& global, const Skeleton& s
 
 // +1 for a limb on the character's left (+X of the hips), -1 on its right.
 float side_of(const std::vector<Transform>& global, const JointRoleIndices& roles, int joint) {
-  const float hips_x = roles.hips >= 0 ? global[static_cast<size_t>(roles.hips)].translation.x : 0.0f;
+  const float hips_x =
+      roles.hips >= 0 ? global[static_cast<size_t>(roles.hips)].translation.x : 0.0f;
   return global[static_cast<size_t>(joint)].translation.x >= hips_x ? 1.0f : -1.0f;
 }
 
@@ -245,9 +248,11 @@ Shape torso_at(float u) {
   struct Key {
     float u, radius, half_width;
   };
-  static constexpr Key keys[] = {
-      {0.00f, 0.100f, 0.045f}, {0.35f, 0.092f, 0.045f}, {0.60f, 0.105f, 0.050f},
-      {0.85f, 0.050f, 0.000f}, {1.00f, 0.050f, 0.000f}};
+  static constexpr Key keys[] = {{0.00f, 0.100f, 0.045f},
+                                 {0.35f, 0.092f, 0.045f},
+                                 {0.60f, 0.105f, 0.050f},
+                                 {0.85f, 0.050f, 0.000f},
+                                 {1.00f, 0.050f, 0.000f}};
   u = std::clamp(u, 0.0f, 1.0f);
   size_t k = 0;
   while (k + 2 < std::size(keys) && u > keys[k + 1].u) ++k;
@@ -279,7 +284,20 @@ constexpr Shape kHead{0.090f, 0.090f};
 constexpr float kHeadStart = 0.09f, kHeadEnd = 0.12f;  // along the neck, from the head joint
 
 // What a joint is to the body.
-enum class Part { Other, None, Spine, Head, Clavicle, UpperArm, LowerArm, Hand, Thigh, Shin, Foot, Toe };
+enum class Part {
+  Other,
+  None,
+  Spine,
+  Head,
+  Clavicle,
+  UpperArm,
+  LowerArm,
+  Hand,
+  Thigh,
+  Shin,
+  Foot,
+  Toe
+};
 
 struct SegmentBuilder {
   const Skeleton& skeleton;
@@ -395,8 +413,7 @@ void add_spine(SegmentBuilder& b, const std::vector<Part>& part, const std::vect
 void add_joint(SegmentBuilder& b, const std::vector<Part>& part, const Limbs& limbs, int joint) {
   const Skeleton& skeleton = b.skeleton;
   const int parent = skeleton.parent(joint);
-  const glm::vec3 from_parent =
-      parent >= 0 ? unit_or(b.at(joint) - b.at(parent), kUp) : kUp;
+  const glm::vec3 from_parent = parent >= 0 ? unit_or(b.at(joint) - b.at(parent), kUp) : kUp;
   const std::vector<int> children = children_of(skeleton, joint);
   auto first_child_with = [&](Part p) {
     for (int c : children) {
@@ -456,9 +473,12 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 Status validate_roles(const Skeleton& skeleton, const JointRoleIndices& roles) {
-  const std::pair<int, const char*> all[] = {{roles.hips, "hips"},           {roles.left_foot, "left foot"},
-                                             {roles.right_foot, "right foot"}, {roles.left_toe, "left toe"},
-                                             {roles.right_toe, "right toe"},  {roles.head, "head"}};
+  const std::pair<int, const char*> all[] = {{roles.hips, "hips"},
+                                             {roles.left_foot, "left foot"},
+                                             {roles.right_foot, "right foot"},
+                                             {roles.left_toe, "left toe"},
+                                             {roles.right_toe, "right toe"},
+                                             {roles.head, "head"}};
   for (const auto& [joint, name] : all) {
     if (joint < -1 || joint >= skeleton.joint_count()) {
       return Error{std::string("character body: the ") + name + " role is joint " +
@@ -473,7 +493,8 @@ Status validate_roles(const Skeleton& skeleton, const JointRoleIndices& roles) {
 
 int bind_source_frame(const Database& db) {
   if (db.frame_count <= 0) return -1;
-  if (const int idle = find_idle_clip(db); idle >= 0) return db.clips[static_cast<size_t>(idle)].start;
+  if (const int idle = find_idle_clip(db); idle >= 0)
+    return db.clips[static_cast<size_t>(idle)].start;
   if (const int calm = find_calmest_standing_frame(db); calm >= 0) return calm;
   return 0;
 }
@@ -559,13 +580,15 @@ Result<CharacterBody> build_character_body(const Skeleton& skeleton,
   return body;
 }
 
-Result<CharacterBody> build_character_body(const Database& db, const CharacterBodyOptions& options) {
+Result<CharacterBody> build_character_body(const Database& db,
+                                           const CharacterBodyOptions& options) {
   const int frame = bind_source_frame(db);
   if (frame < 0) return Error{"character body: the database has no frames to take a pose from"};
   const int joints = db.joint_count();
   std::vector<Transform> local(static_cast<size_t>(joints));
   for (int j = 0; j < joints; ++j) {
-    const size_t i = static_cast<size_t>(frame) * static_cast<size_t>(joints) + static_cast<size_t>(j);
+    const size_t i =
+        static_cast<size_t>(frame) * static_cast<size_t>(joints) + static_cast<size_t>(j);
     local[static_cast<size_t>(j)].translation = db.local_positions[i];
     local[static_cast<size_t>(j)].rotation = db.local_rotations[i];
   }

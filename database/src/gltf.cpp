@@ -248,8 +248,8 @@ Result<AccessorData> locate_accessor(const tinygltf::Model& model, int index, in
                  ") from byte offset " + std::to_string(accessor.byteOffset) + " do not fit in " +
                  view_label + " (" + std::to_string(length) + " bytes)"};
   }
-  return AccessorData{data.data() + view.byteOffset + accessor.byteOffset, stride, count,
-                      components, ct, where};
+  return AccessorData{
+      data.data() + view.byteOffset + accessor.byteOffset, stride, count, components, ct, where};
 }
 
 // Reads every element of an accessor as floats (count * components values); integer
@@ -263,9 +263,8 @@ Result<std::vector<float>> read_accessor(const tinygltf::Model& model, int index
   };
   auto located = locate_accessor(
       model, index, expected_type, ok,
-      allow_normalized_integers
-          ? "FLOAT or normalized BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT"
-          : "FLOAT",
+      allow_normalized_integers ? "FLOAT or normalized BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT"
+                                : "FLOAT",
       what);
   if (!located) return located.error();
   const AccessorData& a = *located;
@@ -292,8 +291,8 @@ Result<std::vector<uint32_t>> read_integer_accessor(const tinygltf::Model& model
                                                     const std::string& expected,
                                                     const std::string& what) {
   auto ok = [&](int ct, bool normalized) {
-    return !normalized && std::find(component_types.begin(), component_types.end(), ct) !=
-                              component_types.end();
+    return !normalized &&
+           std::find(component_types.begin(), component_types.end(), ct) != component_types.end();
   };
   auto located = locate_accessor(model, index, expected_type, ok, expected, what);
   if (!located) return located.error();
@@ -849,15 +848,13 @@ Result<TriangleMesh> read_triangles(const tinygltf::Model& model,
 
 // JOINTS_0 and WEIGHTS_0 as influences on skeleton joints: a skin joint number k becomes the
 // skeleton joint of node skin.joints[k]. Weights are checked and normalized.
-Result<std::vector<VertexInfluences>> read_influences(const tinygltf::Model& model,
-                                                      const tinygltf::Primitive& primitive,
-                                                      size_t vertex_count,
-                                                      const tinygltf::Skin& skin,
-                                                      const SkeletonLayout& layout,
-                                                      const std::string& label) {
+Result<std::vector<VertexInfluences>> read_influences(
+    const tinygltf::Model& model, const tinygltf::Primitive& primitive, size_t vertex_count,
+    const tinygltf::Skin& skin, const SkeletonLayout& layout, const std::string& label) {
   if (primitive.attributes.count("JOINTS_1") || primitive.attributes.count("WEIGHTS_1")) {
-    return Error{label + " has JOINTS_1/WEIGHTS_1: more than four influences per vertex are "
-                         "not supported"};
+    return Error{label +
+                 " has JOINTS_1/WEIGHTS_1: more than four influences per vertex are "
+                 "not supported"};
   }
   auto joints_index = attribute(primitive, "JOINTS_0", label, true);
   if (!joints_index) return joints_index.error();
@@ -868,7 +865,8 @@ Result<std::vector<VertexInfluences>> read_influences(const tinygltf::Model& mod
       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
       "UNSIGNED_BYTE or UNSIGNED_SHORT", label + " JOINTS_0");
   if (!joints) return joints.error();
-  auto weights = read_accessor(model, *weights_index, TINYGLTF_TYPE_VEC4, true, label + " WEIGHTS_0");
+  auto weights =
+      read_accessor(model, *weights_index, TINYGLTF_TYPE_VEC4, true, label + " WEIGHTS_0");
   if (!weights) return weights.error();
   if (joints->size() != vertex_count * 4 || weights->size() != vertex_count * 4) {
     return Error{label + " has " + std::to_string(vertex_count) + " positions but " +
@@ -907,8 +905,8 @@ Result<SkinnedMesh> read_skinned_mesh(const tinygltf::Model& model, int skin_ind
   if (!node) return node.error();
   const int mesh_index = model.nodes[static_cast<size_t>(*node)].mesh;
   const tinygltf::Mesh& gltf_mesh = model.meshes[static_cast<size_t>(mesh_index)];
-  const std::string label = "mesh " + std::to_string(mesh_index) + quoted_name(gltf_mesh.name) +
-                            " primitive 0";
+  const std::string label =
+      "mesh " + std::to_string(mesh_index) + quoted_name(gltf_mesh.name) + " primitive 0";
   if (gltf_mesh.primitives.empty()) {
     return Error{"mesh " + std::to_string(mesh_index) + quoted_name(gltf_mesh.name) +
                  " has no primitives"};
@@ -918,15 +916,15 @@ Result<SkinnedMesh> read_skinned_mesh(const tinygltf::Model& model, int skin_ind
   auto mesh = read_triangles(model, primitive, label);
   if (!mesh) return mesh.error();
   out.mesh = std::move(*mesh);
-  auto influences = read_influences(model, primitive, out.mesh.positions.size(),
-                                    model.skins[static_cast<size_t>(skin_index)], skeleton.layout,
-                                    label);
+  auto influences =
+      read_influences(model, primitive, out.mesh.positions.size(),
+                      model.skins[static_cast<size_t>(skin_index)], skeleton.layout, label);
   if (!influences) return influences.error();
   out.influences = std::move(*influences);
   for (size_t j = 0; j < skeleton.inverse_bind_matrices.size(); ++j) {
-    auto bind = decompose(glm::inverse(glm::dmat4(skeleton.inverse_bind_matrices[j])),
-                          "inverse bind matrix of joint '" +
-                              skeleton.skeleton.name(static_cast<int>(j)) + "'");
+    auto bind = decompose(
+        glm::inverse(glm::dmat4(skeleton.inverse_bind_matrices[j])),
+        "inverse bind matrix of joint '" + skeleton.skeleton.name(static_cast<int>(j)) + "'");
     if (!bind) return bind.error();
     out.bind_global.push_back(*bind);
   }
@@ -1224,9 +1222,11 @@ Status check_body(const SkinnedMesh& body, size_t joints) {
     return Error{"the body has " + std::to_string(body.bind_global.size()) +
                  " bind transforms for " + std::to_string(joints) + " joints"};
   }
-  if (joints > 65536) return Error{"JOINTS_0 as UNSIGNED_SHORT cannot address " + std::to_string(joints) + " joints"};
+  if (joints > 65536)
+    return Error{"JOINTS_0 as UNSIGNED_SHORT cannot address " + std::to_string(joints) + " joints"};
   if (vertices == 0 || mesh.indices.empty()) return Error{"the body mesh is empty"};
-  if (body.influences.size() != vertices || (!mesh.normals.empty() && mesh.normals.size() != vertices)) {
+  if (body.influences.size() != vertices ||
+      (!mesh.normals.empty() && mesh.normals.size() != vertices)) {
     return Error{"the body has " + std::to_string(vertices) + " vertices but " +
                  std::to_string(body.influences.size()) + " influences and " +
                  std::to_string(mesh.normals.size()) + " normals"};
@@ -1316,10 +1316,9 @@ tinygltf::Primitive body_primitive(BufferWriter& writer, const SkinnedMesh& body
         writer.add(mesh.normals.data(), n * sizeof(glm::vec3), TINYGLTF_COMPONENT_TYPE_FLOAT,
                    TINYGLTF_TYPE_VEC3, n, TINYGLTF_TARGET_ARRAY_BUFFER);
   }
-  primitive.attributes["JOINTS_0"] =
-      writer.add(joints.data(), joints.size() * sizeof(uint16_t),
-                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, n,
-                 TINYGLTF_TARGET_ARRAY_BUFFER);
+  primitive.attributes["JOINTS_0"] = writer.add(
+      joints.data(), joints.size() * sizeof(uint16_t), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+      TINYGLTF_TYPE_VEC4, n, TINYGLTF_TARGET_ARRAY_BUFFER);
   primitive.attributes["WEIGHTS_0"] =
       writer.add(weights.data(), weights.size() * sizeof(float), TINYGLTF_COMPONENT_TYPE_FLOAT,
                  TINYGLTF_TYPE_VEC4, n, TINYGLTF_TARGET_ARRAY_BUFFER);
@@ -1390,7 +1389,8 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
     globals = body->bind_global;
     for (size_t j = 0; j < joints; ++j) {
       const int p = skeleton.parent(static_cast<int>(j));
-      bind_local[j] = p < 0 ? globals[j] : compose(inverse(globals[static_cast<size_t>(p)]), globals[j]);
+      bind_local[j] =
+          p < 0 ? globals[j] : compose(inverse(globals[static_cast<size_t>(p)]), globals[j]);
     }
   } else {
     forward_kinematics(skeleton.parents(), skeleton.rest(), globals);

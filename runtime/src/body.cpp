@@ -113,14 +113,14 @@ Status validate_input(std::span<const BoneSegment> segments, const BodyMeshOptio
   if (segments.empty()) return Error{"body mesh: no bone segments to build a body around"};
   for (size_t i = 0; i < segments.size(); ++i) {
     const BoneSegment& s = segments[i];
-    const std::string where = "body mesh: segment " + std::to_string(i) + " (joint " +
-                              std::to_string(s.joint) + ")";
+    const std::string where =
+        "body mesh: segment " + std::to_string(i) + " (joint " + std::to_string(s.joint) + ")";
     if (!finite(s.head) || !finite(s.tail)) return Error{where + ": an end point is not finite"};
     for (const auto& [radius, end] :
          {std::pair{s.head_radius, "head"}, std::pair{s.tail_radius, "tail"}}) {
       if (!(radius > 0.0f) || !std::isfinite(radius)) {
-        return Error{where + ": " + end + " radius must be a positive finite number of metres, got " +
-                     number(radius)};
+        return Error{where + ": " + end +
+                     " radius must be a positive finite number of metres, got " + number(radius)};
       }
     }
   }
@@ -138,11 +138,12 @@ struct Grid {
 
   size_t index(int i, int j, int k) const {
     return static_cast<size_t>(i) +
-           static_cast<size_t>(points.x) * (static_cast<size_t>(j) + static_cast<size_t>(points.y) * k);
+           static_cast<size_t>(points.x) *
+               (static_cast<size_t>(j) + static_cast<size_t>(points.y) * k);
   }
   glm::vec3 position(int i, int j, int k) const {
-    return origin + voxel * glm::vec3(static_cast<float>(i), static_cast<float>(j),
-                                      static_cast<float>(k));
+    return origin +
+           voxel * glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k));
   }
   bool inside(int i, int j, int k) const { return field[index(i, j, k)] < 0.0f; }
 };
@@ -208,11 +209,10 @@ void resolve_ambiguous_faces(Grid& grid) {
         for (int j = 0; j < end.y; ++j) {
           for (int i = 0; i < end.x; ++i) {
             const glm::ivec3 p(i, j, k);
-            const std::array<size_t, 4> c = {grid.index(p.x, p.y, p.z),
-                                             grid.index(p.x + eu.x, p.y + eu.y, p.z + eu.z),
-                                             grid.index(p.x + eu.x + ev.x, p.y + eu.y + ev.y,
-                                                        p.z + eu.z + ev.z),
-                                             grid.index(p.x + ev.x, p.y + ev.y, p.z + ev.z)};
+            const std::array<size_t, 4> c = {
+                grid.index(p.x, p.y, p.z), grid.index(p.x + eu.x, p.y + eu.y, p.z + eu.z),
+                grid.index(p.x + eu.x + ev.x, p.y + eu.y + ev.y, p.z + eu.z + ev.z),
+                grid.index(p.x + ev.x, p.y + ev.y, p.z + ev.z)};
             std::array<float, 4> f;
             for (size_t q = 0; q < 4; ++q) f[q] = grid.field[c[q]];
             const bool a = f[0] < 0.0f, b = f[1] < 0.0f;
@@ -235,11 +235,22 @@ void resolve_ambiguous_faces(Grid& grid) {
 // ---------------------------------------------------------------------------------------------
 // Surface nets
 
-constexpr std::array<std::array<int, 2>, 12> kCellEdges = {{{0, 1}, {2, 3}, {4, 5}, {6, 7},
-                                                            {0, 2}, {1, 3}, {4, 6}, {5, 7},
-                                                            {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+constexpr std::array<std::array<int, 2>, 12> kCellEdges = {{{0, 1},
+                                                            {2, 3},
+                                                            {4, 5},
+                                                            {6, 7},
+                                                            {0, 2},
+                                                            {1, 3},
+                                                            {4, 6},
+                                                            {5, 7},
+                                                            {0, 4},
+                                                            {1, 5},
+                                                            {2, 6},
+                                                            {3, 7}}};
 
-glm::ivec3 corner_offset(int corner) { return {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1}; }
+glm::ivec3 corner_offset(int corner) {
+  return {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1};
+}
 
 // The cell's vertex: the mean of the points where the surface crosses its edges (linear
 // interpolation of the sampled distances), moved onto the surface by Newton steps along the
@@ -260,8 +271,8 @@ glm::vec3 cell_vertex(const Grid& grid, std::span<const Capsule> capsules, float
     sum += glm::mix(glm::vec3(corner_offset(c0)), glm::vec3(corner_offset(c1)), t);
     ++crossings;
   }
-  const glm::vec3 start = grid.position(cell.x, cell.y, cell.z) + grid.voxel * sum /
-                                                                      static_cast<float>(crossings);
+  const glm::vec3 start =
+      grid.position(cell.x, cell.y, cell.z) + grid.voxel * sum / static_cast<float>(crossings);
   glm::vec3 p = start;
   for (int iteration = 0; iteration < 3; ++iteration) {
     const float d = union_distance(capsules, blend, p);
@@ -282,7 +293,8 @@ struct NetVertices {
   glm::ivec3 cells{0};
   size_t index(const glm::ivec3& c) const {
     return static_cast<size_t>(c.x) +
-           static_cast<size_t>(cells.x) * (static_cast<size_t>(c.y) + static_cast<size_t>(cells.y) * c.z);
+           static_cast<size_t>(cells.x) *
+               (static_cast<size_t>(c.y) + static_cast<size_t>(cells.y) * c.z);
   }
 };
 
@@ -316,11 +328,10 @@ void emit_quad(const NetVertices& net, const glm::ivec3& base, int axis, bool in
   eu[(axis + 1) % 3] = 1;
   ev[(axis + 2) % 3] = 1;
   // Counter-clockwise about +axis: (u-, v-), (u+, v-), (u+, v+), (u-, v+).
-  std::array<uint32_t, 4> q = {
-      static_cast<uint32_t>(net.of_cell[net.index(base - eu - ev)]),
-      static_cast<uint32_t>(net.of_cell[net.index(base - ev)]),
-      static_cast<uint32_t>(net.of_cell[net.index(base)]),
-      static_cast<uint32_t>(net.of_cell[net.index(base - eu)])};
+  std::array<uint32_t, 4> q = {static_cast<uint32_t>(net.of_cell[net.index(base - eu - ev)]),
+                               static_cast<uint32_t>(net.of_cell[net.index(base - ev)]),
+                               static_cast<uint32_t>(net.of_cell[net.index(base)]),
+                               static_cast<uint32_t>(net.of_cell[net.index(base - eu)])};
   if (!inside_first) std::swap(q[1], q[3]);
   const auto& pos = mesh.positions;
   const float d02 = glm::distance(pos[q[0]], pos[q[2]]);

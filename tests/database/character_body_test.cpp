@@ -189,8 +189,8 @@ TEST(CharacterBody, LoadBodyMapsJointsByNameAndListsMissingOnes) {
   const Built& b = built();
   const fs::path out = test::scratch_dir() / "body.glb";
   const std::vector<Transform> pose = clip_frame(b.db, b.db.clips[0], 0);
-  ASSERT_TRUE(save_skinned_gltf(b.db.skeleton, b.body.skinned, pose, 1, b.db.frame_time, "pose", out)
-                  .ok());
+  ASSERT_TRUE(
+      save_skinned_gltf(b.db.skeleton, b.body.skinned, pose, 1, b.db.frame_time, "pose", out).ok());
 
   // Mapped back onto the database skeleton by name, it skins as the body it was made from.
   std::vector<std::string> names = b.db.skeleton.names();

@@ -61,15 +61,16 @@ struct Fixture {
 
 std::string fixture_gltf(const Fixture& f) {
   std::vector<unsigned char> b;
-  append<float>(b, {0, 0, 0, 1, 0, 0, 0, 1, 0});                       // 0: positions
-  append<float>(b, {0, 0, 1, 0, 0, 1, 0, 0, 1});                       // 36: normals
-  append<uint8_t>(b, {0, 0, 0, 0, 1, 0, 0, 0, f.third_joint, 0, 0, 0});  // 72: joints
+  append<float>(b, {0, 0, 0, 1, 0, 0, 0, 1, 0});                                // 0: positions
+  append<float>(b, {0, 0, 1, 0, 0, 1, 0, 0, 1});                                // 36: normals
+  append<uint8_t>(b, {0, 0, 0, 0, 1, 0, 0, 0, f.third_joint, 0, 0, 0});         // 72: joints
   append<float>(b, {1, 0, 0, 0, 0.25f, 0.75f, 0, 0, f.third_weight, 0, 0, 0});  // 84: weights
-  append<uint16_t>(b, {0, 1, f.third_index, 0});                        // 132: indices
+  append<uint16_t>(b, {0, 1, f.third_index, 0});                                // 132: indices
   std::string attributes;
   auto attribute = [&](bool on, const std::string& name, int accessor) {
     if (!on) return;
-    attributes += (attributes.empty() ? "" : ", ") + ("\"" + name + "\": ") + std::to_string(accessor);
+    attributes +=
+        (attributes.empty() ? "" : ", ") + ("\"" + name + "\": ") + std::to_string(accessor);
   };
   attribute(f.position, "POSITION", 0);
   attribute(true, "NORMAL", 1);
@@ -87,13 +88,14 @@ std::string fixture_gltf(const Fixture& f) {
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
                 {"bufferView": 1, "componentType": 5126, "count": )" +
          std::to_string(f.normal_count) + R"(, "type": "VEC3"},
-                {"bufferView": 2, "componentType": )" + f.joints_component +
+                {"bufferView": 2, "componentType": )" +
+         f.joints_component +
          R"(, "count": 3, "type": "VEC4"},
                 {"bufferView": 3, "componentType": 5126, "count": 3, "type": "VEC4"},
                 {"bufferView": 4, "componentType": 5123, "count": )" +
          std::to_string(f.index_count) + R"(, "type": "SCALAR"}],
-  "meshes": [{"name": "tri", "primitives": [{"attributes": {)" + attributes +
-         R"(}, "indices": 4, "mode": )" + std::to_string(f.mode) + R"(}]}],
+  "meshes": [{"name": "tri", "primitives": [{"attributes": {)" +
+         attributes + R"(}, "indices": 4, "mode": )" + std::to_string(f.mode) + R"(}]}],
   "nodes": [{"name": "root", "children": [1], "translation": [0, 1, 0]},
             {"name": "child", "translation": [0, 0.5, 0]},
             {"name": "body", "mesh": 0)" +
@@ -185,8 +187,9 @@ TEST(GltfSkinnedMesh, RefusesMalformedMeshesByMessage) {
   expect_refused(f, "vertex 2 has negative weight -1");
   f = {};
   f.joints_component = "5126";
-  expect_refused(f, "JOINTS_0: accessor 2 has component type FLOAT, expected UNSIGNED_BYTE or "
-                    "UNSIGNED_SHORT");
+  expect_refused(f,
+                 "JOINTS_0: accessor 2 has component type FLOAT, expected UNSIGNED_BYTE or "
+                 "UNSIGNED_SHORT");
 }
 
 // A two-joint skeleton and a one-triangle body bound to it.

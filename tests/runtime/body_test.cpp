@@ -56,7 +56,8 @@ TEST(TaperedCapsuleDistance, MatchesTheGeometryOfCapsulesConesAndSpheres) {
   const float c = std::sqrt(1.0f - s * s);
   const glm::vec3 on_side = glm::vec3(0.3f * c, 0.3f * s, 0.0f) + 0.5f * glm::vec3(-s, c, 0.0f);
   EXPECT_NEAR(tapered_capsule_distance(cone, on_side), 0.0f, 1e-6f);
-  EXPECT_NEAR(tapered_capsule_distance(cone, on_side + 0.25f * glm::vec3(c, s, 0.0f)), 0.25f, 1e-6f);
+  EXPECT_NEAR(tapered_capsule_distance(cone, on_side + 0.25f * glm::vec3(c, s, 0.0f)), 0.25f,
+              1e-6f);
 
   // Zero length, and one end sphere inside the other: spheres.
   const BoneSegment point = segment({1, 2, 3}, {1, 2, 3}, 0.1f, 0.2f);
@@ -75,12 +76,14 @@ TEST(BodySignedDistance, TheSmoothUnionFillsTheCreaseAndLeavesFarPointsAlone) {
   EXPECT_NEAR(body_signed_distance(cross, 0.08f, crease), plain - 0.02f, 1e-6f);
   // Far from the crossing only one capsule matters and the blend changes nothing.
   const glm::vec3 along(0.8f, 0.3f, 0.0f);
-  EXPECT_FLOAT_EQ(body_signed_distance(cross, 0.08f, along), body_signed_distance(cross, 0.0f, along));
+  EXPECT_FLOAT_EQ(body_signed_distance(cross, 0.08f, along),
+                  body_signed_distance(cross, 0.0f, along));
 }
 
 TEST(BodyMesh, ACapsuleBecomesAClosedOutwardMeshOnItsSurface) {
   const float radius = 0.05f, length = 0.3f;
-  const BoneSegment bone = segment({0.1f, 0.2f, -0.05f}, {0.1f, 0.2f + length, -0.05f}, radius, radius);
+  const BoneSegment bone =
+      segment({0.1f, 0.2f, -0.05f}, {0.1f, 0.2f + length, -0.05f}, radius, radius);
   BodyMeshOptions options;
   options.voxel_size = 0.01f;
   Result<TriangleMesh> mesh = generate_body_mesh({&bone, 1}, options);
@@ -159,7 +162,8 @@ TEST(BodyMesh, RefusesBadInputNamingWhatIsWrong) {
   const std::vector<BoneSegment> bad_point = {good, segment({0, nan, 0}, {0, 1, 0}, 0.1f, 0.1f, 7)};
   expect_error(generate_body_mesh(bad_point), "segment 1 (joint 7): an end point is not finite");
   const BoneSegment flat = segment({0, 0, 0}, {0, 1, 0}, 0.1f, 0.0f, 2);
-  expect_error(generate_body_mesh({&flat, 1}), "segment 0 (joint 2): tail radius must be a positive");
+  expect_error(generate_body_mesh({&flat, 1}),
+               "segment 0 (joint 2): tail radius must be a positive");
   const BoneSegment negative = segment({0, 0, 0}, {0, 1, 0}, -0.1f, 0.1f, 2);
   expect_error(generate_body_mesh({&negative, 1}), "head radius must be a positive");
 
