@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# The main job. Installs missing Debian packages, builds Release, then runs the most complete
-# real pipeline on the motion capture in ../shared/mocap/bandai-normal (or $MM_DATA):
-#   build the motion database -> show its summary -> run the character controller on every
-#   shipped input script and print its quality metrics -> the crowd benchmark -> benchmark
-#   every search method -> export one clip of it to glTF.
-# Outputs go to out/ (a database, JSON of every benchmark, a .glb).
+# The main job: the motion-matching demo on the motion capture in ../shared/mocap/bandai-normal
+# (or $MM_DATA). Installs missing Debian packages, builds Release, builds the motion database,
+# then:
+# - with a display: opens mm-viewer (gamepad or keyboard; its --help lists the controls);
+# - without one: runs the viewer headless on scripts/input/showcase.txt (walk, turn, run, stop
+#   and stand, walk back, strafe), writing a screenshot every 1.5 s, the last frame and a
+#   top-down plot of the run, then measures the same script with `mm eval`.
+# Everything goes to out/. Set MM_HEADLESS=1 to run headless even with a display.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -23,28 +25,27 @@ fi
 
 scripts/setup.sh release
 mm=build/release/tools/mm
-mkdir -p out
+viewer=build/release/viewer/mm-viewer
+mkdir -p out/viewer
 
-printf '\n=== 1/6 Building the motion database from %s ===\n' "$data"
+printf '\n=== Building the motion database from %s ===\n' "$data"
 "$mm" build "$data" -o out/database.mmdb
 
-printf '\n=== 2/6 Database summary ===\n'
-"$mm" info out/database.mmdb
+if [ -z "${MM_HEADLESS:-}" ] && { [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; }; then
+  printf '\n=== mm-viewer (close the window or press Esc to quit; F1 hides the panel) ===\n'
+  exec "$viewer" --db out/database.mmdb
+fi
 
-printf '\n=== 3/6 Scripted controller runs (mm eval, every script in scripts/input, dt 1/60, IK on) ===\n'
-scripts=()
-for f in scripts/input/*.txt; do scripts+=(--script "$f"); done
-"$mm" eval --db out/database.mmdb "${scripts[@]}" --json out/eval.json
+script=scripts/input/showcase.txt
+printf '\n=== No display: mm-viewer headless on %s ===\n' "$script"
+rm -f out/viewer/*.png
+"$viewer" --db out/database.mmdb --headless --script "$script" --every 90 \
+  --screenshot out/viewer/showcase.png --plot out/viewer/plot.png
 
-printf '\n=== 4/6 Crowd benchmark (mm crowd-bench, 1500 characters, 5 s at 60 Hz) ===\n'
-"$mm" crowd-bench --db out/database.mmdb --characters 1500 --seconds 5 --json out/crowd-bench.json
+printf '\n=== The same script measured (mm eval, dt 1/60, IK on) ===\n'
+"$mm" eval --db out/database.mmdb --script "$script" --json out/viewer/eval.json
 
-printf '\n=== 5/6 Search benchmark (every method, 2000 queries, noise 0.1) ===\n'
-"$mm" search-bench --db out/database.mmdb --queries 2000 --noise 0.1 --json out/search-bench.json
-
-printf '\n=== 6/6 Exporting one walk clip to glTF ===\n'
-"$mm" export out/database.mmdb --clip dataset-2_walk_normal_001 -o out/walk.glb
-
-printf '\nDone: out/database.mmdb, out/eval.json, out/crowd-bench.json, out/search-bench.json,\n'
-printf 'out/walk.glb (opens in Blender). mm eval --help explains the metrics; add --dump FILE.csv for\n'
-printf 'one row per frame of a run.\n'
+printf '\nDone. In out/viewer/: showcase-<frame>.png every 1.5 s of the run and showcase.png (the\n'
+printf 'last frame), plot.png (the whole run from above), eval.json (the metrics printed above).\n'
+printf 'With a display, scripts/run.sh opens the interactive viewer instead; scripts/bench.sh runs\n'
+printf 'every shipped script, the crowd and the search benchmarks.\n'

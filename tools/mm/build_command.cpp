@@ -1,8 +1,6 @@
 // `mm build`: makes a database file from BVH / glTF files and folders, with a progress bar and
 // a summary.
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +11,7 @@
 #include "database_summary.hpp"
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
+#include "progress_bar.hpp"
 
 namespace mm::cli {
 namespace {
@@ -53,35 +52,6 @@ int usage_error(const std::string& message) {
   std::fprintf(stderr, "mm build: %s\n\n%s", message.c_str(), kUsage);
   return 2;
 }
-
-// Draws a progress bar on a terminal, or prints a plain line every 10 % otherwise. The builder
-// counts each file twice (read, then processed).
-class Progress {
- public:
-  explicit Progress(bool enabled) : enabled_(enabled), terminal_(isatty(fileno(stderr)) != 0) {}
-  void update(size_t done, size_t total) {
-    if (!enabled_ || total == 0) return;
-    if (terminal_) {
-      const int width = 40;
-      const int filled = static_cast<int>(width * done / total);
-      std::fprintf(stderr, "\r[%s%s] %3d %%", std::string(filled, '#').c_str(),
-                   std::string(width - filled, '.').c_str(), static_cast<int>(100 * done / total));
-      if (done == total) std::fprintf(stderr, "\n");
-      std::fflush(stderr);
-    } else {
-      const size_t decile = done * 10 / total;
-      if (decile > last_decile_ || done == total) {
-        last_decile_ = decile;
-        std::fprintf(stderr, "mm build: %3d %%\n", static_cast<int>(100 * done / total));
-      }
-    }
-  }
-
- private:
-  bool enabled_;
-  bool terminal_;
-  size_t last_decile_ = 0;
-};
 
 int run_build(const std::vector<std::string>& args) {
   std::vector<std::filesystem::path> inputs;
@@ -200,7 +170,7 @@ int run_build(const std::vector<std::string>& args) {
   if (output.empty()) return usage_error("no output file (-o <out.mmdb>)");
 
   const auto start = std::chrono::steady_clock::now();
-  Progress progress(!quiet);
+  ProgressBar progress("mm build", !quiet);
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   BuildReport report;
   Result<Database> db = build_database(inputs, options, &report);

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The measurements: the controller on every shipped input script (mm eval table), the crowd
+# benchmark, every search method, on the database of ../shared/mocap/bandai-normal (or
+# $MM_DATA). Builds Release first; writes JSON of each to out/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+data=${MM_DATA:-$root/../shared/mocap/bandai-normal}
+
+scripts/setup.sh release
+mm=build/release/tools/mm
+mkdir -p out
+
+printf '\n=== 1/4 Building the motion database from %s ===\n' "$data"
+"$mm" build "$data" -o out/database.mmdb
+
+printf '\n=== 2/4 Scripted controller runs (mm eval, every script in scripts/input, dt 1/60, IK on) ===\n'
+scripts=()
+for f in scripts/input/*.txt; do scripts+=(--script "$f"); done
+"$mm" eval --db out/database.mmdb "${scripts[@]}" --json out/eval.json
+
+printf '\n=== 3/4 Crowd benchmark (mm crowd-bench, 1500 characters, 5 s at 60 Hz) ===\n'
+"$mm" crowd-bench --db out/database.mmdb --characters 1500 --seconds 5 --json out/crowd-bench.json
+
+printf '\n=== 4/4 Search benchmark (every method, 2000 queries, noise 0.1) ===\n'
+"$mm" search-bench --db out/database.mmdb --queries 2000 --noise 0.1 --json out/search-bench.json
+
+printf '\nDone: out/eval.json, out/crowd-bench.json, out/search-bench.json\n'

@@ -1,0 +1,232 @@
+// mm-viewer run as a program: headless (EGL) and windowed under Xvfb, on a short script of the
+// real data, and its images checked: sky, a ground grid and the character where the viewer
+// says it drew it.
+
+#include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include <sys/wait.h>
+
+#include "mm/controller/script.hpp"
+#include "mm/database/builder.hpp"
+#include "mm/database/database_file.hpp"
+#include "test_support.hpp"
+
+namespace mm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ProgramRun {
+  int exit_code = -1;
+  std::string output;
+};
+
+// Runs a shell command line; Mesa leaks a little at exit, which is not ours to report.
+ProgramRun run(const std::string& command_line) {
+  setenv("ASAN_OPTIONS", "detect_leaks=0", 1);
+  ProgramRun r;
+  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string viewer() { return std::string("'") + MM_VIEWER_PATH + "'"; }
+
+std::string script(const std::string& name) {
+  return std::string(MM_SOURCE_DIR) + "/scripts/input/" + name;
+}
+
+// The Bandai normal database, built once per test program into the build tree.
+const fs::path& database_file() {
+  static const fs::path path = [] {
+    const fs::path out = test::scratch_dir() / "normal.mmdb";
+    const fs::path inputs[] = {test::data_dir()};
+    Result<Database> db = build_database(inputs, BuildOptions{});
+    EXPECT_TRUE(db.ok()) << (db.ok() ? "" : db.message());
+    if (db.ok()) {
+      EXPECT_TRUE(save_database(*db, out).ok());
+    }
+    return out;
+  }();
+  return path;
+}
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+  glm::ivec3 at(int x, int y) const {
+    const unsigned char* p = rgb.data() + (static_cast<size_t>(y) * width + x) * 3;
+    return {p[0], p[1], p[2]};
+  }
+};
+
+Image load_png(const fs::path& path) {
+  Image image;
+  int channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &image.width, &image.height, &channels, 3);
+  if (!data) return image;
+  image.rgb.assign(data, data + static_cast<size_t>(image.width) * image.height * 3);
+  stbi_image_free(data);
+  return image;
+}
+
+struct Box {
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+
+// The viewer prints where it drew the character: "pixels x A..B, y C..D".
+bool parse_box(const std::string& output, Box& box) {
+  std::smatch m;
+  const std::regex pattern("pixels x (-?[0-9]+)\\.\\.(-?[0-9]+), y (-?[0-9]+)\\.\\.(-?[0-9]+)");
+  if (!std::regex_search(output, m, pattern)) return false;
+  box = {std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4])};
+  return true;
+}
+
+bool near(const glm::ivec3& a, const glm::ivec3& b, int tolerance) {
+  return std::abs(a.x - b.x) <= tolerance && std::abs(a.y - b.y) <= tolerance &&
+         std::abs(a.z - b.z) <= tolerance;
+}
+
+// The checks of an image of the scene: the top rows are sky, the bottom rows ground crossed
+// by grid lines (two clearly different greys), and the character's box is mostly neither.
+void expect_scene(const Image& image, const Box& box) {
+  ASSERT_GT(image.width, 0) << "no image";
+  const glm::ivec3 sky = image.at(image.width - 1, 0);
+  EXPECT_GT(sky.z, sky.x) << "the sky is bluish";
+  int sky_pixels = 0;
+  for (int x = 0; x < image.width; ++x) sky_pixels += near(image.at(x, 2), sky, 6);
+  EXPECT_GT(sky_pixels, image.width * 9 / 10) << "the top row is sky";
+
+  // Ground: the bottom row away from the character holds the plane's grey and darker lines.
+  const int y = image.height - 2;
+  int light = 0, dark = 0;
+  for (int x = 0; x < image.width; ++x) {
+    const glm::ivec3 c = image.at(x, y);
+    const int grey = (c.x + c.y + c.z) / 3;
+    if (!near(c, glm::ivec3(grey), 8) || grey <= 100) continue;
+    (grey > 145 ? light : dark) += 1;
+  }
+  EXPECT_GT(light, image.width / 2) << "ground plane";
+  EXPECT_GT(dark, 3) << "grid lines";
+
+  ASSERT_GE(box.x0, 0);
+  ASSERT_LT(box.x1, image.width);
+  ASSERT_GE(box.y0, 0);
+  ASSERT_LT(box.y1, image.height);
+  EXPECT_GT((box.x1 - box.x0) * (box.y1 - box.y0), 500) << "the character is not a speck";
+  // Pixels of the character's box that are neither sky nor grey ground: the body's colour.
+  int body = 0, total = 0;
+  for (int py = box.y0; py <= box.y1; ++py) {
+    for (int px = box.x0; px <= box.x1; ++px) {
+      const glm::ivec3 c = image.at(px, py);
+      ++total;
+      // Warm (red over green over blue), unlike the bluish sky, the grey ground and its pure
+      // red and blue axis lines.
+      body += c.x > c.z + 10 && c.x >= c.y && c.y >= c.z && c.x - c.y < 40;
+    }
+  }
+  EXPECT_GT(body, total / 6) << body << " body pixels of " << total;
+}
+
+TEST(ViewerCli, HeadlessScreenshotShowsSkyGroundGridAndTheCharacter) {
+  const fs::path dir = test::scratch_dir();
+  const ProgramRun r = run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
+                    script("circle.txt") + "' --frames 120 --size 640x360 --no-panel --debug none" +
+                    " --screenshot '" + (dir / "shot.png").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Box box;
+  ASSERT_TRUE(parse_box(r.output, box)) << r.output;
+  const Image image = load_png(dir / "shot.png");
+  EXPECT_EQ(image.width, 640);
+  EXPECT_EQ(image.height, 360);
+  expect_scene(image, box);
+}
+
+TEST(ViewerCli, WindowedUnderXvfbShowsTheSameScene) {
+  const fs::path dir = test::scratch_dir();
+  const ProgramRun r = run("xvfb-run -a -s '-screen 0 1024x768x24' " + viewer() + " --db '" +
+                    database_file().string() + "' --script '" + script("zigzag.txt") +
+                    "' --frames 90 --dt 0.0166667 --size 800x450 --no-panel --debug none" +
+                    " --screenshot '" + (dir / "window.png").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Box box;
+  ASSERT_TRUE(parse_box(r.output, box)) << r.output;
+  const Image image = load_png(dir / "window.png");
+  EXPECT_EQ(image.width, 800);
+  EXPECT_EQ(image.height, 450);
+  expect_scene(image, box);
+}
+
+TEST(ViewerCli, EveryWritesNumberedScreenshotsAndThePlot) {
+  const fs::path dir = test::scratch_dir();
+  const ProgramRun r = run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
+                    script("stop-and-go.txt") + "' --frames 60 --every 25 --size 320x180" +
+                    " --screenshot '" + (dir / "s.png").string() + "' --plot '" +
+                    (dir / "plot.png").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "s-000025.png"));
+  EXPECT_TRUE(fs::exists(dir / "s-000050.png"));
+  EXPECT_TRUE(fs::exists(dir / "s.png"));
+  EXPECT_FALSE(fs::exists(dir / "s-000060.png")) << "the last frame is s.png itself";
+  EXPECT_EQ(load_png(dir / "s-000025.png").width, 320);
+  EXPECT_GT(load_png(dir / "plot.png").width, 0);
+}
+
+TEST(ViewerCli, RecordsLiveInputAsAScriptThatParses) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path recorded = dir / "recorded.txt";
+  const ProgramRun r = run("xvfb-run -a " + viewer() + " --db '" + database_file().string() +
+                    "' --frames 20 --dt 0.0166667 --size 320x180 --record '" + recorded.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Result<InputScript> parsed = load_input_script(recorded);
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  // Nobody touches the keyboard under Xvfb: one line, at time 0, of a neutral input.
+  ASSERT_EQ(parsed->events().size(), 1u);
+  EXPECT_EQ(parsed->events()[0].time, 0.0f);
+  EXPECT_EQ(parsed->events()[0].input.left_stick, glm::vec2(0.0f));
+}
+
+TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
+  ProgramRun r = run(viewer() + " --headless --db x.mmdb");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--headless needs --script"), std::string::npos) << r.output;
+  r = run(viewer() + " --db a.mmdb --data b");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("give --db or --data, not both"), std::string::npos) << r.output;
+  r = run(viewer() + " --frames 1.5 --headless --script x");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--frames needs a whole number"), std::string::npos) << r.output;
+  r = run(viewer() + " --weights blobs");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--weights needs distance, envelope, heat or geodesic"), std::string::npos);
+
+  const fs::path dir = test::scratch_dir();
+  r = run(viewer() + " --db '" + (dir / "missing.mmdb").string() + "' --headless --script '" +
+          script("circle.txt") + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("missing.mmdb"), std::string::npos) << r.output;
+  r = run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
+          (dir / "none.txt").string() + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("none.txt"), std::string::npos) << r.output;
+  r = run("env -u DISPLAY -u WAYLAND_DISPLAY " + viewer() + " --db '" + database_file().string() + "'");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("no display"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mm

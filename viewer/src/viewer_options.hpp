@@ -1,0 +1,38 @@
+#pragma once
+// The command line of mm-viewer (see kViewerUsage in viewer_options.cpp).
+
+#include <string>
+#include <vector>
+
+#include "debug_drawing.hpp"
+#include "mm/controller/controller.hpp"
+#include "mm/runtime/bone_weights.hpp"
+#include "skinned_body.hpp"
+
+namespace mm::viewer {
+
+struct ViewerOptions {
+  std::string db_path;    // --db
+  std::string data_path;  // --data (neither: $MM_DATA, else the shared Bandai folder)
+  std::string body_path;  // --body: a skinned glTF character instead of the generated body
+  WeightMethod weights = WeightMethod::HeatDiffusion;
+  SkinningMethod skinning = SkinningMethod::DualQuaternion;
+  std::string script_path;  // replay instead of live input
+  std::string record_path;  // record the live input into this script file
+  ControllerSettings settings;
+  bool headless = false;
+  int frames = 0;  // 0: windowed runs until closed; headless runs the script and 2 s more
+  std::string screenshot_path;
+  int every = 0;   // also a screenshot every K frames
+  std::string plot_path;
+  int width = 1280, height = 720;
+  float dt = 0.0f;  // seconds per update; 0: the wall clock (windowed), 1/60 (headless)
+  bool panel = true;
+  DebugToggles toggles;
+};
+
+// Parses the arguments (without the program name). Returns the exit code to stop with (0 after
+// --help, 2 on a usage error, with the message printed) or -1 to go on.
+int parse_viewer_options(const std::vector<std::string>& args, ViewerOptions& out);
+
+}  // namespace mm::viewer
