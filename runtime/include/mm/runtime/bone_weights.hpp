@@ -24,7 +24,8 @@
 //   graph Laplacian with edge weights 1 / length^2. That L approximates -Laplacian in 1/m^2 on
 //   an even tessellation, so it matches H's units, and it was chosen over the cotangent
 //   Laplacian because its off-diagonal entries are never positive: L + H is then a symmetric
-//   M-matrix, so the solution stays in [0, 1] and sums to 1 over the joints without clipping,
+//   M-matrix, so the solution stays in [0, 1] and sums to 1 over the joints (up to the solver's
+//   tolerance, whose tiny negative residue is clipped to 0),
 //   whereas cotangent weights turn negative on obtuse triangles (and need triangle areas, which
 //   degenerate triangles lack). Every vertex is heated, so each connected component, even one
 //   far from every bone or a lone vertex, has a unique solution. Solved by Jacobi-preconditioned
