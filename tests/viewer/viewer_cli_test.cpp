@@ -31,7 +31,11 @@ struct ProgramRun {
 
 // Runs a shell command line; Mesa leaks a little at exit, which is not ours to report.
 ProgramRun run(const std::string& command_line) {
-  setenv("ASAN_OPTIONS", "detect_leaks=0", 1);
+  static const std::string asan_options = [] {
+    const char* given = std::getenv("ASAN_OPTIONS");
+    return std::string(given && *given ? given : "") + (given && *given ? ":" : "") + "detect_leaks=0";
+  }();
+  setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
   ProgramRun r;
   FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
   if (!pipe) return r;
