@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "base64.hpp"
 #include "mm/database/bvh.hpp"
 #include "mm/database/gltf.hpp"
 #include "mm/runtime/pose.hpp"
@@ -42,22 +43,7 @@ void write_text(const fs::path& path, const std::string& text) {
   write_bytes(path, text.data(), text.size());
 }
 
-// Standard base64 (RFC 4648) with padding, for embedding fixture buffers in data URIs.
-std::string base64(const std::vector<unsigned char>& bytes) {
-  static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < bytes.size(); i += 3) {
-    const uint32_t b0 = bytes[i];
-    const uint32_t b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0;
-    const uint32_t b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0;
-    const uint32_t triple = (b0 << 16) | (b1 << 8) | b2;
-    out += alphabet[(triple >> 18) & 63];
-    out += alphabet[(triple >> 12) & 63];
-    out += i + 1 < bytes.size() ? alphabet[(triple >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? alphabet[triple & 63] : '=';
-  }
-  return out;
-}
+using test::base64;
 
 std::vector<Transform> globals_of(const Clip& clip, int frame) {
   std::vector<Transform> global(static_cast<size_t>(clip.joint_count()));

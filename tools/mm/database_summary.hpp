@@ -8,6 +8,7 @@
 #include <string>
 
 #include "mm/database/database.hpp"
+#include "number_parsing.hpp"
 
 namespace mm::cli {
 
@@ -22,12 +23,6 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
 // Prints one line per feature channel: name, kind, bone or times, columns, weight, and the
 // per-column mean and standard deviation (the normalization's offset and scale * weight).
 void print_feature_statistics(FILE* out, const Database& db);
-
-// The whole text parsed as a finite number, or nothing (no trailing characters allowed).
-std::optional<double> parse_number(const std::string& text);
-
-// The whole text parsed as a non-negative integer, or nothing.
-std::optional<long long> parse_count(const std::string& text);
 
 // "1.5 MB", "820 KB", "12 B".
 std::string human_bytes(uint64_t bytes);

@@ -140,16 +140,10 @@ Status write_plot(const ViewerOptions& options, const Scene& scene) {
 
 // ---- Headless.
 
-Result<InputScript> load_script(const std::string& path) {
-  Result<InputScript> script = load_input_script(path);
-  if (!script) return Error{script.message()};
-  return script;
-}
-
 }  // namespace
 
 int run_headless(const ViewerOptions& options, Scene& scene) {
-  Result<InputScript> script = load_script(options.script_path);
+  Result<InputScript> script = load_input_script(options.script_path);
   if (!script) {
     std::fprintf(stderr, "mm-viewer: %s\n", script.message().c_str());
     return 1;
@@ -237,7 +231,7 @@ void poll_keys(GLFWwindow* window, WindowKeys& keys, bool (&was_down)[3]) {
 int run_windowed(const ViewerOptions& options, Scene& scene) {
   std::optional<InputScript> script;
   if (!options.script_path.empty()) {
-    Result<InputScript> loaded = load_script(options.script_path);
+    Result<InputScript> loaded = load_input_script(options.script_path);
     if (!loaded) {
       std::fprintf(stderr, "mm-viewer: %s\n", loaded.message().c_str());
       return 1;

@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 
+#include "number_parsing.hpp"
+
 namespace mm::viewer {
 namespace {
 
@@ -51,18 +53,11 @@ int usage_error(const std::string& message) {
   return 2;
 }
 
-std::optional<double> parse_number(const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
+// A whole number in [low, high].
 std::optional<int> parse_count(const std::string& text, int low, int high) {
-  char* end = nullptr;
-  const long v = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || v < low || v > high) return std::nullopt;
-  return static_cast<int>(v);
+  const std::optional<long long> n = cli::parse_count(text);
+  if (!n || *n < low || *n > high) return std::nullopt;
+  return static_cast<int>(*n);
 }
 
 bool parse_size(const std::string& text, int& width, int& height) {
@@ -127,7 +122,7 @@ int parse_valued(const std::string& a, const std::string& v, ViewerOptions& out)
   } else if (a == "--size") {
     if (!parse_size(v, out.width, out.height)) return usage_error("--size needs WxH, 64 to 8192");
   } else if (a == "--dt") {
-    const auto dt = parse_number(v);
+    const auto dt = cli::parse_number(v);
     if (!dt || *dt <= 0.0 || *dt > 1.0) return usage_error("--dt needs seconds in (0, 1]");
     out.dt = static_cast<float>(*dt);
   } else {

@@ -1,0 +1,15 @@
+#pragma once
+// Option values of the command-line programs (`mm`, `mm-viewer`): the whole text or nothing.
+
+#include <optional>
+#include <string>
+
+namespace mm::cli {
+
+// The whole text parsed as a finite number, or nothing (no trailing characters allowed).
+std::optional<double> parse_number(const std::string& text);
+
+// The whole text parsed as a non-negative integer, or nothing ("1.5" and "-2" are refused).
+std::optional<long long> parse_count(const std::string& text);
+
+}  // namespace mm::cli
