@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # The test command. Installs missing Debian packages, then:
+#   0. every tracked C++ file is clang-formatted (.clang-format);
 #   1. Release build with -Wall -Wextra -Werror, every test;
 #   2. ASan + UBSan build, every test;
 #   3. the libFuzzer targets (clang), each for a bounded time (MM_FUZZ_SECONDS, default 30).
@@ -12,6 +13,7 @@ step() { printf '\n=== %s ===\n' "$*"; }
 
 step "Release build and tests"
 scripts/setup.sh release
+scripts/check_format.sh
 ctest --test-dir build/release --output-on-failure -j "$jobs"
 [ "${1:-}" = "--fast" ] && exit 0
 
