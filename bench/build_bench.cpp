@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "mm/database/builder.hpp"
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 
 namespace {
 

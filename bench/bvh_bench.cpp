@@ -30,7 +30,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 
 namespace {
 

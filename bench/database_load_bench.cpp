@@ -53,7 +53,8 @@ mm::Database make_synthetic_database() {
   db.local_angular_velocities.resize(samples);
   for (size_t i = 0; i < samples; ++i) {
     db.local_positions[i] = {normal(rng), normal(rng), normal(rng)};
-    db.local_rotations[i] = glm::normalize(glm::quat(normal(rng), normal(rng), normal(rng), normal(rng)));
+    db.local_rotations[i] =
+        glm::normalize(glm::quat(normal(rng), normal(rng), normal(rng), normal(rng)));
     db.local_velocities[i] = {2.0f * normal(rng), normal(rng), 2.0f * normal(rng)};
     db.local_angular_velocities[i] = {3.0f * normal(rng), 3.0f * normal(rng), 3.0f * normal(rng)};
   }
@@ -179,10 +180,11 @@ int main(int argc, char** argv) {
   const auto read = reporter.milliseconds.find("BM_ReadFile");
   const auto load = reporter.milliseconds.find("BM_LoadDatabase");
   if (read != reporter.milliseconds.end() && load != reporter.milliseconds.end()) {
-    std::printf("load_database: %.1f ms (%.0f MB/s); one fread of the file: %.1f ms (%.0f MB/s); "
-                "load / read = %.2fx\n",
-                load->second, g_file_size / 1e3 / load->second, read->second,
-                g_file_size / 1e3 / read->second, load->second / read->second);
+    std::printf(
+        "load_database: %.1f ms (%.0f MB/s); one fread of the file: %.1f ms (%.0f MB/s); "
+        "load / read = %.2fx\n",
+        load->second, g_file_size / 1e3 / load->second, read->second,
+        g_file_size / 1e3 / read->second, load->second / read->second);
   }
   std::filesystem::remove(g_path);
   benchmark::Shutdown();

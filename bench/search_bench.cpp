@@ -29,7 +29,7 @@ using namespace mm;
 
 // The rows every benchmark uses, loaded or generated once.
 struct BenchData {
-  Database database;           // when MM_BENCH_DB names a file
+  Database database;  // when MM_BENCH_DB names a file
   SyntheticSearchData synthetic;
   SearchInput input;
   NoisyQueries queries;        // 1024 queries, noise 0.1
@@ -81,7 +81,9 @@ const BenchData& data() {
   return d;
 }
 
-int row_count() { return static_cast<int>(data().rows.size() / static_cast<size_t>(data().input.dims)); }
+int row_count() {
+  return static_cast<int>(data().rows.size() / static_cast<size_t>(data().input.dims));
+}
 
 // Every row's distance to one query, row-major, as a tree's leaf visits them: the full distance,
 // or bounded by the best so far (FLANN's single tree passes its threshold).
@@ -95,7 +97,8 @@ void row_distances_with(benchmark::State& state, const Distance& distance) {
     const float* query = d.queries.query(q++ % d.queries.count()).data();
     float best = std::numeric_limits<float>::infinity();
     for (int r = 0; r < rows; ++r) {
-      best = std::min(best, distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best));
+      best = std::min(best,
+                      distance(query, d.rows.data() + static_cast<size_t>(r) * dims, dims, best));
     }
     benchmark::DoNotOptimize(best);
   }
@@ -133,7 +136,9 @@ void scan_with(benchmark::State& state, search_kernels::ScanBlocksFn scan) {
   state.SetItemsProcessed(state.iterations() * rows);
 }
 
-void BM_Scan_Portable(benchmark::State& state) { scan_with(state, &search_kernels::scan_blocks_portable); }
+void BM_Scan_Portable(benchmark::State& state) {
+  scan_with(state, &search_kernels::scan_blocks_portable);
+}
 
 // False (and the run marked as skipped) on a CPU without AVX2 + FMA.
 bool avx2_or_skip(benchmark::State& state) {
@@ -165,7 +170,8 @@ void BM_RowDistance_Portable(benchmark::State& state) {
   row_distances_with(state, &ignoring_bound<&search_kernels::row_distance_portable>);
 }
 void BM_RowDistance_Avx2(benchmark::State& state) {
-  if (avx2_or_skip(state)) row_distances_with(state, &ignoring_bound<&search_kernels::row_distance_avx2>);
+  if (avx2_or_skip(state))
+    row_distances_with(state, &ignoring_bound<&search_kernels::row_distance_avx2>);
 }
 void BM_RowDistance_Avx2_Bounded(benchmark::State& state) {
   if (avx2_or_skip(state)) row_distances_with(state, &search_kernels::row_distance_bounded_avx2);
@@ -197,7 +203,8 @@ void BM_Search(benchmark::State& state, const std::string& method) {
   const BenchData& d = data();
   int q = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(s.search(d.queries.query(q++ % d.queries.count()), SearchConstraints{}));
+    benchmark::DoNotOptimize(
+        s.search(d.queries.query(q++ % d.queries.count()), SearchConstraints{}));
   }
   state.SetItemsProcessed(state.iterations());
 }
@@ -219,9 +226,9 @@ void BM_Batch(benchmark::State& state, const std::string& method) {
 const bool registered = [] {
   for (std::string_view name : search_method_names()) {
     const std::string method(name);
-    benchmark::RegisterBenchmark(("BM_Search/" + method).c_str(),
-                                 [method](benchmark::State& st) { BM_Search(st, method); })
-        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_Search/" + method).c_str(), [method](benchmark::State& st) {
+      BM_Search(st, method);
+    })->Unit(benchmark::kMicrosecond);
   }
   for (const char* method : {"kdtree", "boxtree"}) {
     const std::string m(method);
@@ -250,7 +257,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
   double speedup(const std::string& name, const std::string& baseline) const {
     const auto a = time_per_iteration_.find(name);
     const auto b = time_per_iteration_.find(baseline);
-    if (a == time_per_iteration_.end() || b == time_per_iteration_.end() || a->second <= 0) return 0;
+    if (a == time_per_iteration_.end() || b == time_per_iteration_.end() || a->second <= 0)
+      return 0;
     return b->second / a->second;
   }
 
@@ -265,7 +273,8 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  std::printf("\nspeed-ups measured in this run (%s scan kernel):\n", search_kernels::scan_blocks_isa());
+  std::printf("\nspeed-ups measured in this run (%s scan kernel):\n",
+              search_kernels::scan_blocks_isa());
   for (const char* scan : {"BM_Scan_Portable", "BM_Scan_Avx2", "BM_Scan_Avx2_Staged"}) {
     if (const double x = reporter.speedup(scan, "BM_Scan_Scalar"); x > 0) {
       std::printf("  %-28s %7.2fx the scalar loop\n", scan, x);
@@ -276,7 +285,8 @@ int main(int argc, char** argv) {
       std::printf("  %-28s %7.2fx the column-order loop\n", kernel, x);
     }
   }
-  if (const double x = reporter.speedup("BM_RowDistance_Avx2_Bounded", "BM_RowDistance_Avx2"); x > 0) {
+  if (const double x = reporter.speedup("BM_RowDistance_Avx2_Bounded", "BM_RowDistance_Avx2");
+      x > 0) {
     std::printf("  %-28s %7.2fx the full AVX2 distance\n", "BM_RowDistance_Avx2_Bounded", x);
   }
   for (std::string_view name : search_method_names()) {

@@ -17,7 +17,7 @@
 #include <string>
 #include <string_view>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 
 namespace {
 

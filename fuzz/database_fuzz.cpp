@@ -55,7 +55,8 @@ mm::Database make_seed_database() {
   trajectory.kind = mm::FeatureKind::TrajectoryDirection;
   trajectory.times = {0.5f};
   db.schema.channels = {foot, trajectory};
-  for (int i = 0; i < db.frame_count * 5; ++i) db.features.push_back(0.25f * static_cast<float>(i % 7) - 1.0f);
+  for (int i = 0; i < db.frame_count * 5; ++i)
+    db.features.push_back(0.25f * static_cast<float>(i % 7) - 1.0f);
   db.feature_offset = {0.0f, 0.1f, 0.2f, 0.3f, 0.4f};
   db.feature_scale = {1.0f, 2.0f, 0.5f, 1.5f, 3.0f};
   db.searchable = {1, 1, 0, 0, 1, 0};

@@ -43,7 +43,9 @@ bool finite(const glm::quat& q) {
          glm::length(q) > 0.5f;
 }
 
-glm::quat yaw_rotation(float yaw) { return glm::angleAxis(yaw, kUp); }
+glm::quat yaw_rotation(float yaw) {
+  return glm::angleAxis(yaw, kUp);
+}
 
 // A stick with non-finite axes zeroed, scaled back onto the unit disc, and zero inside the
 // dead zone (outside it the magnitude is rescaled so it still reaches 1).
@@ -150,8 +152,8 @@ Status Controller::resolve_schema() {
         trajectory_times_.push_back(t);
         it = trajectory_times_.end() - 1;
       }
-      trajectory_columns_.push_back({column, static_cast<int>(it - trajectory_times_.begin()),
-                                     direction});
+      trajectory_columns_.push_back(
+          {column, static_cast<int>(it - trajectory_times_.begin()), direction});
       column += 2;
     }
   }
@@ -216,8 +218,8 @@ void Controller::start_standing() {
     }
   }
   if (start < 0) {
-    start = static_cast<int>(std::find(candidates.begin(), candidates.end(), 1) -
-                             candidates.begin());
+    start =
+        static_cast<int>(std::find(candidates.begin(), candidates.end(), 1) - candidates.begin());
   }
   teleport(glm::vec3(0.0f), 0.0f);
   transition_to(start);
@@ -283,8 +285,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   if (should_search()) search();
   advance_playback(dt);
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
-  inertialize_update(offsets_,
-                     {sampled_, sampled_velocities_, sampled_angular_velocities_},
+  inertialize_update(offsets_, {sampled_, sampled_velocities_, sampled_angular_velocities_},
                      settings_.inertialization_halflife, dt, locals_, {}, {});
   // Only the root's displayed motion is needed (by the synchronization): the playing root's
   // plus its offsets' rates.
@@ -561,11 +562,12 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
       local[k] = compose(folded, local[k]);
     }
     local[static_cast<size_t>(j)] = Transform{};
-    velocities[static_cast<size_t>(j)] = angular_velocities[static_cast<size_t>(j)] = glm::vec3(0.0f);
+    velocities[static_cast<size_t>(j)] = angular_velocities[static_cast<size_t>(j)] =
+        glm::vec3(0.0f);
   }
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
-  local[0].translation = map * (local[0].translation - transition_dst_position_) +
-                         transition_src_position_;
+  local[0].translation =
+      map * (local[0].translation - transition_dst_position_) + transition_src_position_;
   local[0].rotation = glm::normalize(map * local[0].rotation);
   velocities[0] = map * velocities[0];
   angular_velocities[0] = map * angular_velocities[0];
@@ -589,7 +591,8 @@ void Controller::predict() {
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_, desired_rotation_,
                           settings_.simulation_rotation_halflife, trajectory_times_);
   for (size_t i = 0; i < n; ++i) {
-    debug_.desired_positions[i] = sim_position_ + desired_velocity_ * std::max(0.0f, trajectory_times_[i]);
+    debug_.desired_positions[i] =
+        sim_position_ + desired_velocity_ * std::max(0.0f, trajectory_times_[i]);
   }
   debug_.simulation_position = sim_position_;
   debug_.simulation_velocity = sim_velocity_;
@@ -674,7 +677,8 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
   const Transform root = sample_joint(playback_point(), 0);
   const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
   const glm::quat relative_rotation = inverse_destination * root.rotation;
-  const glm::vec3 relative_position = inverse_destination * (root.translation - transition_dst_position_);
+  const glm::vec3 relative_position =
+      inverse_destination * (root.translation - transition_dst_position_);
   // The new source: the destination's rotation mapped onto the requested one, then the source
   // position recomputed from it so that the mapped root lands exactly on the request.
   const glm::quat old_map = transition_src_rotation_ * inverse_destination;
@@ -696,8 +700,9 @@ void Controller::finish_pose() {
   forward_kinematics(db_->skeleton.parents(), locals_, globals_);
   const Database& db = *db_;
   const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
-  const int frame = std::clamp(clip.start + static_cast<int>(std::lround(clip_time_ / db.frame_time)),
-                               clip.start, clip.end - 1);
+  const int frame =
+      std::clamp(clip.start + static_cast<int>(std::lround(clip_time_ / db.frame_time)), clip.start,
+                 clip.end - 1);
   debug_.clip = clip_;
   debug_.frame = frame;
   debug_.clip_time = clip_time_;
@@ -755,13 +760,15 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   } else if (f.locked) {
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
-    const bool settle = settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
+    const bool settle =
+        settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
     // Beyond the leg's reach (softened, see soft_reach) the held toe would be dragged along the
     // ground anyway.
     const std::vector<int>& leg = leg_joints_[side];
     const glm::vec3 ankle = globals_[static_cast<size_t>(leg[2])].translation;
     const glm::vec3 hip = globals_[static_cast<size_t>(leg[0])].translation;
-    const bool out_of_reach = glm::length(f.position - (animated - ankle) - hip) > kStepReach * leg_length(side);
+    const bool out_of_reach =
+        glm::length(f.position - (animated - ankle) - hip) > kStepReach * leg_length(side);
     const bool dragged = glm::length(drag) > settings_.foot_unlock_radius || out_of_reach;
     if (!contact || dragged || settle) {
       // A foot that has to move while its frame says "contact" steps there rather than slides.
@@ -805,8 +812,8 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
                          kKneeForwardBias * (globals_[0].rotation * kForward);
   apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
-  locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
-      glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
+  locals_[static_cast<size_t>(foot)].rotation =
+      glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
   refresh_subtree(foot);
   restore_leg_lengths(side);
 }

@@ -84,8 +84,8 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   }
   bool has_trajectory = false;
   for (const FeatureChannel& c : db.schema.channels) {
-    has_trajectory |= c.kind == FeatureKind::TrajectoryPosition ||
-                      c.kind == FeatureKind::TrajectoryDirection;
+    has_trajectory |=
+        c.kind == FeatureKind::TrajectoryPosition || c.kind == FeatureKind::TrajectoryDirection;
   }
   if (!has_trajectory) {
     return Error{

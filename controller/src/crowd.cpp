@@ -16,7 +16,9 @@ namespace {
 
 // A float in [0, 1) from the generator's raw bits (std::uniform_real_distribution differs
 // between standard libraries; this does not).
-float unit(std::mt19937& rng) { return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f); }
+float unit(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
 
 }  // namespace
 
@@ -117,15 +119,16 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   }
   result.update_us_mean = total_update * 1e6 / static_cast<double>(update_us.size());
   result.search_share = total_update > 0.0 ? total_search / total_update : 0.0;
-  const size_t rank = std::min(update_us.size() - 1,
-                               static_cast<size_t>(std::ceil(0.99 * update_us.size())) - 1);
+  const size_t rank =
+      std::min(update_us.size() - 1, static_cast<size_t>(std::ceil(0.99 * update_us.size())) - 1);
   std::nth_element(update_us.begin(), update_us.begin() + static_cast<std::ptrdiff_t>(rank),
                    update_us.end());
   result.update_us_p99 = update_us[rank];
   result.frame_ms_mean = wall * 1e3 / frames;
-  result.max_characters_60hz = static_cast<int>(
-      std::floor(static_cast<double>(n) * (1.0 / 60.0) / (wall / frames)));
-  for (const Controller& c : controllers) result.final_positions.push_back(c.root_transform().translation);
+  result.max_characters_60hz =
+      static_cast<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / (wall / frames)));
+  for (const Controller& c : controllers)
+    result.final_positions.push_back(c.root_transform().translation);
   return result;
 }
 

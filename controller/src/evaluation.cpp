@@ -22,9 +22,9 @@ float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
 // The p-th percentile (0..100) by nearest rank; 0 for no values. Reorders `values`.
 double percentile(std::vector<double>& values, double p) {
   if (values.empty()) return 0.0;
-  const size_t rank = std::min(values.size() - 1,
-                               static_cast<size_t>(std::ceil(p / 100.0 * values.size())) -
-                                   (p > 0.0 ? 1 : 0));
+  const size_t rank =
+      std::min(values.size() - 1,
+               static_cast<size_t>(std::ceil(p / 100.0 * values.size())) - (p > 0.0 ? 1 : 0));
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank),
                    values.end());
   return values[rank];
@@ -55,8 +55,8 @@ struct FrameRecord {
 
 // Acceleration magnitudes (second differences) of every joint but joint 0 at frame f of a run
 // whose joint positions are `positions` (frames x joints).
-void joint_accelerations(const std::vector<glm::vec3>& positions, size_t joints, size_t f,
-                         float dt, std::vector<double>& out) {
+void joint_accelerations(const std::vector<glm::vec3>& positions, size_t joints, size_t f, float dt,
+                         std::vector<double>& out) {
   const glm::vec3* a = positions.data() + (f - 1) * joints;
   const glm::vec3* b = positions.data() + f * joints;
   const glm::vec3* c = positions.data() + (f + 1) * joints;
@@ -137,8 +137,7 @@ std::string csv_row(const FrameRecord& r, const glm::vec3* joints, size_t joint_
 
 }  // namespace
 
-double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags,
-                                 bool cubic) {
+double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags, bool cubic) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   std::vector<double> accelerations;
   std::vector<Transform> local(joints), global(joints);
@@ -155,8 +154,8 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
       const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
       const float a = x - static_cast<float>(i0);
       for (size_t j = 0; j < joints; ++j) {
-        local[j] = detail::sample_database_joint(db, clip.start + i0, clip.start + i1, a, j,
-                                                 cubic, InterpolationMethod::Nlerp);
+        local[j] = detail::sample_database_joint(db, clip.start + i0, clip.start + i1, a, j, cubic,
+                                                 InterpolationMethod::Nlerp);
       }
       forward_kinematics(db.skeleton.parents(), local, global);
       for (size_t j = 0; j < joints; ++j) {
@@ -237,22 +236,22 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     if (f == 0) continue;
     for (int side = 0; side < 2; ++side) {
       const size_t toe = static_cast<size_t>(toes[side]);
-      const double speed = 100.0 *
-                           horizontal_distance(positions[f * joints + toe],
-                                               positions[(f - 1) * joints + toe]) /
-                           dt;
+      const double speed =
+          100.0 *
+          horizontal_distance(positions[f * joints + toe], positions[(f - 1) * joints + toe]) / dt;
       if (r.contact[side] && frames[f - 1].contact[side]) skate.push_back(speed);
       if (stand_time >= kStandSettleSeconds) stand_foot.push_back(speed);
     }
     if (stand_time >= kStandSettleSeconds) {
-      stand_root.push_back(100.0 * horizontal_distance(r.root_position, frames[f - 1].root_position) /
-                           dt);
+      stand_root.push_back(100.0 *
+                           horizontal_distance(r.root_position, frames[f - 1].root_position) / dt);
     }
   }
   m.foot_skate_cm_s_mean = mean(skate);
   m.foot_skate_cm_s_p95 = percentile(skate, 95.0);
   m.root_sim_distance_cm_mean = mean(distance);
-  m.root_sim_distance_cm_max = distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end());
+  m.root_sim_distance_cm_max =
+      distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end());
   m.facing_error_deg_mean = mean(facing);
   m.stand_root_speed_cm_s_mean = mean(stand_root);
   m.stand_foot_speed_cm_s_mean = mean(stand_foot);

@@ -16,7 +16,7 @@
 
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "mm/database/idle.hpp"
 #include "workers.hpp"
 

@@ -11,7 +11,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtx/quaternion.hpp>
 
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
 

@@ -5,7 +5,9 @@
 namespace mm {
 
 namespace {
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 }  // namespace
 
 Status Clip::validate() const {
@@ -22,7 +24,8 @@ Status Clip::validate() const {
   for (size_t i = 0; i < local.size(); ++i) {
     const Transform& t = local[i];
     const float n = glm::length(t.rotation);
-    if (!finite(t.translation) || !finite(t.scale) || !std::isfinite(n) || std::abs(n - 1.0f) > 1e-3f) {
+    if (!finite(t.translation) || !finite(t.scale) || !std::isfinite(n) ||
+        std::abs(n - 1.0f) > 1e-3f) {
       return Error{where + "frame " + std::to_string(i / joint_count()) + ", joint '" +
                    skeleton.name(static_cast<int>(i % joint_count())) +
                    "': non-finite transform or non-unit rotation"};

@@ -32,7 +32,8 @@ size_t first_non_finite_serial(const float* values, size_t begin, size_t end) {
   for (size_t block = begin; block < end; block += kBlock) {
     const size_t block_end = std::min(end, block + kBlock);
     uint32_t bad = 0;
-    for (size_t i = block; i < block_end; ++i) bad |= static_cast<uint32_t>(!is_finite_bits(values[i]));
+    for (size_t i = block; i < block_end; ++i)
+      bad |= static_cast<uint32_t>(!is_finite_bits(values[i]));
     if (bad != 0) {
       for (size_t i = block; i < block_end; ++i) {
         if (!std::isfinite(values[i])) return i;
@@ -52,7 +53,8 @@ size_t first_non_unit_serial(const float* quats, size_t begin, size_t end) {
   for (size_t block = begin; block < end; block += kBlock) {
     const size_t block_end = std::min(end, block + kBlock);
     uint32_t bad = 0;
-    for (size_t i = block; i < block_end; ++i) bad |= static_cast<uint32_t>(!is_unit(quats + 4 * i));
+    for (size_t i = block; i < block_end; ++i)
+      bad |= static_cast<uint32_t>(!is_unit(quats + 4 * i));
     if (bad != 0) {
       for (size_t i = block; i < block_end; ++i) {
         if (!is_unit(quats + 4 * i)) return i;
@@ -94,9 +96,8 @@ size_t first_non_finite(std::span<const float> values) {
 
 size_t first_non_unit(std::span<const glm::quat> quats) {
   const float* data = quats.empty() ? nullptr : glm::value_ptr(quats[0]);
-  return first_bad(quats.size(), [&](size_t b, size_t e) {
-    return first_non_unit_serial(data, b, e);
-  });
+  return first_bad(quats.size(),
+                   [&](size_t b, size_t e) { return first_non_unit_serial(data, b, e); });
 }
 
 // First byte that is neither 0 nor 1.
@@ -189,10 +190,12 @@ Status Database::validate() const {
   }
 
   // Roles name existing joints or nothing.
-  const std::pair<const char*, int> role_list[] = {
-      {"hips", roles.hips},           {"left_foot", roles.left_foot},
-      {"right_foot", roles.right_foot}, {"left_toe", roles.left_toe},
-      {"right_toe", roles.right_toe}, {"head", roles.head}};
+  const std::pair<const char*, int> role_list[] = {{"hips", roles.hips},
+                                                   {"left_foot", roles.left_foot},
+                                                   {"right_foot", roles.right_foot},
+                                                   {"left_toe", roles.left_toe},
+                                                   {"right_toe", roles.right_toe},
+                                                   {"head", roles.head}};
   for (const auto& [role, joint] : role_list) {
     if (joint < -1 || joint >= joints) {
       return Error{"database: role " + std::string(role) + " is joint " + std::to_string(joint) +
@@ -200,15 +203,18 @@ Status Database::validate() const {
     }
   }
 
-  if (frame_count <= 0) return Error{"database: has no frames (frame_count " +
-                                     std::to_string(frame_count) + ")"};
+  if (frame_count <= 0)
+    return Error{"database: has no frames (frame_count " + std::to_string(frame_count) + ")"};
   const size_t frames = static_cast<size_t>(frame_count);
   const size_t samples = frames * static_cast<size_t>(joints);
   const std::string per_joint =
       std::to_string(frame_count) + " frames x " + std::to_string(joints) + " joints";
-  if (Status s = check_size("local_positions", local_positions.size(), samples, per_joint); !s) return s;
-  if (Status s = check_size("local_rotations", local_rotations.size(), samples, per_joint); !s) return s;
-  if (Status s = check_size("local_velocities", local_velocities.size(), samples, per_joint); !s) return s;
+  if (Status s = check_size("local_positions", local_positions.size(), samples, per_joint); !s)
+    return s;
+  if (Status s = check_size("local_rotations", local_rotations.size(), samples, per_joint); !s)
+    return s;
+  if (Status s = check_size("local_velocities", local_velocities.size(), samples, per_joint); !s)
+    return s;
   if (Status s = check_size("local_angular_velocities", local_angular_velocities.size(), samples,
                             per_joint);
       !s) {
@@ -238,13 +244,14 @@ Status Database::validate() const {
   const int dims_int = feature_dims();
   if (dims_int <= 0) return Error{"database: the feature schema has no columns"};
   const size_t dims = static_cast<size_t>(dims_int);
-  if (Status s = check_size("features", features.size(), frames * dims,
-                            std::to_string(frame_count) + " frames x " + std::to_string(dims) +
-                                " feature columns");
+  if (Status s = check_size(
+          "features", features.size(), frames * dims,
+          std::to_string(frame_count) + " frames x " + std::to_string(dims) + " feature columns");
       !s) {
     return s;
   }
-  if (Status s = check_size("feature_offset", feature_offset.size(), dims, "one per feature column");
+  if (Status s =
+          check_size("feature_offset", feature_offset.size(), dims, "one per feature column");
       !s) {
     return s;
   }
@@ -277,7 +284,8 @@ Status Database::validate() const {
   for (size_t c = 0; c < clips.size(); ++c) {
     const ClipRange& clip = clips[c];
     const std::string where = "database: clip " + std::to_string(c) + " '" + clip.name + "'";
-    if (clip.name.empty()) return Error{"database: clip " + std::to_string(c) + " has an empty name"};
+    if (clip.name.empty())
+      return Error{"database: clip " + std::to_string(c) + " has an empty name"};
     if (clip.start != expected_start) {
       return Error{where + " starts at frame " + std::to_string(clip.start) + ", expected " +
                    std::to_string(expected_start) +
@@ -289,8 +297,9 @@ Status Database::validate() const {
                    std::to_string(frame_count) + ")"};
     }
     if ((clip.tags & ~known_tags) != 0) {
-      return Error{where + " has tag bit " + std::to_string(std::countr_zero(clip.tags & ~known_tags)) +
-                   " set, but only " + std::to_string(tag_names.size()) + " tags exist"};
+      return Error{where + " has tag bit " +
+                   std::to_string(std::countr_zero(clip.tags & ~known_tags)) + " set, but only " +
+                   std::to_string(tag_names.size()) + " tags exist"};
     }
     expected_start = clip.end;
   }
@@ -303,8 +312,9 @@ Status Database::validate() const {
     for (int f = clips[c].start; f < clips[c].end; ++f) {
       if (frame_clip[static_cast<size_t>(f)] != static_cast<int>(c)) {
         return Error{"database: frame_clip[" + std::to_string(f) + "] is " +
-                     std::to_string(frame_clip[static_cast<size_t>(f)]) + ", but the frame is in clip " +
-                     std::to_string(c) + " '" + clips[c].name + "'"};
+                     std::to_string(frame_clip[static_cast<size_t>(f)]) +
+                     ", but the frame is in clip " + std::to_string(c) + " '" + clips[c].name +
+                     "'"};
       }
     }
   }
@@ -322,8 +332,7 @@ Status Database::validate() const {
       {"local_angular_velocities", &local_angular_velocities}};
   for (const auto& [name, array] : vector_arrays) {
     if (size_t i = first_non_finite(floats_of(*array)); i != kNotFound) {
-      return Error{"database: " + std::string(name) + frame_joint(*this, i / 3) +
-                   " is not finite"};
+      return Error{"database: " + std::string(name) + frame_joint(*this, i / 3) + " is not finite"};
     }
   }
   if (size_t i = first_non_boolean(contacts); i != kNotFound) {

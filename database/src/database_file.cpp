@@ -179,8 +179,8 @@ class SectionReader {
     return fail(std::to_string(remaining()) + " unused bytes at the end of the section");
   }
   Error fail(const std::string& message) const {
-    return Error{std::string(file_) + ": section '" + database_section_name(section_) + "': " +
-                 message};
+    return Error{std::string(file_) + ": section '" + database_section_name(section_) +
+                 "': " + message};
   }
 
  private:
@@ -339,7 +339,7 @@ Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_
     }
     previous_end = s.offset + s.length;
 
-    uint64_t exact = 0;   // expected length of a fixed-size section (0: variable)
+    uint64_t exact = 0;    // expected length of a fixed-size section (0: variable)
     uint64_t minimum = 0;  // smallest possible length of a variable section
     std::string how;
     switch (section) {
@@ -468,7 +468,8 @@ Status read_string_list(std::span<const std::byte> file, const DatabaseFileInfo&
 
 Status read_schema(std::span<const std::byte> file, const DatabaseFileInfo& info,
                    std::string_view name, FeatureSchema& schema) {
-  SectionReader r(section_bytes(file, info, DatabaseSection::Schema), DatabaseSection::Schema, name);
+  SectionReader r(section_bytes(file, info, DatabaseSection::Schema), DatabaseSection::Schema,
+                  name);
   schema.channels.resize(info.channel_count);
   for (uint32_t i = 0; i < info.channel_count; ++i) {
     FeatureChannel& c = schema.channels[i];
@@ -536,7 +537,8 @@ Status read_skeleton(std::span<const std::byte> file, const DatabaseFileInfo& in
   }
   std::vector<int32_t> parents;
   copy_array(file, info, DatabaseSection::SkeletonParents, parents);
-  const std::span<const std::byte> rest_bytes = section_bytes(file, info, DatabaseSection::SkeletonRest);
+  const std::span<const std::byte> rest_bytes =
+      section_bytes(file, info, DatabaseSection::SkeletonRest);
   std::vector<Transform> rest(info.joint_count);
   for (size_t j = 0; j < rest.size(); ++j) {
     float v[10];
@@ -545,11 +547,11 @@ Status read_skeleton(std::span<const std::byte> file, const DatabaseFileInfo& in
     rest[j].translation = {v[4], v[5], v[6]};
     rest[j].scale = {v[7], v[8], v[9]};
   }
-  Result<Skeleton> created = Skeleton::create(std::move(names), std::vector<int>(parents.begin(), parents.end()),
-                                              std::move(rest));
+  Result<Skeleton> created = Skeleton::create(
+      std::move(names), std::vector<int>(parents.begin(), parents.end()), std::move(rest));
   if (!created) {
-    return Error{std::string(name) + ": sections 'skeleton_names'/'skeleton_parents': " +
-                 created.message()};
+    return Error{std::string(name) +
+                 ": sections 'skeleton_names'/'skeleton_parents': " + created.message()};
   }
   skeleton = std::move(created).value();
   return Status::success();
@@ -608,28 +610,46 @@ Status read_contents(std::span<const std::byte> file, const DatabaseFileInfo& in
 // Files at least this large hash on a second thread while the first copies the arrays.
 constexpr size_t kParallelHashBytes = size_t{8} << 20;
 
-std::string errno_text(int error) { return std::generic_category().message(error); }
+std::string errno_text(int error) {
+  return std::generic_category().message(error);
+}
 
 }  // namespace
 
 const char* database_section_name(DatabaseSection section) {
   switch (section) {
-    case DatabaseSection::Schema: return "schema";
-    case DatabaseSection::SkeletonNames: return "skeleton_names";
-    case DatabaseSection::SkeletonParents: return "skeleton_parents";
-    case DatabaseSection::SkeletonRest: return "skeleton_rest";
-    case DatabaseSection::LocalPositions: return "local_positions";
-    case DatabaseSection::LocalRotations: return "local_rotations";
-    case DatabaseSection::LocalVelocities: return "local_velocities";
-    case DatabaseSection::LocalAngularVelocities: return "local_angular_velocities";
-    case DatabaseSection::Contacts: return "contacts";
-    case DatabaseSection::Features: return "features";
-    case DatabaseSection::FeatureOffset: return "feature_offset";
-    case DatabaseSection::FeatureScale: return "feature_scale";
-    case DatabaseSection::Searchable: return "searchable";
-    case DatabaseSection::Clips: return "clips";
-    case DatabaseSection::TagNames: return "tag_names";
-    case DatabaseSection::Count: break;
+    case DatabaseSection::Schema:
+      return "schema";
+    case DatabaseSection::SkeletonNames:
+      return "skeleton_names";
+    case DatabaseSection::SkeletonParents:
+      return "skeleton_parents";
+    case DatabaseSection::SkeletonRest:
+      return "skeleton_rest";
+    case DatabaseSection::LocalPositions:
+      return "local_positions";
+    case DatabaseSection::LocalRotations:
+      return "local_rotations";
+    case DatabaseSection::LocalVelocities:
+      return "local_velocities";
+    case DatabaseSection::LocalAngularVelocities:
+      return "local_angular_velocities";
+    case DatabaseSection::Contacts:
+      return "contacts";
+    case DatabaseSection::Features:
+      return "features";
+    case DatabaseSection::FeatureOffset:
+      return "feature_offset";
+    case DatabaseSection::FeatureScale:
+      return "feature_scale";
+    case DatabaseSection::Searchable:
+      return "searchable";
+    case DatabaseSection::Clips:
+      return "clips";
+    case DatabaseSection::TagNames:
+      return "tag_names";
+    case DatabaseSection::Count:
+      break;
   }
   return "unknown";
 }
@@ -657,8 +677,8 @@ uint64_t database_checksum(std::span<const std::byte> bytes) {
     }
     lane3 = lane_step(lane3, word ^ kTailMul);
   }
-  uint64_t h = std::rotl(lane0, 1) + std::rotl(lane1, 7) + std::rotl(lane2, 12) +
-               std::rotl(lane3, 18);
+  uint64_t h =
+      std::rotl(lane0, 1) + std::rotl(lane1, 7) + std::rotl(lane2, 12) + std::rotl(lane3, 18);
   h += static_cast<uint64_t>(size) * kTailMul;
   return avalanche(h);
 }
@@ -685,16 +705,18 @@ std::vector<std::byte> serialize_database(const Database& db) {
   w.pod(kDatabaseFormatVersion);
   w.pod(kDatabaseEndianMarker);
   w.zeros(kDatabaseHeaderSize - w.size());  // patched below once the sizes are known
-  const uint32_t counts[6] = {
-      static_cast<uint32_t>(db.skeleton.joint_count()), static_cast<uint32_t>(db.frame_count),
-      static_cast<uint32_t>(db.clips.size()),           static_cast<uint32_t>(db.tag_names.size()),
-      static_cast<uint32_t>(db.schema.dims()),          static_cast<uint32_t>(db.schema.channels.size())};
+  const uint32_t counts[6] = {static_cast<uint32_t>(db.skeleton.joint_count()),
+                              static_cast<uint32_t>(db.frame_count),
+                              static_cast<uint32_t>(db.clips.size()),
+                              static_cast<uint32_t>(db.tag_names.size()),
+                              static_cast<uint32_t>(db.schema.dims()),
+                              static_cast<uint32_t>(db.schema.channels.size())};
   w.patch(kOffHeaderSize, kDatabaseHeaderSize);
   w.patch(kOffSectionCount, static_cast<uint32_t>(kDatabaseSectionCount));
   w.patch(kOffCounts, counts);
   w.patch(kOffFrameTime, db.frame_time);
-  const int32_t roles[6] = {db.roles.hips,      db.roles.left_foot, db.roles.right_foot,
-                            db.roles.left_toe,  db.roles.right_toe, db.roles.head};
+  const int32_t roles[6] = {db.roles.hips,     db.roles.left_foot, db.roles.right_foot,
+                            db.roles.left_toe, db.roles.right_toe, db.roles.head};
   w.patch(kOffRoles, roles);
 
   std::array<DatabaseFileSection, kDatabaseSectionCount> table{};
@@ -789,14 +811,15 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
   std::thread worker;
   if (header && bytes.size() >= kParallelHashBytes) {
     try {
-      worker = std::thread([&computed, &worker_failed, &db, covered, bytes, &info = header.value()] {
-        computed = database_checksum(covered);
-        try {
-          copy_arrays_a(bytes, info, db);
-        } catch (...) {
-          worker_failed = true;  // out of memory
-        }
-      });
+      worker =
+          std::thread([&computed, &worker_failed, &db, covered, bytes, &info = header.value()] {
+            computed = database_checksum(covered);
+            try {
+              copy_arrays_a(bytes, info, db);
+            } catch (...) {
+              worker_failed = true;  // out of memory
+            }
+          });
     } catch (...) {
       // No thread to be had: everything runs on this one below.
     }

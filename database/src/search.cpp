@@ -13,8 +13,8 @@ namespace mm {
 
 Status SearchInput::validate() const {
   if (dims < 1 || dims > kMaxSearchDims) {
-    return Error{"search input: feature dimension " + std::to_string(dims) +
-                 " is outside [1, " + std::to_string(kMaxSearchDims) + "]"};
+    return Error{"search input: feature dimension " + std::to_string(dims) + " is outside [1, " +
+                 std::to_string(kMaxSearchDims) + "]"};
   }
   const size_t frames = searchable.size();
   if (features.size() != frames * static_cast<size_t>(dims)) {
@@ -59,8 +59,8 @@ SearchInput search_input(const Database& database) {
 }
 
 std::span<const std::string_view> search_method_names() {
-  static constexpr std::string_view names[] = {"brute", "brute-simd", "aabb", "kdtree", "boxtree",
-                                                   "approx", "kdtree-eps"};
+  static constexpr std::string_view names[] = {"brute",   "brute-simd", "aabb",      "kdtree",
+                                               "boxtree", "approx",     "kdtree-eps"};
   return names;
 }
 
@@ -97,8 +97,8 @@ CandidateSet make_candidate_set(const SearchInput& input) {
   set.frame_clip.assign(input.frame_clip.begin(), input.frame_clip.end());
   set.frame_row.assign(static_cast<size_t>(set.frame_count), -1);
   const auto dims = static_cast<size_t>(input.dims);
-  const auto searchable = static_cast<size_t>(
-      std::count_if(input.searchable.begin(), input.searchable.end(), [](uint8_t s) { return s != 0; }));
+  const auto searchable = static_cast<size_t>(std::count_if(
+      input.searchable.begin(), input.searchable.end(), [](uint8_t s) { return s != 0; }));
   set.rows.reserve(searchable * dims);
   set.row_frame.reserve(searchable);
   set.row_tags.reserve(searchable);
@@ -106,7 +106,8 @@ CandidateSet make_candidate_set(const SearchInput& input) {
     if (!input.searchable[static_cast<size_t>(f)]) continue;
     set.frame_row[static_cast<size_t>(f)] = set.row_count();
     set.row_frame.push_back(f);
-    set.row_tags.push_back(input.clips[static_cast<size_t>(input.frame_clip[static_cast<size_t>(f)])].tags);
+    set.row_tags.push_back(
+        input.clips[static_cast<size_t>(input.frame_clip[static_cast<size_t>(f)])].tags);
     const float* row = input.features.data() + static_cast<size_t>(f) * dims;
     set.rows.insert(set.rows.end(), row, row + dims);
   }
@@ -186,7 +187,9 @@ class BruteSearcher final : public Searcher {
            frame_clip_.capacity() * sizeof(int) + clip_tags_.capacity() * sizeof(uint64_t);
   }
 
-  const float* row(int frame) const { return features_.data() + static_cast<size_t>(frame) * dims_; }
+  const float* row(int frame) const {
+    return features_.data() + static_cast<size_t>(frame) * dims_;
+  }
 
   SearchResult search(std::span<const float> query,
                       const SearchConstraints& constraints) const override {
@@ -219,7 +222,8 @@ class BruteSearcher final : public Searcher {
       }
       // Early exit per row: once the partial sum reaches the bound the row cannot win.
       const float bound = best.cost - constraints.transition_cost;
-      const float distance = search_kernels::squared_distance_bounded(query.data(), row(f), dims_, bound);
+      const float distance =
+          search_kernels::squared_distance_bounded(query.data(), row(f), dims_, bound);
       if (distance < bound && distance + constraints.transition_cost < best.cost) {
         best.frame = f;
         best.cost = distance + constraints.transition_cost;
@@ -274,7 +278,8 @@ struct SearchBatchRunner::State {
       if (first >= count) return;
       const int last = std::min(count, first + kChunk);
       for (int i = first; i < last; ++i) {
-        const SearchConstraints& c = constraints.size() == 1 ? constraints[0] : constraints[static_cast<size_t>(i)];
+        const SearchConstraints& c =
+            constraints.size() == 1 ? constraints[0] : constraints[static_cast<size_t>(i)];
         results[static_cast<size_t>(i)] =
             searcher->search(queries.subspan(static_cast<size_t>(i) * dims, dims), c);
       }
@@ -315,7 +320,9 @@ SearchBatchRunner::~SearchBatchRunner() {
   for (std::thread& worker : state_->workers) worker.join();
 }
 
-int SearchBatchRunner::thread_count() const { return state_->thread_count; }
+int SearchBatchRunner::thread_count() const {
+  return state_->thread_count;
+}
 
 void SearchBatchRunner::run(const Searcher& searcher, std::span<const float> queries,
                             std::span<const SearchConstraints> constraints,

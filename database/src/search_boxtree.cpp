@@ -41,7 +41,7 @@ namespace {
 using search_kernels::kBlockRows;
 
 struct Node {
-  int first_block = 0;   // the node's rows are blocks [first_block, last_block)
+  int first_block = 0;  // the node's rows are blocks [first_block, last_block)
   int last_block = 0;
   int first_child = -1;  // -1 for a leaf; children are first_child and first_child + 1
 };
@@ -70,7 +70,8 @@ constexpr int kRotatedBoxDims = 16;
 // dependent reads, and on a busy machine each one that misses the caches costs ~150 ns.
 __attribute__((always_inline)) inline void traverse(const TreeView& tree, const float* query,
                                                     const search_kernels::RowFilter& filter,
-                                                    bool tag_filter, search_kernels::ScanBest& best) {
+                                                    bool tag_filter,
+                                                    search_kernels::ScanBest& best) {
   struct Pending {
     int node;
     float distance;
@@ -90,12 +91,14 @@ __attribute__((always_inline)) inline void traverse(const TreeView& tree, const 
   auto push = [&](int node, float distance) {
     const Node& n = tree.nodes[node];
     if (n.first_child >= 0) {
-      const char* boxes = reinterpret_cast<const char*>(tree.boxes + static_cast<size_t>(n.first_child) * box_stride);
+      const char* boxes = reinterpret_cast<const char*>(
+          tree.boxes + static_cast<size_t>(n.first_child) * box_stride);
       for (size_t offset = 0; offset < 2 * box_stride * sizeof(float); offset += 64) {
         __builtin_prefetch(boxes + offset);
       }
     } else {
-      const char* rows = reinterpret_cast<const char*>(tree.blocks + static_cast<size_t>(n.first_block) * block_floats);
+      const char* rows = reinterpret_cast<const char*>(
+          tree.blocks + static_cast<size_t>(n.first_block) * block_floats);
       for (size_t offset = 0; offset < 32 * 64; offset += 64) __builtin_prefetch(rows + offset);
     }
     stack[size++] = {node, distance};
@@ -165,7 +168,8 @@ class BoxTree {
     // every split partitions its range into the other buffer in one streaming pass.
     std::vector<float> work(static_cast<size_t>(count) * row_size);
     for (int i = 0; i < count; ++i) {
-      std::copy_n(set.row(rows[static_cast<size_t>(i)]), dims, work.data() + static_cast<size_t>(i) * row_size);
+      std::copy_n(set.row(rows[static_cast<size_t>(i)]), dims,
+                  work.data() + static_cast<size_t>(i) * row_size);
     }
     if (rotate && count > 0) {
       rotation_ = principal_axes(work.data(), count, dims, 4096);
@@ -227,7 +231,8 @@ class BoxTree {
     ExactRanker ranker;
     if (!rotation_.empty()) {
       rotation_.apply(query, point);
-      ranker.start(set, rotation_, query, shared.distance, row_norm(point, set.dims), max_row_norm_);
+      ranker.start(set, rotation_, query, shared.distance, row_norm(point, set.dims),
+                   max_row_norm_);
       ranker.scanned_to_set = tree_row_.data();
       filter.offer = &ExactRanker::offer;
       filter.offer_context = &ranker;
@@ -243,8 +248,15 @@ class BoxTree {
       base = box_distance(point + box_dims_, root_box_.data() + box_dims_,
                           root_box_.data() + padded_dims_ + box_dims_, padded_dims_ - box_dims_);
     }
-    const TreeView view{nodes_.data(), boxes_.data(), node_tags_or_.data(), node_tags_and_.data(),
-                        blocks_.data(), set.dims, box_dims_, base, scan};
+    const TreeView view{nodes_.data(),
+                        boxes_.data(),
+                        node_tags_or_.data(),
+                        node_tags_and_.data(),
+                        blocks_.data(),
+                        set.dims,
+                        box_dims_,
+                        base,
+                        scan};
     traverse_fn(view, point, filter, tag_filter, best);
     int found = best.row;
     float found_distance = best.distance;
@@ -264,7 +276,8 @@ class BoxTree {
            tree_frame_.capacity() * sizeof(int) + tree_tags_.capacity() * sizeof(uint64_t) +
            blocks_.capacity() * sizeof(float) +
            (block_tags_or_.capacity() + block_tags_and_.capacity()) * sizeof(uint64_t) +
-           nodes_.capacity() * sizeof(Node) + (boxes_.capacity() + root_box_.capacity()) * sizeof(float) +
+           nodes_.capacity() * sizeof(Node) +
+           (boxes_.capacity() + root_box_.capacity()) * sizeof(float) +
            (node_tags_or_.capacity() + node_tags_and_.capacity()) * sizeof(uint64_t);
   }
 
@@ -325,7 +338,8 @@ class BoxTree {
     // The pivot is the key of rank left_size: rows below it go left, rows above it right, and
     // rows equal to it fill the left side up to its size.
     float* keys = buffers.keys.data() + first;
-    for (int i = 0; i < count; ++i) keys[i] = source[static_cast<size_t>(first + i) * row_size + split_dim];
+    for (int i = 0; i < count; ++i)
+      keys[i] = source[static_cast<size_t>(first + i) * row_size + split_dim];
     std::nth_element(keys, keys + left_size, keys + count);
     const float pivot = keys[left_size];
     int less = 0;
@@ -414,15 +428,15 @@ class BoxTree {
   int padded_dims_ = 8;
   int box_dims_ = 8;  // columns covered by the node boxes
   int leaf_rows_ = 32;
-  std::vector<int> tree_row_;         // tree order -> candidate row
-  std::vector<int> tree_frame_;       // tree order -> frame
-  std::vector<uint64_t> tree_tags_;   // tree order -> clip tags
-  std::vector<float> blocks_;         // tree-ordered rows (in the tree's space), packed
+  std::vector<int> tree_row_;        // tree order -> candidate row
+  std::vector<int> tree_frame_;      // tree order -> frame
+  std::vector<uint64_t> tree_tags_;  // tree order -> clip tags
+  std::vector<float> blocks_;        // tree-ordered rows (in the tree's space), packed
   std::vector<uint64_t> block_tags_or_;
   std::vector<uint64_t> block_tags_and_;
-  std::vector<Node> nodes_;           // node 0 is the root
-  std::vector<float> boxes_;          // per node: lows then highs, box_dims_ each
-  std::vector<float> root_box_;       // lows then highs over all columns, padded_dims_ each
+  std::vector<Node> nodes_;      // node 0 is the root
+  std::vector<float> boxes_;     // per node: lows then highs, box_dims_ each
+  std::vector<float> root_box_;  // lows then highs over all columns, padded_dims_ each
   std::vector<uint64_t> node_tags_or_;
   std::vector<uint64_t> node_tags_and_;
 };
@@ -439,7 +453,8 @@ class BoxTreeSearcher final : public Searcher {
     }
     traverse_ = search_kernels::avx2_supported() ? &traverse_avx2 : &traverse_portable;
     // In principal axes most rows of a visited leaf are decided by their first 8 or 16 columns.
-    scan_ = options.principal_axes ? search_kernels::scan_blocks_staged() : search_kernels::scan_blocks();
+    scan_ = options.principal_axes ? search_kernels::scan_blocks_staged()
+                                   : search_kernels::scan_blocks();
   }
 
   std::string_view method() const override { return "boxtree"; }

@@ -58,7 +58,8 @@ __attribute__((always_inline)) inline float box_distance(const float* query, con
   }
   float lanes[8];
   std::memcpy(lanes, &acc, sizeof lanes);
-  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
+         ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
 }
 
 // True when a clip with `tags` passes the include / exclude filter.
@@ -109,7 +110,8 @@ struct FeatureRotation {
     return 2.0f * std::sqrt(n) * (2.0f * n + 2.0f) * 5.97e-8f;
   }
   size_t memory_bytes() const {
-    return (mean.capacity() + axes.capacity()) * sizeof(float) + variance.capacity() * sizeof(double);
+    return (mean.capacity() + axes.capacity()) * sizeof(float) +
+           variance.capacity() * sizeof(double);
   }
 };
 
@@ -130,13 +132,13 @@ float row_norm(const float* x, int dims);
 // the canonical best row lies at most slack above it in the scanned space, so it is never pruned.
 struct ExactRanker {
   const CandidateSet* set = nullptr;
-  const float* query = nullptr;          // unrotated
-  const int* scanned_to_set = nullptr;   // scanned row -> candidate row (null: the same)
-  float best_distance = 0.0f;            // canonical distance of best_row (the bound while none)
-  int best_row = -1;                     // scanned row of the best decided row, -1 while none
-  float upper = 0.0f;                    // >= the best canonical distance of every offered row
-  float rotation_error = 0.0f;           // bound on |rotated difference - exact difference|
-  float relative_error = 0.0f;           // relative rounding of one distance computation
+  const float* query = nullptr;         // unrotated
+  const int* scanned_to_set = nullptr;  // scanned row -> candidate row (null: the same)
+  float best_distance = 0.0f;           // canonical distance of best_row (the bound while none)
+  int best_row = -1;                    // scanned row of the best decided row, -1 while none
+  float upper = 0.0f;                   // >= the best canonical distance of every offered row
+  float rotation_error = 0.0f;          // bound on |rotated difference - exact difference|
+  float relative_error = 0.0f;          // relative rounding of one distance computation
   static constexpr int kPendingRows = 16;
   int pending_row[kPendingRows];         // offered rows not decided yet
   float pending_distance[kPendingRows];  // their scanned distances
@@ -191,8 +193,8 @@ struct GroupDistance {
 // their bounding boxes in the original space and the OR and AND of their rows' tags. Tree
 // methods build one structure per group and visit groups nearest first.
 struct RowGroups {
-  int query_dims = 0;    // columns of a query
-  int padded_dims = 0;   // columns rounded up to a multiple of 8
+  int query_dims = 0;        // columns of a query
+  int padded_dims = 0;       // columns rounded up to a multiple of 8
   std::vector<float> boxes;  // per group: padded lows, then padded highs
   std::vector<uint64_t> tags_or;
   std::vector<uint64_t> tags_and;

@@ -3,12 +3,12 @@
 // randomized trees with a leaf-check budget).
 //
 // All three index the searchable rows only (the mask is fixed when the database is built),
-// split into k-means groups (RowGroups) with one FLANN index per group, each over the group's principal-axes
-// coordinates. A query visits the groups nearest first by the distance to their bounding box and
-// stops at the first group whose box is farther than the best cost found. Inside a group the
-// per-query rules are applied by a custom FLANN result set: a row that fails the tag filter or
-// lies in the window is never recorded, and the threshold starts at the best so far (at first
-// the continuation's distance minus the transition cost). Rows found in a rotated space are
+// split into k-means groups (RowGroups) with one FLANN index per group, each over the group's
+// principal-axes coordinates. A query visits the groups nearest first by the distance to their
+// bounding box and stops at the first group whose box is farther than the best cost found. Inside a
+// group the per-query rules are applied by a custom FLANN result set: a row that fails the tag
+// filter or lies in the window is never recorded, and the threshold starts at the best so far (at
+// first the continuation's distance minus the transition cost). Rows found in a rotated space are
 // decided by their unrotated distance (ExactRanker). The single trees prune a branch only when
 // its lower bound reaches the threshold, so `kdtree` is exact under every constraint.
 //
@@ -47,7 +47,8 @@ struct FlannDistance {
   template <typename Iterator1, typename Iterator2>
   float operator()(Iterator1 a, Iterator2 b, size_t size, float worst_dist = -1) const {
     // FLANN passes -1 when there is no bound.
-    if (bounded && worst_dist >= 0.0f) return bounded_kernel(&*a, &*b, static_cast<int>(size), worst_dist);
+    if (bounded && worst_dist >= 0.0f)
+      return bounded_kernel(&*a, &*b, static_cast<int>(size), worst_dist);
     return kernel(&*a, &*b, static_cast<int>(size));
   }
   // One column's share of the distance (FLANN's incremental bound of a branch).
@@ -122,12 +123,12 @@ struct ApproxTraits {
 // One group: its rows (rotated or not), their candidate rows, frames and tags, and the index.
 template <class Index>
 struct FlannGroup {
-  FeatureRotation rotation;      // empty when the index is over the raw columns
-  std::vector<float> points;     // the group's rows in the index's space (FLANN points into
-                                 // it), released once built when the index keeps its own copy
-  std::vector<int> set_rows;     // index row -> candidate row
-  std::vector<int> frames;       // index row -> frame
-  std::vector<uint64_t> tags;    // index row -> clip tags
+  FeatureRotation rotation;    // empty when the index is over the raw columns
+  std::vector<float> points;   // the group's rows in the index's space (FLANN points into
+                               // it), released once built when the index keeps its own copy
+  std::vector<int> set_rows;   // index row -> candidate row
+  std::vector<int> frames;     // index row -> frame
+  std::vector<uint64_t> tags;  // index row -> clip tags
   float max_row_norm = 0.0f;
   std::unique_ptr<Index> index;
 };
@@ -293,15 +294,16 @@ class FlannSearcher final : public Searcher {
         jobs.push_back({forest, g, forest->trees[g].set_rows.size()});
       }
     }
-    std::stable_sort(jobs.begin(), jobs.end(), [](const Job& a, const Job& b) { return a.rows > b.rows; });
+    std::stable_sort(jobs.begin(), jobs.end(),
+                     [](const Job& a, const Job& b) { return a.rows > b.rows; });
     const double dense_below = dense_variance_below(set);
     std::vector<Status> built(jobs.size(), Status::success());
-    detail::run_workers(jobs.size(), detail::worker_threads(options.build_threads),
-                        [&](int, size_t j) {
-                          built[j] = jobs[j].forest->build_group(
-                              jobs[j].group, set, options.principal_axes, dense_below, params,
-                              Traits::kName, Traits::kCopiesRows);
-                        });
+    detail::run_workers(
+        jobs.size(), detail::worker_threads(options.build_threads), [&](int, size_t j) {
+          built[j] =
+              jobs[j].forest->build_group(jobs[j].group, set, options.principal_axes, dense_below,
+                                          params, Traits::kName, Traits::kCopiesRows);
+        });
     for (const Status& status : built) {
       if (!status) return Error{status.message()};
     }
@@ -375,7 +377,8 @@ Status check_single_tree_options(std::string_view method, const SearchOptions& o
 
 Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
                                               const SearchOptions& options) {
-  if (Status valid = check_single_tree_options("kdtree", options); !valid) return Error{valid.message()};
+  if (Status valid = check_single_tree_options("kdtree", options); !valid)
+    return Error{valid.message()};
   // KDTreeSingleIndex ignores the check count, and eps 0 keeps it exact.
   return FlannSearcher<ExactTraits>::make(
       input, options, options.kdtree_group_rows,
@@ -389,7 +392,8 @@ Result<std::unique_ptr<Searcher>> make_kdtree_eps(const SearchInput& input,
     return Error{valid.message()};
   }
   if (!(options.kdtree_eps >= 0.0f) || !std::isfinite(options.kdtree_eps)) {
-    return Error{"kdtree-eps: eps must be finite and >= 0, got " + std::to_string(options.kdtree_eps)};
+    return Error{"kdtree-eps: eps must be finite and >= 0, got " +
+                 std::to_string(options.kdtree_eps)};
   }
   // FLANN skips a branch when its lower bound times (1 + eps) reaches the best distance so far.
   flann::SearchParams search_params;

@@ -79,7 +79,8 @@ std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::v
     const float* last = centres.data() + static_cast<size_t>(k - 1) * row_size;
     double total = 0.0;
     for (size_t i = 0; i < sample.size(); ++i) {
-      nearest[i] = std::min(nearest[i], search_kernels::squared_distance(set.row(sample[i]), last, dims));
+      nearest[i] =
+          std::min(nearest[i], search_kernels::squared_distance(set.row(sample[i]), last, dims));
       total += nearest[i];
     }
     if (!(total > 0.0)) break;  // every sample row is a centre already
@@ -105,7 +106,8 @@ std::vector<std::vector<int>> kmeans_split(const CandidateSet& set, const std::v
     for (int r : sample) {
       const int c = nearest_centre(r);
       ++counts[static_cast<size_t>(c)];
-      for (size_t d = 0; d < row_size; ++d) sums[static_cast<size_t>(c) * row_size + d] += set.row(r)[d];
+      for (size_t d = 0; d < row_size; ++d)
+        sums[static_cast<size_t>(c) * row_size + d] += set.row(r)[d];
     }
     for (int c = 0; c < k_count; ++c) {
       if (counts[static_cast<size_t>(c)] == 0) continue;  // keeps its old place
@@ -139,7 +141,8 @@ double total_variance(const CandidateSet& set, const std::vector<int>& rows) {
   }
   double variance = 0.0;
   const auto n = static_cast<double>(rows.size());
-  for (size_t d = 0; d < dims; ++d) variance += std::max(0.0, sum_squares[d] / n - (sum[d] / n) * (sum[d] / n));
+  for (size_t d = 0; d < dims; ++d)
+    variance += std::max(0.0, sum_squares[d] / n - (sum[d] / n) * (sum[d] / n));
   return variance;
 }
 
@@ -244,7 +247,8 @@ double dense_variance_below(const CandidateSet& set) {
 }
 
 size_t RowGroups::memory_bytes() const {
-  return boxes.capacity() * sizeof(float) + (tags_or.capacity() + tags_and.capacity()) * sizeof(uint64_t);
+  return boxes.capacity() * sizeof(float) +
+         (tags_or.capacity() + tags_and.capacity()) * sizeof(uint64_t);
 }
 
 RowGroups make_row_groups(const CandidateSet& set, int group_rows,

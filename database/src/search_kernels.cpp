@@ -20,7 +20,8 @@ typedef float Float8 __attribute__((vector_size(32)));
 float sum_lanes(const Float8& acc) {
   float lanes[8];
   std::memcpy(lanes, &acc, sizeof lanes);
-  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) + ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
+         ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
 }
 
 // The rare path of a scan: some lane of a block beat the bound; check the lanes in row order
@@ -125,9 +126,10 @@ __attribute__((target("avx2,fma"), always_inline)) inline float row_distance_avx
   }
   if (d < dims) {
     // The masked loads read only the remaining columns (never past the end of a row).
-    const __m256i mask = _mm256_cmpgt_epi32(_mm256_set1_epi32(dims - d),
-                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    const __m256 diff = _mm256_sub_ps(_mm256_maskload_ps(a + d, mask), _mm256_maskload_ps(b + d, mask));
+    const __m256i mask =
+        _mm256_cmpgt_epi32(_mm256_set1_epi32(dims - d), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    const __m256 diff =
+        _mm256_sub_ps(_mm256_maskload_ps(a + d, mask), _mm256_maskload_ps(b + d, mask));
     acc = _mm256_fmadd_ps(diff, diff, acc);
   }
   return horizontal_sum(acc);
@@ -319,8 +321,7 @@ __attribute__((target("avx2,fma"), always_inline)) inline void scan_blocks_avx2_
 __attribute__((target("avx2,fma"))) void scan_blocks_avx2(const float* blocks, int first_block,
                                                           int last_block, int dims,
                                                           const float* query,
-                                                          const RowFilter& filter,
-                                                          ScanBest& best) {
+                                                          const RowFilter& filter, ScanBest& best) {
   scan_blocks_avx2_impl<false>(blocks, first_block, last_block, dims, query, filter, best);
 }
 
@@ -340,7 +341,9 @@ bool avx2_supported() {
   return supported;
 }
 
-ScanBlocksFn scan_blocks() { return avx2_supported() ? &scan_blocks_avx2 : &scan_blocks_portable; }
+ScanBlocksFn scan_blocks() {
+  return avx2_supported() ? &scan_blocks_avx2 : &scan_blocks_portable;
+}
 
 ScanBlocksFn scan_blocks_staged() {
   return avx2_supported() ? &scan_blocks_staged_avx2 : &scan_blocks_portable;
@@ -354,6 +357,8 @@ BoundedRowDistanceFn row_distance_bounded() {
   return avx2_supported() ? &row_distance_bounded_avx2 : &row_distance_bounded_portable;
 }
 
-const char* scan_blocks_isa() { return avx2_supported() ? "avx2" : "portable"; }
+const char* scan_blocks_isa() {
+  return avx2_supported() ? "avx2" : "portable";
+}
 
 }  // namespace mm::search_kernels

@@ -37,13 +37,19 @@ __attribute__((always_inline)) inline void rotate_blocks(const FeatureRotation& 
   std::memcpy(y, sums, static_cast<size_t>(r.padded_dims) * sizeof(float));
 }
 
-__attribute__((always_inline)) inline void rotate(const FeatureRotation& r, const float* x, float* y) {
+__attribute__((always_inline)) inline void rotate(const FeatureRotation& r, const float* x,
+                                                  float* y) {
   switch (r.padded_dims / 8) {
-    case 1: return rotate_blocks<1>(r, x, y);
-    case 2: return rotate_blocks<2>(r, x, y);
-    case 3: return rotate_blocks<3>(r, x, y);
-    case 4: return rotate_blocks<4>(r, x, y);
-    default: return rotate_blocks<0>(r, x, y);
+    case 1:
+      return rotate_blocks<1>(r, x, y);
+    case 2:
+      return rotate_blocks<2>(r, x, y);
+    case 3:
+      return rotate_blocks<3>(r, x, y);
+    case 4:
+      return rotate_blocks<4>(r, x, y);
+    default:
+      return rotate_blocks<0>(r, x, y);
   }
 }
 
@@ -52,7 +58,9 @@ __attribute__((target("avx2,fma"))) void rotate_avx2(const FeatureRotation& r, c
   rotate(r, x, y);
 }
 
-void rotate_portable(const FeatureRotation& r, const float* x, float* y) { rotate(r, x, y); }
+void rotate_portable(const FeatureRotation& r, const float* x, float* y) {
+  rotate(r, x, y);
+}
 
 }  // namespace
 
@@ -88,7 +96,8 @@ void jacobi_eigen(size_t n, std::vector<double>& a, std::vector<double>& v) {
         const double apq = a[p * n + q];
         if (apq == 0.0) continue;
         const double theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
-        const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
+        const double t =
+            (theta >= 0.0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
         const double c = 1.0 / std::sqrt(t * t + 1.0);
         const double s = t * c;
         for (size_t k = 0; k < n; ++k) {

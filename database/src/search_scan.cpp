@@ -116,9 +116,8 @@ class AabbSearcher final : public Searcher {
     int best_row = -1;
     for (int large_first = 0; large_first < rows; large_first += kLargeBox) {
       const size_t large_box = static_cast<size_t>(large_first / kLargeBox) * dims;
-      if (search_kernels::box_squared_distance_bounded(q, large_.lo.data() + large_box,
-                                                       large_.hi.data() + large_box, dims,
-                                                       best) >= best) {
+      if (search_kernels::box_squared_distance_bounded(
+              q, large_.lo.data() + large_box, large_.hi.data() + large_box, dims, best) >= best) {
         continue;
       }
       const int large_last = std::min(rows, large_first + kLargeBox);
@@ -132,7 +131,8 @@ class AabbSearcher final : public Searcher {
         const int small_last = std::min(large_last, small_first + kSmallBox);
         for (int r = small_first; r < small_last; ++r) {
           if (!plan.filter.passes(r)) continue;
-          const float distance = search_kernels::squared_distance_bounded(q, set_.row(r), dims, best);
+          const float distance =
+              search_kernels::squared_distance_bounded(q, set_.row(r), dims, best);
           if (distance < best) {
             best = distance;
             best_row = r;

@@ -36,7 +36,8 @@ SyntheticSearchData make_synthetic_search_data(const SyntheticSearchSpec& spec) 
     ClipRange clip;
     clip.name = "synthetic_" + std::to_string(c);
     clip.start = data.frame_count();
-    const int frames = min_frames + static_cast<int>(unit(rng) * static_cast<float>(max_frames - min_frames + 1));
+    const int frames =
+        min_frames + static_cast<int>(unit(rng) * static_cast<float>(max_frames - min_frames + 1));
     clip.end = clip.start + std::min(frames, max_frames);
     const bool standing = unit(rng) < spec.standing_fraction;
     if (standing) clip.tags |= 1;

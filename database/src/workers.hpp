@@ -19,7 +19,8 @@ int run_workers(size_t items, int threads, const Work& work) {
     for (size_t i = next.fetch_add(1); i < items; i = next.fetch_add(1)) work(worker, i);
   };
   std::vector<std::thread> pool;
-  const int wanted = static_cast<int>(std::min<size_t>(static_cast<size_t>(std::max(threads, 1)), items));
+  const int wanted =
+      static_cast<int>(std::min<size_t>(static_cast<size_t>(std::max(threads, 1)), items));
   for (int t = 1; t < wanted; ++t) {
     try {
       pool.emplace_back(loop, t);

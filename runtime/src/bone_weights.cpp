@@ -22,7 +22,9 @@ constexpr float kMinLength = 1e-6f;
 // Weights within this of a vertex's largest weight tie with it for "dominant".
 constexpr float kDominanceTolerance = 1e-6f;
 
-std::string str(size_t n) { return std::to_string(n); }
+std::string str(size_t n) {
+  return std::to_string(n);
+}
 
 bool finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -147,8 +149,8 @@ struct BoneDistance {
 BoneDistance bone_distance(const glm::vec3& p, const BoneSegment& bone) {
   const glm::vec3 d = bone.tail - bone.head;
   const float length2 = glm::dot(d, d);
-  const float t = length2 > 0.0f ? std::clamp(glm::dot(p - bone.head, d) / length2, 0.0f, 1.0f)
-                                 : 0.0f;
+  const float t =
+      length2 > 0.0f ? std::clamp(glm::dot(p - bone.head, d) / length2, 0.0f, 1.0f) : 0.0f;
   const float axis = glm::length(p - (bone.head + t * d));
   return {axis, axis - glm::mix(bone.head_radius, bone.tail_radius, t)};
 }
@@ -425,8 +427,8 @@ Result<RawWeights> heat_weights(const Proximity& px, const EdgeGraph& graph,
       sourced = sourced || owns;
     }
     if (!sourced) continue;  // no vertex is nearest to j: its weights are exactly 0
-    const double residual = conjugate_gradient(sys, b, x, options.heat_tolerance,
-                                               options.heat_max_iterations);
+    const double residual =
+        conjugate_gradient(sys, b, x, options.heat_tolerance, options.heat_max_iterations);
     if (!(residual <= options.heat_tolerance)) {
       return Error{"bone weights: heat diffusion for joint " + std::to_string(joints.ids[j]) +
                    " did not converge in " + std::to_string(options.heat_max_iterations) +
@@ -457,7 +459,7 @@ VertexInfluences top_influences(std::span<const float> row, const JointTable& jo
     count = std::min(count + 1, kMaxInfluences);
   }
   if (count == 0) best[count++] = {1.0f, nearest};  // cannot happen; never leave it weightless
-  for (int pass = 0; pass < 2; ++pass) {  // normalize, drop the small, normalize again
+  for (int pass = 0; pass < 2; ++pass) {            // normalize, drop the small, normalize again
     float sum = 0.0f;
     for (size_t k = 0; k < count; ++k) sum += best[k].first;
     for (size_t k = 0; k < count; ++k) best[k].first /= sum;
@@ -476,8 +478,7 @@ std::vector<VertexInfluences> prune(const RawWeights& raw, const Proximity& px,
   const size_t jc = px.joint_count;
   std::vector<VertexInfluences> out(px.nearest.size());
   for (size_t v = 0; v < out.size(); ++v) {
-    out[v] = top_influences(std::span(raw).subspan(v * jc, jc), joints, px.nearest[v],
-                            min_weight);
+    out[v] = top_influences(std::span(raw).subspan(v * jc, jc), joints, px.nearest[v], min_weight);
   }
   return out;
 }
@@ -496,7 +497,6 @@ Result<RawWeights> raw_weights(const TriangleMesh& mesh, const Proximity& px,
   }
   return Error{"bone weights: unknown method " + std::to_string(static_cast<int>(options.method))};
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // Quality checks.
@@ -584,8 +584,8 @@ void check_jumps(const EdgeGraph& graph, std::span<const VertexInfluences> influ
       for (const VertexInfluences* end : ends) {
         for (int k = 0; k < 4; ++k) {
           const int joint = end->joints[k];
-          const float jump = std::abs(joint_weight(influences[a], joint) -
-                                      joint_weight(influences[b], joint));
+          const float jump =
+              std::abs(joint_weight(influences[a], joint) - joint_weight(influences[b], joint));
           if (jump > report.max_neighbor_jump || report.jump_joint < 0) {
             report.max_neighbor_jump = jump;
             report.jump_vertex_a = a;

@@ -64,9 +64,8 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   const float upper = glm::distance(a, b);
   const float lower = glm::distance(b, c);
   if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
-      !finite(in.root.rotation) || !finite(in.mid.rotation) ||
-      !finite(in.root_parent_rotation) || !std::isfinite(in.extension_epsilon) ||
-      upper < kMinBoneLength || lower < kMinBoneLength) {
+      !finite(in.root.rotation) || !finite(in.mid.rotation) || !finite(in.root_parent_rotation) ||
+      !std::isfinite(in.extension_epsilon) || upper < kMinBoneLength || lower < kMinBoneLength) {
     return unchanged(in);
   }
 

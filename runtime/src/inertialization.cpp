@@ -103,21 +103,19 @@ void inertialize_transition(InertializationOffsets& offsets, const PoseMotion& o
   assert(incoming.velocities.empty() || incoming.velocities.size() == n);
   assert(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
   for (size_t i = 0; i < n; ++i) {
-    inertialize_position_transition(offsets.positions[i], offsets.velocities[i],
-                                    outgoing.local[i].translation,
-                                    at_or_zero(outgoing.velocities, i),
-                                    incoming.local[i].translation,
-                                    at_or_zero(incoming.velocities, i));
-    inertialize_rotation_transition(offsets.rotations[i], offsets.rotation_rates[i],
-                                    outgoing.local[i].rotation,
-                                    at_or_zero(outgoing.angular_velocities, i),
-                                    incoming.local[i].rotation,
-                                    at_or_zero(incoming.angular_velocities, i));
+    inertialize_position_transition(
+        offsets.positions[i], offsets.velocities[i], outgoing.local[i].translation,
+        at_or_zero(outgoing.velocities, i), incoming.local[i].translation,
+        at_or_zero(incoming.velocities, i));
+    inertialize_rotation_transition(
+        offsets.rotations[i], offsets.rotation_rates[i], outgoing.local[i].rotation,
+        at_or_zero(outgoing.angular_velocities, i), incoming.local[i].rotation,
+        at_or_zero(incoming.angular_velocities, i));
   }
 }
 
-void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming,
-                        float halflife, float dt, std::span<Transform> out_local,
+void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming, float halflife,
+                        float dt, std::span<Transform> out_local,
                         std::span<glm::vec3> out_velocities,
                         std::span<glm::vec3> out_angular_velocities) {
   const size_t n = offsets.rotations.size();
@@ -141,9 +139,9 @@ void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incom
       out_velocities[i] = at_or_zero(incoming.velocities, i) + offsets.velocities[i];
     }
     if (!out_angular_velocities.empty()) {
-      out_angular_velocities[i] =
-          rotation_vector_rate_to_angular_velocity(offsets.rotations[i], offsets.rotation_rates[i]) +
-          offset_rotation * at_or_zero(incoming.angular_velocities, i);
+      out_angular_velocities[i] = rotation_vector_rate_to_angular_velocity(
+                                      offsets.rotations[i], offsets.rotation_rates[i]) +
+                                  offset_rotation * at_or_zero(incoming.angular_velocities, i);
     }
   }
 }

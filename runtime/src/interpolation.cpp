@@ -21,7 +21,9 @@ glm::quat negated_if_far(const glm::quat& from, const glm::quat& q) {
 
 }  // namespace
 
-glm::quat quat_abs(const glm::quat& q) { return q.w < 0.0f ? -q : q; }
+glm::quat quat_abs(const glm::quat& q) {
+  return q.w < 0.0f ? -q : q;
+}
 
 glm::vec3 quat_log(const glm::quat& q) {
   const glm::vec3 v(q.x, q.y, q.z);
@@ -38,7 +40,9 @@ glm::quat quat_exp(const glm::vec3& half_angle_axis) {
   return glm::quat(std::cos(a), v.x, v.y, v.z);
 }
 
-glm::vec3 quat_to_scaled_angle_axis(const glm::quat& q) { return 2.0f * quat_log(quat_abs(q)); }
+glm::vec3 quat_to_scaled_angle_axis(const glm::quat& q) {
+  return 2.0f * quat_log(quat_abs(q));
+}
 
 glm::quat quat_from_scaled_angle_axis(const glm::vec3& scaled_angle_axis) {
   return quat_exp(0.5f * scaled_angle_axis);
@@ -191,16 +195,14 @@ Transform transform_slerp(const Transform& a, const Transform& b, float t) {
 }
 
 Transform transform_sclerp(const Transform& a, const Transform& b, float t) {
-  const DualQuat q =
-      dual_quat_sclerp(dual_quat_from_transform(a), dual_quat_from_transform(b), t);
+  const DualQuat q = dual_quat_sclerp(dual_quat_from_transform(a), dual_quat_from_transform(b), t);
   Transform out = dual_quat_to_transform(q);
   out.rotation = glm::normalize(out.rotation);
   out.scale = glm::mix(a.scale, b.scale, t);
   return out;
 }
 
-Transform interpolate(const Transform& a, const Transform& b, float t,
-                      InterpolationMethod method) {
+Transform interpolate(const Transform& a, const Transform& b, float t, InterpolationMethod method) {
   switch (method) {
     case InterpolationMethod::Nlerp:
       return transform_nlerp(a, b, t);
@@ -249,8 +251,8 @@ Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
   return out;
 }
 
-void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time,
-                 float time, InterpolationMethod method, WrapMode wrap, std::span<Transform> out) {
+void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time, float time,
+                 InterpolationMethod method, WrapMode wrap, std::span<Transform> out) {
   assert(joint_count > 0 && frame_time > 0.0f);
   assert(!frames.empty() && frames.size() % static_cast<size_t>(joint_count) == 0);
   assert(out.size() == static_cast<size_t>(joint_count));

@@ -27,7 +27,8 @@ Status Skeleton::validate(const std::vector<std::string>& names, const std::vect
   std::unordered_map<std::string_view, size_t> seen;
   seen.reserve(names.size());
   for (size_t i = 0; i < names.size(); ++i) {
-    if (names[i].empty()) return Error{"skeleton: joint " + std::to_string(i) + " has an empty name"};
+    if (names[i].empty())
+      return Error{"skeleton: joint " + std::to_string(i) + " has an empty name"};
     auto [it, inserted] = seen.emplace(names[i], i);
     if (!inserted) {
       return Error{"skeleton: duplicate joint name '" + names[i] + "' (joints " +

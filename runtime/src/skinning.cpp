@@ -58,8 +58,8 @@ void skinning_matrices(std::span<const Transform> global,
   }
 }
 
-void skinning_dual_quats(std::span<const Transform> global,
-                         std::span<const Transform> inverse_bind, std::span<DualQuat> skin) {
+void skinning_dual_quats(std::span<const Transform> global, std::span<const Transform> inverse_bind,
+                         std::span<DualQuat> skin) {
   assert(global.size() == inverse_bind.size() && global.size() == skin.size());
   for (size_t i = 0; i < global.size(); ++i) {
     skin[i] = dual_quat_normalize(dual_quat_from_transform(global[i]) *
@@ -98,8 +98,7 @@ void skin_linear_blend(std::span<const glm::mat4> skin, std::span<const glm::vec
   }
 }
 
-void skin_dual_quaternion(std::span<const DualQuat> skin,
-                          std::span<const glm::vec3> rest_positions,
+void skin_dual_quaternion(std::span<const DualQuat> skin, std::span<const glm::vec3> rest_positions,
                           std::span<const glm::vec3> rest_normals,
                           std::span<const VertexInfluences> influences,
                           std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals) {

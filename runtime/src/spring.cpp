@@ -73,7 +73,9 @@ CharacterCoefficients character_coefficients(double w, double t) {
   return c;
 }
 
-glm::vec3 scaled(double s, const glm::vec3& v) { return static_cast<float>(s) * v; }
+glm::vec3 scaled(double s, const glm::vec3& v) {
+  return static_cast<float>(s) * v;
+}
 
 void apply_spring(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, const SpringCoefficients& c) {
   const glm::vec3 j0 = x - goal;
@@ -91,10 +93,14 @@ void apply_character(glm::vec3& x, glm::vec3& v, glm::vec3& a, const glm::vec3& 
   a = scaled(c.e, a) - scaled(c.e * c.w * c.t, j1);
 }
 
-bool usable(float halflife, float dt) { return std::isfinite(halflife) && std::isfinite(dt); }
+bool usable(float halflife, float dt) {
+  return std::isfinite(halflife) && std::isfinite(dt);
+}
 
 // A prediction time that is negative or non-finite predicts "now".
-double prediction_time(float t) { return std::isfinite(t) && t > 0.0f ? t : 0.0; }
+double prediction_time(float t) {
+  return std::isfinite(t) && t > 0.0f ? t : 0.0;
+}
 
 }  // namespace
 
@@ -106,9 +112,13 @@ float angular_frequency_to_halflife(float angular_frequency) {
   return kHalflifeFrequencyFactor / angular_frequency;
 }
 
-float halflife_to_damping(float halflife) { return 2.0f * halflife_to_angular_frequency(halflife); }
+float halflife_to_damping(float halflife) {
+  return 2.0f * halflife_to_angular_frequency(halflife);
+}
 
-float damping_to_halflife(float damping) { return angular_frequency_to_halflife(0.5f * damping); }
+float damping_to_halflife(float damping) {
+  return angular_frequency_to_halflife(0.5f * damping);
+}
 
 float halflife_to_stiffness(float halflife) {
   const float w = halflife_to_angular_frequency(halflife);
@@ -150,8 +160,8 @@ void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
   v = step.vx * j0 + step.vv * v0;
 }
 
-void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity,
-                            const glm::quat& goal, float halflife, float dt) {
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
+                            float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(goal)) return;
   glm::vec3 error = quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
   critical_spring_update(error, angular_velocity, glm::vec3(0.0f), halflife, dt);
@@ -182,8 +192,8 @@ void critical_spring_predict(std::span<glm::quat> rotations,
   assert(angular_velocities.empty() || angular_velocities.size() == times.size());
   const bool frozen = !std::isfinite(halflife) || !finite(goal);
   const double w = angular_frequency(halflife);
-  const glm::vec3 error0 = frozen ? glm::vec3(0.0f)
-                                  : quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
+  const glm::vec3 error0 =
+      frozen ? glm::vec3(0.0f) : quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
   for (size_t i = 0; i < times.size(); ++i) {
     if (frozen) {
       if (!rotations.empty()) rotations[i] = rotation;
@@ -193,7 +203,8 @@ void critical_spring_predict(std::span<glm::quat> rotations,
     glm::vec3 error = error0;
     glm::vec3 rate = angular_velocity;
     apply_spring(error, rate, glm::vec3(0.0f), spring_coefficients(w, prediction_time(times[i])));
-    if (!rotations.empty()) rotations[i] = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+    if (!rotations.empty())
+      rotations[i] = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
     if (!angular_velocities.empty()) angular_velocities[i] = rate;
   }
 }

@@ -28,8 +28,8 @@ bool finite_pose(const Controller& c) {
   for (const Transform& t : c.global_transforms()) {
     const glm::vec3 p = t.translation;
     const glm::quat q = t.rotation;
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) ||
-        !std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(q.w) ||
+        !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
       return false;
     }
   }
@@ -74,7 +74,8 @@ TEST(ControllerSettingsTest, SetByName) {
 TEST(ControllerDatabaseTest, CandidatesLeaveClipEndsOutAndSpeedsComeFromTheData) {
   const auto shared = normal_controller_database();
   const Database& db = shared->database();
-  const int excluded = static_cast<int>(std::lround(shared->options().clip_end_exclusion / db.frame_time));
+  const int excluded =
+      static_cast<int>(std::lround(shared->options().clip_end_exclusion / db.frame_time));
   ASSERT_GT(excluded, 0);
   int candidates = 0;
   for (const ClipRange& clip : db.clips) {
@@ -224,7 +225,8 @@ TEST(ControllerTest, RootAdjustmentKeepsTransitionSourceAndDestinationConsistent
     adjusted.update(kDt, push_toward(0.0f));
     twin.update(kDt, push_toward(0.0f));
     ASSERT_FALSE(adjusted.debug().searched);
-    const glm::vec3 expected = requested + turn_rotation * (twin.root_transform().translation - twin_start);
+    const glm::vec3 expected =
+        requested + turn_rotation * (twin.root_transform().translation - twin_start);
     EXPECT_LT(glm::length(adjusted.root_transform().translation - expected), 1e-4f) << i;
     EXPECT_NEAR(wrap_angle(quat_yaw(adjusted.root_transform().rotation) -
                            quat_yaw(twin.root_transform().rotation)),
@@ -244,7 +246,8 @@ TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
   for (int i = 0; i < 240; ++i) {
     c.update(kDt, released);
     if (i >= 75) {
-      EXPECT_LT(horizontal_speed(c.root_transform().translation, previous[0].translation, kDt), 0.02f)
+      EXPECT_LT(horizontal_speed(c.root_transform().translation, previous[0].translation, kDt),
+                0.02f)
           << "frame " << i;
       for (int toe : toes) {
         EXPECT_LT(horizontal_speed(c.global_transforms()[static_cast<size_t>(toe)].translation,

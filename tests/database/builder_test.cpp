@@ -9,14 +9,14 @@
 #include <cstring>
 #include <fstream>
 
+#include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
-#include "database_helpers.hpp"
 #include "test_support.hpp"
 
 namespace mm {

@@ -157,7 +157,8 @@ std::string load_error(const std::vector<std::byte>& bytes) {
 
 void write_file(const std::filesystem::path& path, const std::vector<std::byte>& bytes) {
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
 }
 
 // Overwrites a value at `offset`, then recomputes the trailing checksum with the public hash so
@@ -261,7 +262,8 @@ TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
   EXPECT_TRUE(contains(load_error(corrupt), "checksum mismatch")) << load_error(corrupt);
   // Resealed, the value check finds it: sample 100000 is frame 25000, joint 0.
   const std::string message = load_error(patched(bytes, vel + 12 * 100000 + 4, nan));
-  EXPECT_TRUE(contains(message, "local_velocities[frame 25000, joint 0 'Simulation'] is not finite"))
+  EXPECT_TRUE(
+      contains(message, "local_velocities[frame 25000, joint 0 'Simulation'] is not finite"))
       << message;
 }
 
@@ -278,7 +280,8 @@ TEST(DatabaseFile, EveryTruncationIsRefusedWithItsSize) {
     if (length == 0) {
       expected = "empty file";
     } else if (length < kDatabaseHeaderSize) {
-      expected = "truncated: expected at least 336 bytes of header, file has " + std::to_string(length);
+      expected =
+          "truncated: expected at least 336 bytes of header, file has " + std::to_string(length);
     } else {
       expected = "truncated: expected " + std::to_string(bytes.size()) + " bytes, file has " +
                  std::to_string(length);
@@ -345,7 +348,8 @@ TEST(DatabaseFile, WrongMagicVersionAndEndiannessHaveSpecificMessages) {
   // A text-mode copy turns "\r\n" into "\n": the magic catches it.
   std::vector<std::byte> mangled;
   for (size_t i = 0; i < bytes.size(); ++i) {
-    if (bytes[i] == std::byte{'\r'} && i + 1 < bytes.size() && bytes[i + 1] == std::byte{'\n'}) continue;
+    if (bytes[i] == std::byte{'\r'} && i + 1 < bytes.size() && bytes[i + 1] == std::byte{'\n'})
+      continue;
     mangled.push_back(bytes[i]);
   }
   EXPECT_TRUE(contains(load_error(mangled), "text-mode")) << load_error(mangled);
@@ -369,7 +373,8 @@ TEST(DatabaseFile, EmptyAndMissingFilesNameThePath) {
   write_file(empty, {});
   Result<Database> from_empty = load_database(empty);
   ASSERT_FALSE(from_empty.ok());
-  EXPECT_TRUE(contains(from_empty.message(), empty.string() + ": empty file")) << from_empty.message();
+  EXPECT_TRUE(contains(from_empty.message(), empty.string() + ": empty file"))
+      << from_empty.message();
 
   const auto missing = dir / "no_such_database.mmdb";
   Result<Database> from_missing = load_database(missing);
@@ -420,11 +425,11 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
        "section 'local_positions': 960 bytes, expected 1008"},
       {"zero channels", patched(bytes, 52, uint32_t{0}), "channel_count 0 is outside"},
       {"too many tags", patched(bytes, 44, uint32_t{65}), "tag_count 65 is outside"},
-      {"more clips than the section holds", patched(bytes, 40, uint32_t{20}),
-       "section 'clips'"},
+      {"more clips than the section holds", patched(bytes, 40, uint32_t{20}), "section 'clips'"},
       {"section past the end", patched(bytes, table + 16 * 14, uint64_t{1} << 40),
        "section 'tag_names': offset 1099511627776"},
-      {"misaligned section", patched(bytes, table + 16 * 4, section_offset(bytes, DatabaseSection::LocalPositions) + 4),
+      {"misaligned section",
+       patched(bytes, table + 16 * 4, section_offset(bytes, DatabaseSection::LocalPositions) + 4),
        "section 'local_positions': offset"},
       {"huge string length", patched(bytes, names, uint32_t{0x7FFFFFFF}),
        "section 'skeleton_names': string 0 claims 2147483647 bytes"},
@@ -518,7 +523,11 @@ TEST(DatabaseValidate, CatchesEachInconsistency) {
       {"clip gap", [](Database& d) { d.clips[1].start = 13; }, "starts at frame 13, expected 12"},
       {"clips short", [](Database& d) { d.clips[1].end = 19; }, "the clips end at frame 19"},
       {"clip past end", [](Database& d) { d.clips[1].end = 21; }, "range [12, 21)"},
-      {"empty clip", [](Database& d) { d.clips[0].end = 0; d.clips[1].start = 0; },
+      {"empty clip",
+       [](Database& d) {
+         d.clips[0].end = 0;
+         d.clips[1].start = 0;
+       },
        "range [0, 0)"},
       {"tag bit", [](Database& d) { d.clips[0].tags = uint64_t{1} << 63; }, "tag bit 63"},
       {"too many tags", [](Database& d) { d.tag_names.resize(65, "x"); }, "65 tag names"},
@@ -542,7 +551,8 @@ TEST(DatabaseValidate, CatchesEachInconsistency) {
       {"offset", [](Database& d) { d.feature_offset[6] = nan; }, "feature_offset[6]"},
       {"scale inf", [](Database& d) { d.feature_scale[0] = INFINITY; }, "feature_scale[0] is inf"},
       {"searchable", [](Database& d) { d.searchable[19] = 2; }, "searchable[19] is 2"},
-      {"rest", [](Database& d) {
+      {"rest",
+       [](Database& d) {
          std::vector<Transform> rest = d.skeleton.rest();
          rest[2].translation.x = nan;
          d.skeleton = Skeleton::create(d.skeleton.names(), d.skeleton.parents(), rest).value();
@@ -601,7 +611,8 @@ TEST(DatabaseChecksum, DetectsEverySingleWordChangeAndDependsOnLength) {
   }
   // Every prefix length hashes differently from its neighbour (the tail and length handling).
   for (size_t n = 1; n <= data.size(); ++n) {
-    ASSERT_NE(database_checksum(std::span(data).first(n)), database_checksum(std::span(data).first(n - 1)))
+    ASSERT_NE(database_checksum(std::span(data).first(n)),
+              database_checksum(std::span(data).first(n - 1)))
         << n;
   }
   // Zero bytes appended change the hash (the length is mixed in).

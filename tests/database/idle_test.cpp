@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/runtime/pose.hpp"
-#include "database_helpers.hpp"
 #include "test_support.hpp"
 
 namespace mm {

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/preprocess.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"

@@ -39,7 +39,8 @@ const Database& subset_database() {
     if (files) {
       for (size_t i = 0; i < files->size(); i += 9) chosen.push_back((*files)[i]);
     }
-    for (const char* duplicate : {"dataset-2_walk-turn-left_normal_027", "dataset-2_walk-turn-left_normal_031"}) {
+    for (const char* duplicate :
+         {"dataset-2_walk-turn-left_normal_027", "dataset-2_walk-turn-left_normal_031"}) {
       const fs::path path = test::clip_path(duplicate);
       if (std::find(chosen.begin(), chosen.end(), path) == chosen.end()) chosen.push_back(path);
     }
@@ -97,7 +98,8 @@ std::vector<Query> real_queries(const Database& db, int count, uint64_t seed) {
     k /= 4;
     q.constraints.exclude_tags = excludes[k % 3];
     if (playing == 1) q.constraints.current_frame = one.source_frames[0];
-    if (playing == 2) q.constraints.current_frame = static_cast<int>(rng() % static_cast<uint32_t>(db.frame_count));
+    if (playing == 2)
+      q.constraints.current_frame = static_cast<int>(rng() % static_cast<uint32_t>(db.frame_count));
     queries.push_back(std::move(q));
   }
   return queries;
@@ -119,7 +121,8 @@ struct MethodCase {
     SearchOptions o;
     o.principal_axes = principal_axes;
     o.tag_class_indices = tag_class_indices;
-    if (group_rows >= 0) o.kdtree_group_rows = o.boxtree_group_rows = o.approx_group_rows = group_rows;
+    if (group_rows >= 0)
+      o.kdtree_group_rows = o.boxtree_group_rows = o.approx_group_rows = group_rows;
     return o;
   }
 };
@@ -136,12 +139,12 @@ std::string case_name(const ::testing::TestParamInfo<MethodCase>& info) {
 const MethodCase kExactCases[] = {
     {"brute-simd"},
     {"aabb"},
-    {"kdtree"},                          // one FLANN tree in principal axes, tag-class indices
-    {"kdtree", false, -1, false},        // one FLANN tree over the raw columns, filter only
-    {"kdtree", true, 1024},              // a FLANN tree per k-means group
-    {"boxtree"},                         // k-means groups, each in its own axes
-    {"boxtree", false},                  // groups over the raw columns
-    {"boxtree", true, 0},                // a single tree
+    {"kdtree"},                    // one FLANN tree in principal axes, tag-class indices
+    {"kdtree", false, -1, false},  // one FLANN tree over the raw columns, filter only
+    {"kdtree", true, 1024},        // a FLANN tree per k-means group
+    {"boxtree"},                   // k-means groups, each in its own axes
+    {"boxtree", false},            // groups over the raw columns
+    {"boxtree", true, 0},          // a single tree
 };
 
 class RealExactness : public ::testing::TestWithParam<MethodCase> {};

@@ -8,9 +8,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <new>
 #include <limits>
 #include <memory>
+#include <new>
 #include <random>
 #include <string>
 #include <utility>
@@ -63,16 +63,36 @@ void* counted_aligned(std::size_t size, std::align_val_t align) {
   if (void* p = counted_aligned(size, align)) return p;
   throw std::bad_alloc();
 }
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
-[[gnu::noinline]] void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete[](void* p, const std::nothrow_t&) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete[](void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+[[gnu::noinline]] void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
 
 namespace mm {
 namespace {
@@ -100,9 +120,8 @@ struct TinyDatabase {
   std::vector<float> features{0, 1, 2, 3, 4, 5, 10, 11, 12, 13, 14, 15, 2.5f, 2.5f, 2.5f};
   std::vector<uint8_t> searchable{1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1};
   std::vector<int> frame_clip{0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 2};
-  std::vector<ClipRange> clips{{"walk", 0, 6, 0b001, false},
-                               {"run", 6, 12, 0b010, false},
-                               {"idle", 12, 15, 0b101, false}};
+  std::vector<ClipRange> clips{
+      {"walk", 0, 6, 0b001, false}, {"run", 6, 12, 0b010, false}, {"idle", 12, 15, 0b101, false}};
 
   SearchInput input() const {
     SearchInput view;
@@ -388,7 +407,8 @@ void check_scan(search_kernels::ScanBlocksFn scan) {
       float expected = bound;
       for (int r = 0; r < rows; ++r) {
         if (!filter.passes(r)) continue;
-        const float d = search_kernels::squared_distance(q.data(), &data[static_cast<size_t>(r) * dims], dims);
+        const float d =
+            search_kernels::squared_distance(q.data(), &data[static_cast<size_t>(r) * dims], dims);
         if (d < expected) {
           expected = d;
           expected_row = r;
@@ -400,7 +420,8 @@ void check_scan(search_kernels::ScanBlocksFn scan) {
       ASSERT_EQ(best.row >= 0, expected_row >= 0) << "dims " << dims << " trial " << trial;
       if (expected_row >= 0) {
         EXPECT_TRUE(same_cost(best.distance, expected)) << best.distance << " vs " << expected;
-        const float d = search_kernels::squared_distance(q.data(), &data[static_cast<size_t>(best.row) * dims], dims);
+        const float d = search_kernels::squared_distance(
+            q.data(), &data[static_cast<size_t>(best.row) * dims], dims);
         EXPECT_TRUE(same_cost(d, expected));
         EXPECT_TRUE(filter.passes(best.row));
       }
@@ -408,7 +429,9 @@ void check_scan(search_kernels::ScanBlocksFn scan) {
   }
 }
 
-TEST(SearchKernels, PortableScanMatchesScalarLoop) { check_scan(&search_kernels::scan_blocks_portable); }
+TEST(SearchKernels, PortableScanMatchesScalarLoop) {
+  check_scan(&search_kernels::scan_blocks_portable);
+}
 
 TEST(SearchKernels, Avx2ScanMatchesScalarLoop) {
   // This machine and the CI machine support AVX2; the check keeps the test honest elsewhere.
@@ -447,12 +470,14 @@ void check_row_distance(search_kernels::RowDistanceFn distance,
       for (int d = 0; d < dims; ++d) {
         a[static_cast<size_t>(d)] = value(rng);
         b[static_cast<size_t>(d)] = value(rng);
-        const double diff = static_cast<double>(a[static_cast<size_t>(d)]) - b[static_cast<size_t>(d)];
+        const double diff =
+            static_cast<double>(a[static_cast<size_t>(d)]) - b[static_cast<size_t>(d)];
         exact += diff * diff;
       }
       const float full = distance(a.get(), b.get(), dims);
       EXPECT_NEAR(full, exact, 1e-5 * exact + 1e-30) << "dims " << dims;
-      EXPECT_NEAR(full, search_kernels::squared_distance(a.get(), b.get(), dims), 1e-5 * exact + 1e-30);
+      EXPECT_NEAR(full, search_kernels::squared_distance(a.get(), b.get(), dims),
+                  1e-5 * exact + 1e-30);
       for (const float fraction : {0.0f, 0.1f, 0.5f, 0.999f, 1.0f, 2.0f}) {
         const float bound = full * fraction;
         const float got = bounded(a.get(), b.get(), dims, bound);
@@ -481,12 +506,14 @@ TEST(SearchKernels, PortableRowDistanceMatchesColumnSum) {
 TEST(SearchKernels, Avx2RowDistanceMatchesColumnSum) {
   if (!search_kernels::avx2_supported()) {
     EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_portable);
-    EXPECT_EQ(search_kernels::row_distance_bounded(), &search_kernels::row_distance_bounded_portable);
+    EXPECT_EQ(search_kernels::row_distance_bounded(),
+              &search_kernels::row_distance_bounded_portable);
     return;
   }
   EXPECT_EQ(search_kernels::row_distance(), &search_kernels::row_distance_avx2);
   EXPECT_EQ(search_kernels::row_distance_bounded(), &search_kernels::row_distance_bounded_avx2);
-  check_row_distance(&search_kernels::row_distance_avx2, &search_kernels::row_distance_bounded_avx2);
+  check_row_distance(&search_kernels::row_distance_avx2,
+                     &search_kernels::row_distance_bounded_avx2);
 }
 
 // --- every method against brute on synthetic data --------------------------------------------
@@ -530,7 +557,8 @@ std::vector<Query> constrained_queries(const SyntheticSearchData& data, int per_
                 q.features.push_back(data.features[static_cast<size_t>(source) * data.dims + d] +
                                      noise * gauss(rng));
               }
-              q.constraints.current_frame = playing ? (i % 2 ? source : frames[rng() % frames.size()]) : -1;
+              q.constraints.current_frame =
+                  playing ? (i % 2 ? source : frames[rng() % frames.size()]) : -1;
               q.constraints.window_frames = window;
               q.constraints.transition_cost = cost;
               q.constraints.include_tags = include;
@@ -546,7 +574,8 @@ std::vector<Query> constrained_queries(const SyntheticSearchData& data, int per_
 }
 
 // The queries as one batch: their features back to back, and one constraint each.
-std::pair<std::vector<float>, std::vector<SearchConstraints>> as_batch(const std::vector<Query>& queries) {
+std::pair<std::vector<float>, std::vector<SearchConstraints>> as_batch(
+    const std::vector<Query>& queries) {
   std::pair<std::vector<float>, std::vector<SearchConstraints>> batch;
   for (const Query& q : queries) {
     batch.first.insert(batch.first.end(), q.features.begin(), q.features.end());

@@ -20,7 +20,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
@@ -263,10 +263,10 @@ TEST(BvhParse, PositionAndRotationChannelsInAnyOrder) {
 TEST(BvhParse, ThreeChannelJointsPositionOnlyPartialAndNoChannels) {
   const std::string text =
       "HIERARCHY\n"
-      "ROOT R\n{\nOFFSET 1 2 3\nCHANNELS 3 Xposition Yposition Zposition\n"     // position only
-      "JOINT P\n{\nOFFSET 4 5 6\nCHANNELS 1 Yposition\n"                        // one position
-      "JOINT N\n{\nOFFSET 7 8 9\nCHANNELS 0\n"                                  // no channels
-      "JOINT Q\n{\nOFFSET 0 1 0\nCHANNELS 3 Yrotation Xrotation Zrotation\n"    // rotation only
+      "ROOT R\n{\nOFFSET 1 2 3\nCHANNELS 3 Xposition Yposition Zposition\n"   // position only
+      "JOINT P\n{\nOFFSET 4 5 6\nCHANNELS 1 Yposition\n"                      // one position
+      "JOINT N\n{\nOFFSET 7 8 9\nCHANNELS 0\n"                                // no channels
+      "JOINT Q\n{\nOFFSET 0 1 0\nCHANNELS 3 Yrotation Xrotation Zrotation\n"  // rotation only
       "End Site\n{\nOFFSET 0 1 0\n}\n}\n}\n}\n}\n"
       "MOTION\nFrames: 1\nFrame Time: 0.1\n10 20 30 50 5 15 25\n";
   Result<Clip> clip = parse_bvh(text, "channels.bvh", BvhOptions{1.0f});
@@ -295,11 +295,11 @@ TEST(BvhParse, CrlfTabsSpacesAndBlankLinesGiveTheSameClip) {
   }
   spaced.insert(spaced.begin() + 19, "");  // a blank line between the two frames
   const std::vector<std::string> variants = {
-      crlf,                                                // CRLF
-      join(spaced),                                        // mixed spaces and tabs
-      join(spaced, "\r\n"),                                // both
-      plain.substr(0, plain.size() - 1),                   // no newline at the end
-      crlf.substr(0, crlf.size() - 2),                     // CRLF, no final CRLF
+      crlf,                               // CRLF
+      join(spaced),                       // mixed spaces and tabs
+      join(spaced, "\r\n"),               // both
+      plain.substr(0, plain.size() - 1),  // no newline at the end
+      crlf.substr(0, crlf.size() - 2),    // CRLF, no final CRLF
   };
   Result<Clip> reference = parse_bvh(plain, kFixturePath);
   ASSERT_TRUE(reference.ok()) << reference.message();
@@ -336,17 +336,14 @@ TEST(BvhParse, EndSitesAreDroppedAndNamesKept) {
 // must never round differently). With scale 1 a position channel stores the value itself.
 TEST(BvhParse, NumbersDecodeExactlyLikeFromChars) {
   std::mt19937 rng(12345);
-  std::vector<std::string> tokens = {"0",         "-0",          "-0.000000",   ".5",
-                                     "5.",        "1e-3",        "-2.5E+2",     "3.4e38",
-                                     "123456789", "0.1",         "16777217",    "9007199254740993",
-                                     "1.00000005960464477539062", "0.333333333333333333333",
-                                     "12345678901234567890123456789", "-543.347000",
-                                     // Within a double ulp of a float midpoint: rounding to
-                                     // double first and then to float gets these wrong.
-                                     "72.35174942016602", "0.01362472167238593",
-                                     "67.36651229858398", "62.52469825744629",
-                                     "70.62986373901367", "0.6426003873348236",
-                                     "0.07552148029208183", "0.5115454494953156"};
+  std::vector<std::string> tokens = {
+      "0", "-0", "-0.000000", ".5", "5.", "1e-3", "-2.5E+2", "3.4e38", "123456789", "0.1",
+      "16777217", "9007199254740993", "1.00000005960464477539062", "0.333333333333333333333",
+      "12345678901234567890123456789", "-543.347000",
+      // Within a double ulp of a float midpoint: rounding to
+      // double first and then to float gets these wrong.
+      "72.35174942016602", "0.01362472167238593", "67.36651229858398", "62.52469825744629",
+      "70.62986373901367", "0.6426003873348236", "0.07552148029208183", "0.5115454494953156"};
   for (int i = 0; i < 3000; ++i) {
     const int int_digits = static_cast<int>(rng() % 9);
     const int fraction_digits = static_cast<int>(rng() % 12);
@@ -370,10 +367,10 @@ TEST(BvhParse, NumbersDecodeExactlyLikeFromChars) {
   for (size_t i = 0; i < tokens.size(); ++i) {
     float expected = 0.0f;
     const std::string& token = tokens[i];
-    ASSERT_EQ(std::from_chars(token.data(), token.data() + token.size(), expected).ec,
-              std::errc())
+    ASSERT_EQ(std::from_chars(token.data(), token.data() + token.size(), expected).ec, std::errc())
         << token;
-    const float actual = clip->pose(static_cast<int>(i / 3))[0].translation[static_cast<int>(i % 3)];
+    const float actual =
+        clip->pose(static_cast<int>(i / 3))[0].translation[static_cast<int>(i % 3)];
     EXPECT_EQ(std::bit_cast<uint32_t>(actual), std::bit_cast<uint32_t>(expected))
         << token << ": " << actual << " vs " << expected;
   }
@@ -392,7 +389,9 @@ TEST(BvhParse, TinyValuesUnderflowToZeroAndLeadingPlusIsAccepted) {
 // ---------------------------------------------------------------------------------------------
 // Malformed input: each refused with the file, the line and what was expected.
 
-TEST(BvhMalformed, EmptyFile) { expect_refused("", 1, {"expected 'HIERARCHY'", "end of file"}); }
+TEST(BvhMalformed, EmptyFile) {
+  expect_refused("", 1, {"expected 'HIERARCHY'", "end of file"});
+}
 
 TEST(BvhMalformed, TruncatedInTheHierarchy) {
   // Cut after line 9: the file ends on line 10 while joint Spine is open.
@@ -428,8 +427,9 @@ TEST(BvhMalformed, TruncatedRealFilesInHierarchyAndMotion) {
   ASSERT_NE(motion, std::string::npos);
   // Cuts: mid-hierarchy (several places), mid-motion-line, and just after a motion line.
   size_t after_third_frame = text.find("Frame Time");
-  for (int newline = 0; newline < 4; ++newline) after_third_frame = text.find('\n', after_third_frame) + 1;
-  const std::vector<size_t> cuts = {motion / 3, motion / 2 + 7, motion - 5, motion + 3,
+  for (int newline = 0; newline < 4; ++newline)
+    after_third_frame = text.find('\n', after_third_frame) + 1;
+  const std::vector<size_t> cuts = {motion / 3,      motion / 2 + 7,   motion - 5,       motion + 3,
                                     text.size() / 2, text.size() - 10, after_third_frame};
   for (size_t cut : cuts) {
     SCOPED_TRACE("cut at byte " + std::to_string(cut));
@@ -438,7 +438,8 @@ TEST(BvhMalformed, TruncatedRealFilesInHierarchyAndMotion) {
     write_file(path, truncated);
     Result<Clip> clip = load_bvh(path);
     ASSERT_FALSE(clip.ok());
-    const std::string where = path.string() + ":" + std::to_string(last_line_number(truncated)) + ":";
+    const std::string where =
+        path.string() + ":" + std::to_string(last_line_number(truncated)) + ":";
     EXPECT_NE(clip.message().find(where), std::string::npos)
         << "wanted " << where << " in: " << clip.message();
     EXPECT_NE(clip.message().find("expected"), std::string::npos) << clip.message();
@@ -497,7 +498,8 @@ TEST(BvhMalformed, NonFiniteOffset) {
 
 TEST(BvhMalformed, NonFiniteOrZeroFrameTime) {
   expect_refused(fixture_with_line(18, "Frame Time: nan"), 18, {"expected a positive frame time"});
-  expect_refused(fixture_with_line(18, "Frame Time: 1e999"), 18, {"expected a positive frame time"});
+  expect_refused(fixture_with_line(18, "Frame Time: 1e999"), 18,
+                 {"expected a positive frame time"});
 }
 
 TEST(BvhMalformed, UnknownChannelName) {
@@ -577,7 +579,8 @@ TEST(BvhMalformed, NegativeFrameTime) {
 }
 
 TEST(BvhMalformed, ZeroFrameCount) {
-  expect_refused(fixture_with_line(17, "Frames: 0"), 17, {"expected a positive frame count", "'0'"});
+  expect_refused(fixture_with_line(17, "Frames: 0"), 17,
+                 {"expected a positive frame count", "'0'"});
 }
 
 TEST(BvhMalformed, NegativeFrameCount) {
@@ -688,10 +691,13 @@ TEST(BvhStress, ManyJointsWithoutChannelsCannotExpandASmallFile) {
   const int motion_line = last_line_number(text);
   text += "MOTION\nFrames: 5000\nFrame Time: 0.1\n";
   for (int i = 0; i < 5000; ++i) text += "1\n";
-  expect_refused(text, motion_line, {"expected at most 16 joint transforms per byte",
-                                     "2001 joints", "without channels"}, "wide.bvh");
+  expect_refused(
+      text, motion_line,
+      {"expected at most 16 joint transforms per byte", "2001 joints", "without channels"},
+      "wide.bvh");
   // The same skeleton with a few frames is a legitimate file.
-  const std::string few = text.substr(0, text.find("Frames:")) + "Frames: 3\nFrame Time: 0.1\n1\n2\n3\n";
+  const std::string few =
+      text.substr(0, text.find("Frames:")) + "Frames: 3\nFrame Time: 0.1\n1\n2\n3\n";
   Result<Clip> clip = parse_bvh(few, "wide.bvh");
   ASSERT_TRUE(clip.ok()) << clip.message();
   EXPECT_EQ(clip->joint_count(), 2001);

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "base64.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "test_support.hpp"
 
 namespace mm {

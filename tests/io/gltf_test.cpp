@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "base64.hpp"
-#include "mm/database/bvh.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/bvh.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 

@@ -36,8 +36,8 @@ struct MeshBuilder {
 
   Ring add_ring(const glm::vec3& center, const glm::vec3& axis, glm::vec3 start, float radius) {
     start -= glm::dot(start, axis) * axis;  // into the ring's plane
-    if (glm::length(start) < 1e-3f) start = std::abs(axis.x) < 0.9f ? glm::vec3(1, 0, 0)
-                                                                     : glm::vec3(0, 1, 0);
+    if (glm::length(start) < 1e-3f)
+      start = std::abs(axis.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
     start = glm::normalize(start - glm::dot(start, axis) * axis);
     const glm::vec3 side = glm::cross(axis, start);
     Ring ring{{}, center, start};
@@ -51,7 +51,9 @@ struct MeshBuilder {
     return ring;
   }
 
-  void triangle(uint32_t a, uint32_t b, uint32_t c) { mesh.indices.insert(mesh.indices.end(), {a, b, c}); }
+  void triangle(uint32_t a, uint32_t b, uint32_t c) {
+    mesh.indices.insert(mesh.indices.end(), {a, b, c});
+  }
 
   void connect(const Ring& a, const Ring& b) {
     const size_t n = a.vertices.size();
@@ -77,8 +79,8 @@ struct MeshBuilder {
     const glm::vec3 axis = glm::normalize(bone.tail - bone.head);
     const float length = glm::distance(bone.head, bone.tail);
     const int steps = std::max(1, static_cast<int>(std::round(length / spacing)));
-    const Ring first = start ? *start
-                             : add_ring(bone.head, axis, glm::vec3(1, 0, 0), bone.head_radius);
+    const Ring first =
+        start ? *start : add_ring(bone.head, axis, glm::vec3(1, 0, 0), bone.head_radius);
     Ring previous = first;
     for (int i = 1; i <= steps; ++i) {
       const float t = static_cast<float>(i) / static_cast<float>(steps);
@@ -103,8 +105,12 @@ struct Model {
 
 // Where a bone's tube starts: a new ring capped at its head, or a ring of an earlier bone.
 constexpr int kNewRing = -1;
-constexpr int head_ring(int bone) { return 2 * bone; }
-constexpr int tail_ring(int bone) { return 2 * bone + 1; }
+constexpr int head_ring(int bone) {
+  return 2 * bone;
+}
+constexpr int tail_ring(int bone) {
+  return 2 * bone + 1;
+}
 
 // Bone b's tube starts at ring start[b]; rings no other tube starts from are capped a radius
 // beyond the segment, on the capsule's surface.
@@ -126,7 +132,8 @@ Model build_model(std::vector<BoneSegment> bones, const std::vector<int>& start,
   for (size_t b = 0; b < bones.size(); ++b) {
     const BoneSegment& s = bones[b];
     const glm::vec3 axis = glm::normalize(s.tail - s.head);
-    if (start[b] == kNewRing && !shared[2 * b]) builder.cap(rings[2 * b], s.head - s.head_radius * axis);
+    if (start[b] == kNewRing && !shared[2 * b])
+      builder.cap(rings[2 * b], s.head - s.head_radius * axis);
     if (!shared[2 * b + 1]) builder.cap(rings[2 * b + 1], s.tail + s.tail_radius * axis);
   }
   return {builder.mesh, std::move(bones)};
@@ -136,7 +143,8 @@ Model build_model(std::vector<BoneSegment> bones, const std::vector<int>& start,
 Model chain_model(int around = 16, float spacing = 0.02f) {
   const glm::vec3 hip(0.0f, 1.0f, 0.0f), knee(0.0f, 0.55f, 0.04f), ankle(0.0f, 0.1f, -0.03f),
       toe(0.0f, 0.05f, 0.18f);
-  return build_model({{hip, knee, 0.07f, 0.05f, 2}, {knee, ankle, 0.05f, 0.04f, 5},
+  return build_model({{hip, knee, 0.07f, 0.05f, 2},
+                      {knee, ankle, 0.05f, 0.04f, 5},
                       {ankle, toe, 0.04f, 0.035f, 9}},
                      {kNewRing, tail_ring(0), tail_ring(1)}, around, spacing);
 }
@@ -166,8 +174,8 @@ Model components_model() {
   const Model arm = build_model({bone({0.4f, 1.0f, 0.0f}, {0.4f, 1.3f, 0.0f}, 0.04f, 11),
                                  bone({0.4f, 1.3f, 0.0f}, {0.4f, 1.55f, 0.0f}, 0.035f, 12)},
                                 {kNewRing, tail_ring(0)}, 12, 0.02f);
-  const Model stray = build_model({bone({1.5f, 2.0f, 1.0f}, {1.6f, 2.0f, 1.0f}, 0.03f, 99)},
-                                  {kNewRing}, 8, 0.02f);
+  const Model stray =
+      build_model({bone({1.5f, 2.0f, 1.0f}, {1.6f, 2.0f, 1.0f}, 0.03f, 99)}, {kNewRing}, 8, 0.02f);
   for (const Model* part : {&arm, &stray}) {
     const uint32_t base = static_cast<uint32_t>(model.mesh.positions.size());
     model.mesh.positions.insert(model.mesh.positions.end(), part->mesh.positions.begin(),
@@ -188,18 +196,18 @@ Model components_model() {
 Model body_model() {
   auto v = [](float x, float y, float z) { return glm::vec3(x, y, z); };
   std::vector<BoneSegment> bones = {
-      bone(v(0, 1.0f, 0), v(0, 1.15f, 0), 0.13f, 0),             // 0 hips -> spine
-      bone(v(0, 1.15f, 0), v(0, 1.3f, 0), 0.14f, 1),            // 1 spine
-      {v(0, 1.3f, 0), v(0, 1.45f, 0), 0.15f, 0.07f, 2},         // 2 chest
-      bone(v(0, 1.45f, 0), v(0, 1.65f, 0), 0.05f, 3),           // 3 neck
-      bone(v(0, 1.65f, 0), v(0, 1.85f, 0), 0.09f, 4),             // 4 head
-      bone(v(0, 1.0f, 0), v(0.1f, 0.95f, 0), 0.1f, 0),          // 5 hips -> left hip
-      bone(v(0, 1.0f, 0), v(-0.1f, 0.95f, 0), 0.1f, 0),         // 6 hips -> right hip
-      bone(v(0.1f, 0.95f, 0), v(0.1f, 0.52f, 0), 0.07f, 5),     // 7 left thigh
-      bone(v(0.1f, 0.52f, 0), v(0.1f, 0.1f, 0), 0.05f, 6),      // 8 left shin
-      bone(v(0.1f, 0.1f, 0), v(0.1f, 0.03f, 0.15f), 0.04f, 7),  // 9 left foot
-      bone(v(-0.1f, 0.95f, 0), v(-0.1f, 0.52f, 0), 0.07f, 8),   // 10 right thigh
-      bone(v(-0.1f, 0.52f, 0), v(-0.1f, 0.1f, 0), 0.05f, 9),    // 11 right shin
+      bone(v(0, 1.0f, 0), v(0, 1.15f, 0), 0.13f, 0),               // 0 hips -> spine
+      bone(v(0, 1.15f, 0), v(0, 1.3f, 0), 0.14f, 1),               // 1 spine
+      {v(0, 1.3f, 0), v(0, 1.45f, 0), 0.15f, 0.07f, 2},            // 2 chest
+      bone(v(0, 1.45f, 0), v(0, 1.65f, 0), 0.05f, 3),              // 3 neck
+      bone(v(0, 1.65f, 0), v(0, 1.85f, 0), 0.09f, 4),              // 4 head
+      bone(v(0, 1.0f, 0), v(0.1f, 0.95f, 0), 0.1f, 0),             // 5 hips -> left hip
+      bone(v(0, 1.0f, 0), v(-0.1f, 0.95f, 0), 0.1f, 0),            // 6 hips -> right hip
+      bone(v(0.1f, 0.95f, 0), v(0.1f, 0.52f, 0), 0.07f, 5),        // 7 left thigh
+      bone(v(0.1f, 0.52f, 0), v(0.1f, 0.1f, 0), 0.05f, 6),         // 8 left shin
+      bone(v(0.1f, 0.1f, 0), v(0.1f, 0.03f, 0.15f), 0.04f, 7),     // 9 left foot
+      bone(v(-0.1f, 0.95f, 0), v(-0.1f, 0.52f, 0), 0.07f, 8),      // 10 right thigh
+      bone(v(-0.1f, 0.52f, 0), v(-0.1f, 0.1f, 0), 0.05f, 9),       // 11 right shin
       bone(v(-0.1f, 0.1f, 0), v(-0.1f, 0.03f, 0.15f), 0.04f, 10),  // 12 right foot
       bone(v(0.05f, 1.42f, 0), v(0.18f, 1.42f, 0), 0.05f, 11),     // 13 left clavicle
       bone(v(0.18f, 1.42f, 0), v(0.46f, 1.42f, 0), 0.05f, 12),     // 14 left upper arm
@@ -277,8 +285,8 @@ size_t nearest_vertex(const TriangleMesh& mesh, const glm::vec3& point) {
 ::testing::AssertionResult obeys_rules(const Model& model,
                                        const std::vector<VertexInfluences>& influences) {
   if (influences.size() != model.mesh.vertex_count()) {
-    return ::testing::AssertionFailure() << influences.size() << " influences for "
-                                         << model.mesh.vertex_count() << " vertices";
+    return ::testing::AssertionFailure()
+           << influences.size() << " influences for " << model.mesh.vertex_count() << " vertices";
   }
   for (size_t v = 0; v < influences.size(); ++v) {
     const VertexInfluences& inf = influences[v];
@@ -288,13 +296,15 @@ size_t nearest_vertex(const TriangleMesh& mesh, const glm::vec3& point) {
       if (!(w >= 0.0f)) return ::testing::AssertionFailure() << "vertex " << v << " weight " << w;
       sum += w;
       if (w == 0.0f) continue;
-      const bool known = std::any_of(model.bones.begin(), model.bones.end(),
-                                     [&](const BoneSegment& b) { return b.joint == inf.joints[k]; });
-      if (!known) return ::testing::AssertionFailure() << "vertex " << v << " joint " << inf.joints[k];
+      const bool known =
+          std::any_of(model.bones.begin(), model.bones.end(),
+                      [&](const BoneSegment& b) { return b.joint == inf.joints[k]; });
+      if (!known)
+        return ::testing::AssertionFailure() << "vertex " << v << " joint " << inf.joints[k];
       for (int m = 0; m < k; ++m) {
         if (inf.weights[m] > 0.0f && inf.joints[m] == inf.joints[k]) {
-          return ::testing::AssertionFailure() << "vertex " << v << " has joint "
-                                               << inf.joints[k] << " twice";
+          return ::testing::AssertionFailure()
+                 << "vertex " << v << " has joint " << inf.joints[k] << " twice";
         }
       }
     }
@@ -320,7 +330,8 @@ size_t nearest_vertex(const TriangleMesh& mesh, const glm::vec3& point) {
   return ::testing::AssertionSuccess();
 }
 
-std::vector<VertexInfluences> compute_or_fail(const Model& model, const BoneWeightOptions& options) {
+std::vector<VertexInfluences> compute_or_fail(const Model& model,
+                                              const BoneWeightOptions& options) {
   Result<std::vector<VertexInfluences>> weights =
       compute_bone_weights(model.mesh, model.bones, options);
   EXPECT_TRUE(weights.ok()) << (weights ? "" : weights.message());
@@ -343,10 +354,11 @@ INSTANTIATE_TEST_SUITE_P(BoneWeights, EveryMethod, ::testing::ValuesIn(kAllMetho
 
 // The report's findings, for the log (they are measurements, not rules).
 void print_report(const char* what, const WeightQualityReport& r) {
-  std::printf("%s: largest jump %.3f (joint %d, vertices %zu-%zu), %zu vertices not dominated "
-              "by their nearest bone\n",
-              what, r.max_neighbor_jump, r.jump_joint, r.jump_vertex_a, r.jump_vertex_b,
-              r.not_nearest_vertices.size());
+  std::printf(
+      "%s: largest jump %.3f (joint %d, vertices %zu-%zu), %zu vertices not dominated "
+      "by their nearest bone\n",
+      what, r.max_neighbor_jump, r.jump_joint, r.jump_vertex_a, r.jump_vertex_b,
+      r.not_nearest_vertices.size());
 }
 
 TEST_P(EveryMethod, ChainObeysEveryRule) {
@@ -437,11 +449,12 @@ TEST_P(EveryMethod, EveryComponentIsBoundToItsNearestBone) {
   const std::vector<VertexInfluences> weights = compute_or_fail(model, with_method(GetParam()));
   ASSERT_TRUE(obeys_rules(model, weights));
   // The stray tube (the last vertices, beyond every bone's reach) follows its nearest bone.
-  const size_t stray_first = chain_model().mesh.vertex_count() +
-                             build_model({bone({0.4f, 1.0f, 0.0f}, {0.4f, 1.3f, 0.0f}, 0.04f, 11),
-                                          bone({0.4f, 1.3f, 0.0f}, {0.4f, 1.55f, 0.0f}, 0.035f, 12)},
-                                         {kNewRing, tail_ring(0)}, 12, 0.02f)
-                                 .mesh.vertex_count();
+  const size_t stray_first =
+      chain_model().mesh.vertex_count() +
+      build_model({bone({0.4f, 1.0f, 0.0f}, {0.4f, 1.3f, 0.0f}, 0.04f, 11),
+                   bone({0.4f, 1.3f, 0.0f}, {0.4f, 1.55f, 0.0f}, 0.035f, 12)},
+                  {kNewRing, tail_ring(0)}, 12, 0.02f)
+          .mesh.vertex_count();
   ASSERT_LT(stray_first, weights.size());
   for (size_t v = stray_first; v < weights.size(); ++v) {
     const int nearest = nearest_joint(model.mesh.positions[v], model.bones);
@@ -466,8 +479,8 @@ TEST_P(EveryMethod, SameInputSameWeights) {
 
 // Two parallel fingers 2 cm apart, separate meshes: close in space, far along the surface.
 Model two_fingers() {
-  Model a = build_model({bone({0.0f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}, 0.05f, 0)}, {kNewRing}, 16,
-                        0.02f);
+  Model a =
+      build_model({bone({0.0f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}, 0.05f, 0)}, {kNewRing}, 16, 0.02f);
   const Model b = build_model({bone({0.12f, 0.0f, 0.0f}, {0.12f, 0.3f, 0.0f}, 0.05f, 1)},
                               {kNewRing}, 16, 0.02f);
   const uint32_t base = static_cast<uint32_t>(a.mesh.positions.size());
@@ -503,7 +516,8 @@ TEST_P(EveryMethod, WeightsCrossAGapOnlyThroughSpace) {
 Model star(std::vector<glm::vec3> points, float radius) {
   Model model;
   const glm::vec3 dirs[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  for (int j = 0; j < 6; ++j) model.bones.push_back(bone(0.3f * dirs[j], 0.6f * dirs[j], radius, j));
+  for (int j = 0; j < 6; ++j)
+    model.bones.push_back(bone(0.3f * dirs[j], 0.6f * dirs[j], radius, j));
   model.mesh.positions = std::move(points);
   return model;
 }
@@ -517,16 +531,17 @@ TEST(BoneWeights, DistanceKeepsTheFourNearestJointsByTheDocumentedLaw) {
   for (size_t v = 0; v < weights.size(); ++v) {
     const glm::vec3 p = model.mesh.positions[v];
     std::vector<std::pair<float, int>> by_distance;
-    for (const BoneSegment& b : model.bones) by_distance.emplace_back(surface_distance(p, b), b.joint);
+    for (const BoneSegment& b : model.bones)
+      by_distance.emplace_back(surface_distance(p, b), b.joint);
     std::sort(by_distance.begin(), by_distance.end());
     const float s_min = by_distance[0].first;
     for (int k = 0; k < 4; ++k) {
       ASSERT_EQ(weights[v].joints[k], by_distance[static_cast<size_t>(k)].second) << v << " " << k;
       // w_k / w_0 = (softness / (s_k - s_min + softness))^power
-      const float expected = std::pow(options.distance_softness /
-                                          (by_distance[static_cast<size_t>(k)].first - s_min +
-                                           options.distance_softness),
-                                      options.distance_power);
+      const float expected =
+          std::pow(options.distance_softness / (by_distance[static_cast<size_t>(k)].first - s_min +
+                                                options.distance_softness),
+                   options.distance_power);
       EXPECT_NEAR(weights[v].weights[k] / weights[v].weights[0], expected, 1e-4f) << v << " " << k;
     }
   }
@@ -534,10 +549,11 @@ TEST(BoneWeights, DistanceKeepsTheFourNearestJointsByTheDocumentedLaw) {
 
 TEST(BoneWeights, EnvelopeIsFullInsideSharedInOverlapsAndFallsBackOutside) {
   // Five fat capsules (0.31) whose heads are 0.3 from the origin, and a thin one along +x.
-  Model model = star({{0.55f, 0.01f, 0.0f},  // inside the thin +x capsule, beyond the others' falloff
-                      {0.0f, 0.0f, 0.0f},    // inside the five fat capsules
-                      {2.0f, 0.1f, 0.0f}},   // outside every envelope, nearest the +x bone
-                     0.31f);
+  Model model =
+      star({{0.55f, 0.01f, 0.0f},  // inside the thin +x capsule, beyond the others' falloff
+            {0.0f, 0.0f, 0.0f},    // inside the five fat capsules
+            {2.0f, 0.1f, 0.0f}},   // outside every envelope, nearest the +x bone
+           0.31f);
   model.bones[0].head_radius = model.bones[0].tail_radius = 0.02f;
   const std::vector<VertexInfluences> weights =
       compute_or_fail(model, with_method(WeightMethod::Envelope));
@@ -556,8 +572,8 @@ TEST(BoneWeights, EnvelopeIsFullInsideSharedInOverlapsAndFallsBackOutside) {
 
 TEST(BoneWeights, HeatWithoutEdgesIsTheNearestBone) {
   // No triangles: L is zero, so (L + H) w = H p gives w = p exactly.
-  const Model model = star({{0.02f, 0.05f, -0.04f}, {-0.1f, 0.01f, 0.03f}, {0.0f, 0.7f, 0.1f}},
-                           0.02f);
+  const Model model =
+      star({{0.02f, 0.05f, -0.04f}, {-0.1f, 0.01f, 0.03f}, {0.0f, 0.7f, 0.1f}}, 0.02f);
   const std::vector<VertexInfluences> weights =
       compute_or_fail(model, with_method(WeightMethod::HeatDiffusion));
   ASSERT_TRUE(obeys_rules(model, weights));
@@ -626,10 +642,10 @@ TEST(BoneWeightsCheck, CleanWeightsPassEveryRule) {
 TEST(BoneWeightsCheck, FindsBrokenVertices) {
   const Model model = chain_model();
   std::vector<VertexInfluences> w = compute_or_fail(model, with_method(WeightMethod::Distance));
-  w[5] = {{2, 5, 0, 0}, {1.2f, -0.2f, 0.0f, 0.0f}};  // sums to 1, one negative
-  w[7].weights *= 0.9f;                              // sums to 0.9
-  w[9] = {{2, 0, 0, 0}, {0.0f, 0.0f, 0.0f, 0.0f}};   // no weight (and sums to 0)
-  w[11] = {{42, 0, 0, 0}, {1.0f, 0.0f, 0.0f, 0.0f}}; // a joint no bone has
+  w[5] = {{2, 5, 0, 0}, {1.2f, -0.2f, 0.0f, 0.0f}};   // sums to 1, one negative
+  w[7].weights *= 0.9f;                               // sums to 0.9
+  w[9] = {{2, 0, 0, 0}, {0.0f, 0.0f, 0.0f, 0.0f}};    // no weight (and sums to 0)
+  w[11] = {{42, 0, 0, 0}, {1.0f, 0.0f, 0.0f, 0.0f}};  // a joint no bone has
   w[13] = {{2, 5, 0, 0}, {std::numeric_limits<float>::quiet_NaN(), 1.0f, 0.0f, 0.0f}};
   const WeightQualityReport report = check_or_fail(model, w);
   EXPECT_FALSE(report.rules_hold());
@@ -699,20 +715,23 @@ TEST(BoneWeightsInput, BadMeshesAreRefused) {
   TriangleMesh mesh = good.mesh;
   mesh.indices.pop_back();
   e = compute_error(mesh, good.bones);
-  EXPECT_TRUE(contains(e, std::to_string(mesh.indices.size()) +
-                              " triangle indices, not a multiple of 3")) << e;
+  EXPECT_TRUE(
+      contains(e, std::to_string(mesh.indices.size()) + " triangle indices, not a multiple of 3"))
+      << e;
 
   mesh = good.mesh;
   mesh.indices[7] = static_cast<uint32_t>(n);
   e = compute_error(mesh, good.bones);
   EXPECT_TRUE(contains(e, "triangle 2 has vertex index " + std::to_string(n) +
-                              ", out of range for " + std::to_string(n) + " vertices")) << e;
+                              ", out of range for " + std::to_string(n) + " vertices"))
+      << e;
 
   mesh = good.mesh;
   mesh.normals.pop_back();
   e = compute_error(mesh, good.bones);
   EXPECT_TRUE(contains(e, std::to_string(n - 1) + " normals for " + std::to_string(n) +
-                              " vertices (normals must be empty or one per vertex)")) << e;
+                              " vertices (normals must be empty or one per vertex)"))
+      << e;
 
   mesh = good.mesh;
   mesh.normals.clear();  // allowed
@@ -781,10 +800,10 @@ TEST(BoneWeightsInput, CheckRefusesBadInput) {
   const std::vector<VertexInfluences> short_list(good.mesh.vertex_count() - 1);
   Result<WeightQualityReport> report = check_bone_weights(good.mesh, good.bones, short_list);
   ASSERT_FALSE(report.ok());
-  EXPECT_TRUE(contains(report.message(),
-                       std::to_string(short_list.size()) + " influences for " +
-                           std::to_string(good.mesh.vertex_count()) +
-                           " vertices (one per vertex needed)")) << report.message();
+  EXPECT_TRUE(contains(report.message(), std::to_string(short_list.size()) + " influences for " +
+                                             std::to_string(good.mesh.vertex_count()) +
+                                             " vertices (one per vertex needed)"))
+      << report.message();
   const std::vector<VertexInfluences> none;
   report = check_bone_weights(TriangleMesh{}, good.bones, none);
   ASSERT_FALSE(report.ok());

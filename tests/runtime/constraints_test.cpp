@@ -69,8 +69,7 @@ TEST(DistanceConstraint, SkipsZeroTotalWeightCoincidentEndsAndNonFinite) {
       {{0, 0, 0}, {2, 0, 0}, 1.0f, 0.0f, 0.0f},    // both pinned
       {{0, 0, 0}, {2, 0, 0}, 1.0f, -1.0f, -2.0f},  // both "negative" = pinned
       {{1, 2, 3}, {1, 2, 3}, 1.0f, 1.0f, 1.0f},    // coincident: no direction
-      {{0, 0, 0}, {2, 0, 0}, nan, 1.0f, 1.0f},
-      {{0, 0, 0}, {2, 0, 0}, 1.0f, nan, 1.0f},
+      {{0, 0, 0}, {2, 0, 0}, nan, 1.0f, 1.0f},    {{0, 0, 0}, {2, 0, 0}, 1.0f, nan, 1.0f},
   };
   for (const Case& c : cases) {
     glm::vec3 a = c.a, b = c.b;
@@ -80,8 +79,8 @@ TEST(DistanceConstraint, SkipsZeroTotalWeightCoincidentEndsAndNonFinite) {
   }
   // The same through the solver, next to a constraint that does apply.
   std::vector<glm::vec3> points{{0, 0, 0}, {0, 0, 0}, {3, 0, 0}};
-  const std::array<DistanceConstraint, 2> constraints{
-      DistanceConstraint{0, 1, 1.0f, 1.0f, 1.0f}, DistanceConstraint{1, 2, 1.0f, 0.0f, 0.0f}};
+  const std::array<DistanceConstraint, 2> constraints{DistanceConstraint{0, 1, 1.0f, 1.0f, 1.0f},
+                                                      DistanceConstraint{1, 2, 1.0f, 0.0f, 0.0f}};
   relax_distance_constraints(points, constraints, 10);
   EXPECT_EQ(points[0], glm::vec3(0.0f));
   EXPECT_EQ(points[1], glm::vec3(0.0f));
@@ -139,8 +138,8 @@ TEST(DistanceConstraints, OnePassWithRootPinnedAndLeafFreeSolvesChainExactly) {
   // With the root side pinned in every constraint (weight_a = 0), one ordered pass fixes each
   // point in turn: a forward-reaching chain.
   std::vector<glm::vec3> points{{0, 0, 0}, {0, 3, 0}, {0, 3, 4}};
-  const std::array<DistanceConstraint, 2> constraints{
-      DistanceConstraint{0, 1, 1.0f, 0.0f, 1.0f}, DistanceConstraint{1, 2, 2.0f, 0.0f, 1.0f}};
+  const std::array<DistanceConstraint, 2> constraints{DistanceConstraint{0, 1, 1.0f, 0.0f, 1.0f},
+                                                      DistanceConstraint{1, 2, 2.0f, 0.0f, 1.0f}};
   relax_distance_constraints(points, constraints, 1);
   EXPECT_TRUE(near_vec3(points[1], {0, 1, 0}, 1e-6f));
   // Point 2 moves toward the new point 1 along their difference: from (0,3,4), which is

@@ -135,7 +135,8 @@ TEST(TwoBoneIk, KneeFollowsThePole) {
     EXPECT_TRUE(near_vec3(r.end_position, target, 1e-4f));
     // By hand: an isosceles triangle with legs 0.45 and base 0.7 has its apex
     // sqrt(0.45^2 - 0.35^2) = 0.2828 from the base's midpoint, toward the pole.
-    const glm::vec3 expected_knee = hip + glm::vec3(0.0f, -0.35f, side * std::sqrt(0.45f * 0.45f - 0.35f * 0.35f));
+    const glm::vec3 expected_knee =
+        hip + glm::vec3(0.0f, -0.35f, side * std::sqrt(0.45f * 0.45f - 0.35f * 0.35f));
     EXPECT_TRUE(near_vec3(r.mid_position, expected_knee, 1e-4f)) << side;
   }
 }
@@ -169,7 +170,8 @@ TEST(TwoBoneIk, UnreachableTargetGivesAStraightLimbTowardIt) {
       EXPECT_GT(knee_angle, glm::radians(177.0f)) << trial;
       const std::vector<Transform> g = leg.posed(r);
       EXPECT_NEAR(glm::distance(g[Leg::kHip].translation, g[Leg::kKnee].translation), upper, 1e-5f);
-      EXPECT_NEAR(glm::distance(g[Leg::kKnee].translation, g[Leg::kAnkle].translation), lower, 1e-5f);
+      EXPECT_NEAR(glm::distance(g[Leg::kKnee].translation, g[Leg::kAnkle].translation), lower,
+                  1e-5f);
     }
   }
 }
@@ -198,8 +200,8 @@ TEST(TwoBoneIk, DegenerateInputsNeverGiveNaN) {
     ASSERT_TRUE(finite_result(r));
     const std::vector<Transform> g = leg.posed(r);
     EXPECT_NEAR(glm::distance(g[Leg::kHip].translation, g[Leg::kKnee].translation), 0.45f, 1e-5f);
-    EXPECT_NEAR(glm::distance(g[Leg::kHip].translation, g[Leg::kAnkle].translation),
-                1e-4f * 0.9f, 1e-4f);
+    EXPECT_NEAR(glm::distance(g[Leg::kHip].translation, g[Leg::kAnkle].translation), 1e-4f * 0.9f,
+                1e-4f);
   }
   // Pole along the hip->target line, and a zero pole.
   for (const glm::vec3& pole : {glm::vec3(0, -1, 0), glm::vec3(0.0f)}) {
@@ -211,7 +213,8 @@ TEST(TwoBoneIk, DegenerateInputsNeverGiveNaN) {
   // Zero-length bones: the input comes back unchanged.
   {
     Leg flat(0.0f, 0.45f, true);
-    const TwoBoneIkResult r = solve_two_bone_ik(flat.input(hip + glm::vec3(0, -0.3f, 0), {0, 0, 1}));
+    const TwoBoneIkResult r =
+        solve_two_bone_ik(flat.input(hip + glm::vec3(0, -0.3f, 0), {0, 0, 1}));
     ASSERT_TRUE(finite_result(r));
     EXPECT_FALSE(r.reached);
     EXPECT_TRUE(test::same_rotation(r.root_local, flat.local[Leg::kHip].rotation, 1e-6f));

@@ -111,7 +111,9 @@ constexpr float kDelta = 2e-3f;
 
 // Richardson-extrapolated one-sided derivatives (2*D(h/2) - D(h)) cancel the first-order error
 // of a one-sided difference, including the jump in acceleration a transition may introduce.
-glm::vec3 richardson(const glm::vec3& d_h, const glm::vec3& d_half) { return 2.0f * d_half - d_h; }
+glm::vec3 richardson(const glm::vec3& d_h, const glm::vec3& d_half) {
+  return 2.0f * d_half - d_h;
+}
 
 // Checks that the output just after `time` (offsets at `time`, incoming animation `incoming`)
 // starts from `value` with derivative `velocity` / `angular_velocity`.
@@ -131,9 +133,9 @@ void expect_continuous(const InertializationOffsets& offsets, Animation& incomin
     EXPECT_TRUE(near_vec3(at.velocities[j], velocity[j], 1e-5f));
     EXPECT_TRUE(near_vec3(at.angular_velocities[j], angular_velocity[j], 2e-5f));
     // And so does the actual motion of the output, by finite differences.
-    const glm::vec3 v = richardson((full.local[j].translation - at.local[j].translation) / kDelta,
-                                   (half.local[j].translation - at.local[j].translation) /
-                                       (0.5f * kDelta));
+    const glm::vec3 v =
+        richardson((full.local[j].translation - at.local[j].translation) / kDelta,
+                   (half.local[j].translation - at.local[j].translation) / (0.5f * kDelta));
     EXPECT_TRUE(near_vec3(v, velocity[j], 2e-3f));
     const glm::vec3 w = richardson(
         finite_difference_angular_velocity(at.local[j].rotation, full.local[j].rotation, kDelta),
@@ -202,11 +204,11 @@ TEST(Inertialization, RepeatedTransitionsStayContinuous) {
     left_velocity[j] = richardson(
         (at_switch.local[j].translation - before.local[j].translation) / kDelta,
         (at_switch.local[j].translation - before_half.local[j].translation) / (0.5f * kDelta));
-    left_angular_velocity[j] = richardson(
-        finite_difference_angular_velocity(before.local[j].rotation, at_switch.local[j].rotation,
-                                           kDelta),
-        finite_difference_angular_velocity(before_half.local[j].rotation,
-                                           at_switch.local[j].rotation, 0.5f * kDelta));
+    left_angular_velocity[j] =
+        richardson(finite_difference_angular_velocity(before.local[j].rotation,
+                                                      at_switch.local[j].rotation, kDelta),
+                   finite_difference_angular_velocity(before_half.local[j].rotation,
+                                                      at_switch.local[j].rotation, 0.5f * kDelta));
     // The left-hand finite difference agrees with what the inertializer reports at t2.
     EXPECT_TRUE(near_vec3(left_velocity[j], at_switch.velocities[j], 2e-3f)) << j;
     EXPECT_TRUE(near_vec3(left_angular_velocity[j], at_switch.angular_velocities[j], 3e-3f)) << j;
@@ -311,8 +313,8 @@ TEST(RotationVectorJacobian, MatchesFiniteDifferenceAndInverts) {
   EXPECT_TRUE(near_vec3(rotation_vector_rate_to_angular_velocity(glm::vec3(0.0f), r), r, 0.0f));
   EXPECT_TRUE(near_vec3(angular_velocity_to_rotation_vector_rate(glm::vec3(1e-9f), r), r, 1e-7f));
   // At exactly pi the inverse is finite.
-  const glm::vec3 at_pi = angular_velocity_to_rotation_vector_rate(
-      glm::vec3(0.0f, glm::pi<float>(), 0.0f), r);
+  const glm::vec3 at_pi =
+      angular_velocity_to_rotation_vector_rate(glm::vec3(0.0f, glm::pi<float>(), 0.0f), r);
   EXPECT_TRUE(test::finite_vec3(at_pi));
 }
 

@@ -30,8 +30,8 @@ TEST(QuatLogExp, ScaledAngleAxisMatchesAngleAndAxis) {
     const glm::vec3 axis = test::random_unit_vec3();
     const glm::vec3 v = quat_to_scaled_angle_axis(glm::angleAxis(angle, axis));
     EXPECT_TRUE(near_vec3(v, angle * axis, 2e-5f)) << "angle " << angle;
-    EXPECT_TRUE(same_rotation(quat_from_scaled_angle_axis(angle * axis), glm::angleAxis(angle, axis),
-                              1e-6f));
+    EXPECT_TRUE(same_rotation(quat_from_scaled_angle_axis(angle * axis),
+                              glm::angleAxis(angle, axis), 1e-6f));
   }
 }
 
@@ -110,7 +110,8 @@ TEST(QuatSlerp, ConstantAngularSpeedAlongOneGreatCircle) {
       EXPECT_NEAR(rotation_angle_between(a, s), t * total, 2e-5) << t;
       // Every sample is a rotation about the same relative axis (one great circle).
       if (t * total > 1e-2) {
-        const glm::vec3 step_axis = glm::normalize(quat_to_scaled_angle_axis(glm::conjugate(a) * s));
+        const glm::vec3 step_axis =
+            glm::normalize(quat_to_scaled_angle_axis(glm::conjugate(a) * s));
         EXPECT_TRUE(near_vec3(step_axis, axis, 1e-4f));
       }
       previous = s;
@@ -141,8 +142,8 @@ TEST(QuatSlerp, TakesTheShortestPath) {
   for (int k = 0; k <= 10; ++k) {
     const float t = k / 10.0f;
     EXPECT_TRUE(same_rotation(quat_slerp(a, b, t), quat_slerp(a, -b, t), 1e-6f));
-    EXPECT_TRUE(same_rotation(quat_slerp(a, b, t), glm::angleAxis(glm::radians(-60.0f * t), kUp),
-                              1e-6f));
+    EXPECT_TRUE(
+        same_rotation(quat_slerp(a, b, t), glm::angleAxis(glm::radians(-60.0f * t), kUp), 1e-6f));
   }
 }
 
@@ -228,7 +229,8 @@ TEST(DualQuat, ProductComposesAndConjugateInverts) {
     const Transform b = test::random_transform();
     const DualQuat ab = dual_quat_from_transform(a) * dual_quat_from_transform(b);
     const glm::vec3 p = test::random_vec3(-1.0f, 1.0f);
-    EXPECT_TRUE(near_vec3(dual_quat_transform_point(ab, p), transform_point(compose(a, b), p), 1e-5f));
+    EXPECT_TRUE(
+        near_vec3(dual_quat_transform_point(ab, p), transform_point(compose(a, b), p), 1e-5f));
     const DualQuat identity = dual_quat_conjugate(ab) * ab;
     EXPECT_TRUE(near_vec3(dual_quat_transform_point(identity, p), p, 1e-5f));
   }
@@ -241,7 +243,8 @@ TEST(DualQuat, NormalizeRestoresUnitAndOrthogonality) {
   EXPECT_NEAR(glm::length(n.real), 1.0f, 1e-6f);
   EXPECT_NEAR(glm::dot(n.real, n.dual), 0.0f, 1e-6f);
   const DualQuat zero = dual_quat_normalize(0.0f * a);
-  EXPECT_TRUE(near_vec3(dual_quat_transform_point(zero, glm::vec3(1, 2, 3)), glm::vec3(1, 2, 3), 0.0f));
+  EXPECT_TRUE(
+      near_vec3(dual_quat_transform_point(zero, glm::vec3(1, 2, 3)), glm::vec3(1, 2, 3), 0.0f));
 }
 
 // A screw: turn `angle` about +Z through the point `center`, and slide `slide` along +Z.
@@ -544,20 +547,22 @@ TEST(TransformHermite, ExactAtTheEndsAndFollowsTheDerivatives) {
   }
   // The translation's derivative at the start is the given velocity (not the chord's).
   const float h = 1e-3f;
-  const glm::vec3 slope = (transform_hermite(a, va, wa, b, vb, wb, duration, h).translation -
-                           a.translation) / (h * duration);
+  const glm::vec3 slope =
+      (transform_hermite(a, va, wa, b, vb, wb, duration, h).translation - a.translation) /
+      (h * duration);
   EXPECT_TRUE(near_vec3(slope, va, 2e-2f));
   // The rotation's rate at the start is the given angular velocity.
   const glm::quat early = transform_hermite(a, va, wa, b, vb, wb, duration, h).rotation;
-  const glm::vec3 rate = quat_to_scaled_angle_axis(early * glm::conjugate(a.rotation)) /
-                         (h * duration);
+  const glm::vec3 rate =
+      quat_to_scaled_angle_axis(early * glm::conjugate(a.rotation)) / (h * duration);
   EXPECT_TRUE(near_vec3(rate, wa, 2e-2f));
   // Linear interpolation would have the chord's slope instead: the test tells them apart when
   // the velocity is not the chord's.
   Transform c = b;
   c.translation = a.translation + glm::vec3(0.0f, 0.0f, 0.05f);
-  const glm::vec3 other = (transform_hermite(a, va, wa, c, vb, wb, duration, h).translation -
-                           a.translation) / (h * duration);
+  const glm::vec3 other =
+      (transform_hermite(a, va, wa, c, vb, wb, duration, h).translation - a.translation) /
+      (h * duration);
   EXPECT_TRUE(near_vec3(other, va, 2e-2f));
   EXPECT_FALSE(near_vec3(other, (c.translation - a.translation) / duration, 0.1f));
 }

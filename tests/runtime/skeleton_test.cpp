@@ -13,8 +13,9 @@ Transform at(float x, float y, float z) {
 }
 
 TEST(Skeleton, ComputesSubtreeSizesAndFindsByName) {
-  auto sk = Skeleton::create({"Hips", "Spine", "Chest", "LeftLeg", "LeftFoot"}, {-1, 0, 1, 0, 3},
-                             {at(0, 1, 0), at(0, .5f, 0), at(0, .6f, 0), at(.1f, 0, 0), at(0, -.4f, 0)});
+  auto sk =
+      Skeleton::create({"Hips", "Spine", "Chest", "LeftLeg", "LeftFoot"}, {-1, 0, 1, 0, 3},
+                       {at(0, 1, 0), at(0, .5f, 0), at(0, .6f, 0), at(.1f, 0, 0), at(0, -.4f, 0)});
   ASSERT_TRUE(sk.ok()) << sk.message();
   EXPECT_EQ(sk->subtree_sizes(), (std::vector<int>{5, 2, 1, 2, 1}));
   EXPECT_EQ(sk->find("Chest"), 2);

@@ -97,7 +97,8 @@ TEST(Skinning, IdentityPoseGivesRestPositions) {
 std::vector<float> joint_ring_radii(const Cylinder& cyl, const std::vector<glm::vec3>& positions) {
   std::vector<float> radii;
   for (int k = 0; k < Cylinder::kAround; ++k) {
-    radii.push_back(glm::distance(positions[cyl.index(Cylinder::kJointRing, k)], glm::vec3(1, 0, 0)));
+    radii.push_back(
+        glm::distance(positions[cyl.index(Cylinder::kJointRing, k)], glm::vec3(1, 0, 0)));
   }
   return radii;
 }
@@ -216,8 +217,10 @@ TEST(Skinning, SingleFullInfluenceIsTheExactRigidTransform) {
   for (size_t v = 0; v < positions.size(); ++v) {
     const int j = static_cast<int>(v % 3);
     // Expected, by transforms alone: into the bind frame, then out of the current one.
-    const glm::vec3 expected = transform_point(global[j], transform_point(inverse(bind[j]), positions[v]));
-    const glm::vec3 expected_normal = global[j].rotation * (glm::conjugate(bind[j].rotation) * normals[v]);
+    const glm::vec3 expected =
+        transform_point(global[j], transform_point(inverse(bind[j]), positions[v]));
+    const glm::vec3 expected_normal =
+        global[j].rotation * (glm::conjugate(bind[j].rotation) * normals[v]);
     EXPECT_TRUE(near_vec3(lbs[v], expected, 2e-5f)) << v;
     EXPECT_TRUE(near_vec3(dqs[v], expected, 2e-5f)) << v;
     EXPECT_TRUE(near_vec3(lbs_n[v], expected_normal, 1e-5f)) << v;
@@ -275,7 +278,8 @@ TEST(Skinning, MatrixOverloadsAgreeWithHandProducts) {
     // The bind pose maps to the identity, and both overloads agree.
     const glm::mat4 at_bind = to_matrix(bind[j]) * inverse_bind_matrices[j];
     for (int c = 0; c < 4; ++c) {
-      EXPECT_TRUE(near_vec3(glm::vec3(from_transforms[j][c]), glm::vec3(from_matrices[j][c]), 1e-4f));
+      EXPECT_TRUE(
+          near_vec3(glm::vec3(from_transforms[j][c]), glm::vec3(from_matrices[j][c]), 1e-4f));
       EXPECT_TRUE(near_vec3(glm::vec3(at_bind[c]), glm::vec3(glm::mat4(1.0f)[c]), 1e-5f));
     }
   }

@@ -69,7 +69,8 @@ struct Rk4Character {
   }
 };
 
-// ---- conversions ----------------------------------------------------------------------------------
+// ---- conversions
+// ----------------------------------------------------------------------------------
 
 TEST(SpringConversions, CriticalDampingAndRoundTrips) {
   for (float h : {0.05f, 0.2f, 1.0f, 3.0f}) {
@@ -88,7 +89,8 @@ TEST(SpringConversions, CriticalDampingAndRoundTrips) {
   EXPECT_NEAR((1.0 + u) * std::exp(-u), 0.5, 1e-7);
 }
 
-// ---- scalar and vec3 springs ----------------------------------------------------------------------
+// ---- scalar and vec3 springs
+// ----------------------------------------------------------------------
 
 TEST(CriticalSpring, ScalarMatchesRk4OfTheOde) {
   struct Case {
@@ -247,7 +249,8 @@ TEST(RotationSpring, NonFiniteGoalAndZeroDtAreIgnored) {
   EXPECT_EQ(w, glm::vec3(0.1f, 0.2f, 0.3f));
 }
 
-// ---- predictions ---------------------------------------------------------------------------------
+// ---- predictions
+// ---------------------------------------------------------------------------------
 
 TEST(SpringPredict, MatchesRk4AndRepeatedUpdates) {
   const float h = 0.2f;
@@ -296,7 +299,8 @@ TEST(SpringPredict, RotationsMatchRepeatedUpdates) {
   }
 }
 
-// ---- spring character ----------------------------------------------------------------------------
+// ---- spring character
+// ----------------------------------------------------------------------------
 
 TEST(SpringCharacter, MatchesRk4AcrossDesiredVelocityChanges) {
   const float h = 0.3f;
@@ -306,7 +310,7 @@ TEST(SpringCharacter, MatchesRk4AcrossDesiredVelocityChanges) {
   const float dt = 1.0f / 60.0f;
   for (int frame = 0; frame < 180; ++frame) {
     // Walk forward, then strafe, then stop.
-    const glm::vec3 desired = frame < 60 ? glm::vec3(0, 0, 1.5f)
+    const glm::vec3 desired = frame < 60    ? glm::vec3(0, 0, 1.5f)
                               : frame < 120 ? glm::vec3(2.0f, 0, 0.5f)
                                             : glm::vec3(0.0f);
     spring_character_update(x, v, a, desired, h, dt);

@@ -51,13 +51,13 @@ inline Transform random_transform(float max_translation = 2.0f) {
 // The angle (radians) of the rotation from a to b: conjugate(a) * b in double precision, then
 // atan2 of its vector length and |w| (accurate for tiny angles too, unlike acos of a dot).
 inline double rotation_angle_between(const glm::quat& a, const glm::quat& b) {
-  const glm::dquat r = glm::conjugate(glm::dquat(a.w, a.x, a.y, a.z)) * glm::dquat(b.w, b.x, b.y, b.z);
+  const glm::dquat r =
+      glm::conjugate(glm::dquat(a.w, a.x, a.y, a.z)) * glm::dquat(b.w, b.x, b.y, b.z);
   return 2.0 * std::atan2(std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z), std::abs(r.w));
 }
 
 // True when a and b are the same rotation (q or -q) within tol, component-wise.
-inline ::testing::AssertionResult same_rotation(const glm::quat& a, const glm::quat& b,
-                                                float tol) {
+inline ::testing::AssertionResult same_rotation(const glm::quat& a, const glm::quat& b, float tol) {
   const glm::quat bs = glm::dot(a, b) < 0.0f ? -b : b;
   const float err = std::max(std::max(std::abs(a.w - bs.w), std::abs(a.x - bs.x)),
                              std::max(std::abs(a.y - bs.y), std::abs(a.z - bs.z)));
@@ -70,9 +70,9 @@ inline ::testing::AssertionResult same_rotation(const glm::quat& a, const glm::q
 inline ::testing::AssertionResult near_vec3(const glm::vec3& a, const glm::vec3& b, float tol) {
   const float err = glm::length(a - b);
   if (err <= tol) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "vectors differ by " << err << ": (" << a.x << ", "
-                                       << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y
-                                       << ", " << b.z << ")";
+  return ::testing::AssertionFailure()
+         << "vectors differ by " << err << ": (" << a.x << ", " << a.y << ", " << a.z << ") vs ("
+         << b.x << ", " << b.y << ", " << b.z << ")";
 }
 
 inline bool finite_quat(const glm::quat& q) {

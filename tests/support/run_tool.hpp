@@ -2,10 +2,10 @@
 // Runs the `mm` program under test (MM_TOOL_PATH, set by tests/CMakeLists.txt for the tools
 // suites) in a shell and captures what it prints.
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <string>
-#include <sys/wait.h>
 
 namespace mm::test {
 
@@ -23,7 +23,8 @@ inline CommandRun run_mm(const std::string& arguments) {
   if (!pipe) return run;
   std::array<char, 4096> buffer;
   size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;

@@ -33,7 +33,8 @@ inline void expect_obeys_search_rules(const SearchInput& input, std::span<const 
   }
   double d = 0;
   for (int k = 0; k < input.dims; ++k) {
-    const double diff = double(query[k]) - input.features[static_cast<size_t>(frame) * input.dims + k];
+    const double diff =
+        double(query[k]) - input.features[static_cast<size_t>(frame) * input.dims + k];
     d += diff * diff;
   }
   const double expected = d + (is_next ? 0.0 : c.transition_cost);

@@ -4,11 +4,15 @@
 
 namespace mm::test {
 
-std::filesystem::path mocap_dir() { return std::filesystem::path(MM_SHARED_DIR) / "mocap"; }
+std::filesystem::path mocap_dir() {
+  return std::filesystem::path(MM_SHARED_DIR) / "mocap";
+}
 
 // Tests assert facts about the Bandai files (counts, names), so they always read that folder;
 // MM_DATA only redirects the run command.
-std::filesystem::path data_dir() { return mocap_dir() / "bandai-normal"; }
+std::filesystem::path data_dir() {
+  return mocap_dir() / "bandai-normal";
+}
 
 std::filesystem::path scratch_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
@@ -22,6 +26,8 @@ std::filesystem::path scratch_dir() {
   return dir;
 }
 
-std::filesystem::path clip_path(const std::string& stem) { return data_dir() / (stem + ".bvh"); }
+std::filesystem::path clip_path(const std::string& stem) {
+  return data_dir() / (stem + ".bvh");
+}
 
 }  // namespace mm::test

@@ -10,9 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "run_tool.hpp"
 #include "test_support.hpp"
 
@@ -79,7 +79,8 @@ TEST(Cli, BuildWritesALoadableDatabaseAndPrintsItsSummary) {
   // The frames of the three sources, counted by the importer independently of the builder,
   // and the idle clip's.
   int frames = 0;
-  for (const auto& entry : fs::directory_iterator(in)) frames += load_bvh(entry.path())->frame_count;
+  for (const auto& entry : fs::directory_iterator(in))
+    frames += load_bvh(entry.path())->frame_count;
   EXPECT_EQ(db->frame_count, frames + 90);
 
   const CommandRun info = run_mm("info " + quoted(out));
@@ -259,12 +260,12 @@ TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
     std::ifstream file(json_path);
     const nlohmann::json json = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
     ASSERT_FALSE(json.is_discarded()) << json_path;
-    for (const char* method : {"brute", "brute-simd", "aabb", "kdtree", "boxtree", "approx",
-                               "kdtree-eps"}) {
+    for (const char* method :
+         {"brute", "brute-simd", "aabb", "kdtree", "boxtree", "approx", "kdtree-eps"}) {
       ASSERT_TRUE(json.contains(method)) << method;
       const nlohmann::json& m = json[method];
-      for (const char* field : {"build_ms", "memory_bytes", "median_us", "p99_us",
-                                "exact_match_rate", "cost_ratio"}) {
+      for (const char* field :
+           {"build_ms", "memory_bytes", "median_us", "p99_us", "exact_match_rate", "cost_ratio"}) {
         ASSERT_TRUE(m.contains(field) && m[field].is_number()) << method << " " << field;
       }
       EXPECT_GT(m["memory_bytes"].get<double>(), 0) << method;
@@ -301,9 +302,10 @@ TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
 // factor of the nearest distance.
 TEST(Cli, SearchBenchNeighbourhoodOfExactRowsIsTheRowItself) {
   const fs::path json_path = test::scratch_dir() / "noiseless.json";
-  const CommandRun run = run_mm("search-bench --synthetic --queries 100 --noise 0 --quiet "
-                                "--methods brute,brute-simd --no-flann-reference --json " +
-                                quoted(json_path));
+  const CommandRun run = run_mm(
+      "search-bench --synthetic --queries 100 --noise 0 --quiet "
+      "--methods brute,brute-simd --no-flann-reference --json " +
+      quoted(json_path));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   std::ifstream file(json_path);
   const nlohmann::json json = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);

@@ -3,12 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -35,15 +35,14 @@ std::string read_text(const fs::path& path) {
 // program. ctest runs every test as its own process, in parallel: each gets its own folder.
 const fs::path& small_database() {
   static const fs::path path = [] {
-    const fs::path dir = fs::path(MM_BINARY_DIR) / "test-scratch" /
-                         ("controller-cli-" + std::to_string(getpid()));
+    const fs::path dir =
+        fs::path(MM_BINARY_DIR) / "test-scratch" / ("controller-cli-" + std::to_string(getpid()));
     fs::create_directories(dir);
     std::string files;
-    for (const char* stem :
-         {"dataset-2_walk_normal_001", "dataset-2_walk_normal_002", "dataset-2_walk_normal_003",
-          "dataset-2_walk-turn-left_normal_001", "dataset-2_walk-turn-right_normal_001",
-          "dataset-2_run_normal_001", "dataset-2_run_normal_002",
-          "dataset-2_wave-left-hand_normal_001"}) {
+    for (const char* stem : {"dataset-2_walk_normal_001", "dataset-2_walk_normal_002",
+                             "dataset-2_walk_normal_003", "dataset-2_walk-turn-left_normal_001",
+                             "dataset-2_walk-turn-right_normal_001", "dataset-2_run_normal_001",
+                             "dataset-2_run_normal_002", "dataset-2_wave-left-hand_normal_001"}) {
       files.append("'").append(test::clip_path(stem).string()).append("' ");
     }
     // Removed when the test program exits.
@@ -76,7 +75,8 @@ const char* const kScript =
     "6 0 0 0 0\n";
 
 std::string eval_arguments(const fs::path& script, const std::string& extra) {
-  return "eval --db '" + small_database().string() + "' --script '" + script.string() + "' " + extra;
+  return "eval --db '" + small_database().string() + "' --script '" + script.string() + "' " +
+         extra;
 }
 
 TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
@@ -97,7 +97,8 @@ TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
     // The terminal shows the same figures under the same names.
     EXPECT_NE(run.output.find(key), std::string::npos) << key;
   }
-  EXPECT_LE(json["foot_skate_cm_s_mean"].get<double>(), json["foot_skate_cm_s_p95"].get<double>() + 1e-9);
+  EXPECT_LE(json["foot_skate_cm_s_mean"].get<double>(),
+            json["foot_skate_cm_s_p95"].get<double>() + 1e-9);
   EXPECT_LE(json["root_sim_distance_cm_mean"].get<double>(),
             json["root_sim_distance_cm_max"].get<double>() + 1e-9);
   // The script's last line is at 6 s, and the run goes on 2 s past it: 8 s at 60 Hz. The stick
@@ -135,7 +136,8 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
       "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,desired_yaw_deg,"
       "transition,contact_l,contact_r";
   for (const std::string& joint : db->skeleton.names()) {
-    header.append(",").append(joint).append("_x,").append(joint).append("_y,").append(joint).append("_z");
+    header.append(",").append(joint).append("_x,").append(joint).append("_y,").append(joint).append(
+        "_z");
   }
   std::istringstream lines(dumps[0]);
   std::string first;
@@ -144,7 +146,8 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
   int rows = 0;
   for (std::string line; std::getline(lines, line);) {
     ++rows;
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), std::count(header.begin(), header.end(), ','));
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','),
+              std::count(header.begin(), header.end(), ','));
   }
   EXPECT_EQ(rows, 400);  // 8 s at dt 0.02
 }
@@ -161,8 +164,9 @@ TEST(ControllerCli, EvalUsageErrorsExitWith2) {
   const fs::path dir = test::scratch_dir();
   const fs::path script = write_script(dir, "walk.txt", kScript);
   for (const std::string& arguments :
-       {std::string("eval --script '") + script.string() + "'", eval_arguments(script, "--ik maybe"),
-        eval_arguments(script, "--dt 0"), eval_arguments(script, "--set warp_speed=9"),
+       {std::string("eval --script '") + script.string() + "'",
+        eval_arguments(script, "--ik maybe"), eval_arguments(script, "--dt 0"),
+        eval_arguments(script, "--set warp_speed=9"),
         eval_arguments(script, "--set inertialization_halflife=-1")}) {
     const CommandRun run = run_mm(arguments);
     EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
@@ -175,8 +179,9 @@ TEST(ControllerCli, EvalUsageErrorsExitWith2) {
 TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
   const fs::path dir = test::scratch_dir();
   const fs::path json_path = dir / "crowd.json";
-  const CommandRun run = run_mm("crowd-bench --db '" + small_database().string() +
-                                "' --characters 24 --seconds 1 --json '" + json_path.string() + "'");
+  const CommandRun run =
+      run_mm("crowd-bench --db '" + small_database().string() +
+             "' --characters 24 --seconds 1 --json '" + json_path.string() + "'");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("final positions identical"), std::string::npos) << run.output;
   const nlohmann::json json = nlohmann::json::parse(read_text(json_path));

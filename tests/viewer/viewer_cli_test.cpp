@@ -32,7 +32,8 @@ struct ProgramRun {
 ProgramRun run(const std::string& command_line) {
   static const std::string asan_options = [] {
     const char* given = std::getenv("ASAN_OPTIONS");
-    return std::string(given && *given ? given : "") + (given && *given ? ":" : "") + "detect_leaks=0";
+    return std::string(given && *given ? given : "") + (given && *given ? ":" : "") +
+           "detect_leaks=0";
   }();
   setenv("ASAN_OPTIONS", asan_options.c_str(), 1);
   ProgramRun r;
@@ -46,7 +47,9 @@ ProgramRun run(const std::string& command_line) {
   return r;
 }
 
-std::string viewer() { return std::string("'") + MM_VIEWER_PATH + "'"; }
+std::string viewer() {
+  return std::string("'") + MM_VIEWER_PATH + "'";
+}
 
 std::string script(const std::string& name) {
   return std::string(MM_SOURCE_DIR) + "/scripts/input/" + name;
@@ -147,9 +150,10 @@ void expect_scene(const Image& image, const Box& box) {
 
 TEST(ViewerCli, HeadlessScreenshotShowsSkyGroundGridAndTheCharacter) {
   const fs::path dir = test::scratch_dir();
-  const ProgramRun r = run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
-                    script("circle.txt") + "' --frames 120 --size 640x360 --no-panel --debug none" +
-                    " --screenshot '" + (dir / "shot.png").string() + "'");
+  const ProgramRun r =
+      run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
+          script("circle.txt") + "' --frames 120 --size 640x360 --no-panel --debug none" +
+          " --screenshot '" + (dir / "shot.png").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   Box box;
   ASSERT_TRUE(parse_box(r.output, box)) << r.output;
@@ -162,9 +166,9 @@ TEST(ViewerCli, HeadlessScreenshotShowsSkyGroundGridAndTheCharacter) {
 TEST(ViewerCli, WindowedUnderXvfbShowsTheSameScene) {
   const fs::path dir = test::scratch_dir();
   const ProgramRun r = run("xvfb-run -a -s '-screen 0 1024x768x24' " + viewer() + " --db '" +
-                    database_file().string() + "' --script '" + script("zigzag.txt") +
-                    "' --frames 90 --dt 0.0166667 --size 800x450 --no-panel --debug none" +
-                    " --screenshot '" + (dir / "window.png").string() + "'");
+                           database_file().string() + "' --script '" + script("zigzag.txt") +
+                           "' --frames 90 --dt 0.0166667 --size 800x450 --no-panel --debug none" +
+                           " --screenshot '" + (dir / "window.png").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   Box box;
   ASSERT_TRUE(parse_box(r.output, box)) << r.output;
@@ -176,10 +180,10 @@ TEST(ViewerCli, WindowedUnderXvfbShowsTheSameScene) {
 
 TEST(ViewerCli, EveryWritesNumberedScreenshotsAndThePlot) {
   const fs::path dir = test::scratch_dir();
-  const ProgramRun r = run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
-                    script("stop-and-go.txt") + "' --frames 60 --every 25 --size 320x180" +
-                    " --screenshot '" + (dir / "s.png").string() + "' --plot '" +
-                    (dir / "plot.png").string() + "'");
+  const ProgramRun r = run(
+      viewer() + " --db '" + database_file().string() + "' --headless --script '" +
+      script("stop-and-go.txt") + "' --frames 60 --every 25 --size 320x180" + " --screenshot '" +
+      (dir / "s.png").string() + "' --plot '" + (dir / "plot.png").string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "s-000025.png"));
   EXPECT_TRUE(fs::exists(dir / "s-000050.png"));
@@ -192,8 +196,9 @@ TEST(ViewerCli, EveryWritesNumberedScreenshotsAndThePlot) {
 TEST(ViewerCli, RecordsLiveInputAsAScriptThatParses) {
   const fs::path dir = test::scratch_dir();
   const fs::path recorded = dir / "recorded.txt";
-  const ProgramRun r = run("xvfb-run -a " + viewer() + " --db '" + database_file().string() +
-                    "' --frames 20 --dt 0.0166667 --size 320x180 --record '" + recorded.string() + "'");
+  const ProgramRun r =
+      run("xvfb-run -a " + viewer() + " --db '" + database_file().string() +
+          "' --frames 20 --dt 0.0166667 --size 320x180 --record '" + recorded.string() + "'");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   Result<InputScript> parsed = load_input_script(recorded);
   ASSERT_TRUE(parsed.ok()) << parsed.message();
@@ -215,7 +220,8 @@ TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
   EXPECT_NE(r.output.find("--frames needs a whole number"), std::string::npos) << r.output;
   r = run(viewer() + " --weights blobs");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("--weights needs distance, envelope, heat or geodesic"), std::string::npos);
+  EXPECT_NE(r.output.find("--weights needs distance, envelope, heat or geodesic"),
+            std::string::npos);
 
   const fs::path dir = test::scratch_dir();
   r = run(viewer() + " --db '" + (dir / "missing.mmdb").string() + "' --headless --script '" +
@@ -226,7 +232,8 @@ TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
           (dir / "none.txt").string() + "'");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("none.txt"), std::string::npos) << r.output;
-  r = run("env -u DISPLAY -u WAYLAND_DISPLAY " + viewer() + " --db '" + database_file().string() + "'");
+  r = run("env -u DISPLAY -u WAYLAND_DISPLAY " + viewer() + " --db '" + database_file().string() +
+          "'");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("no display"), std::string::npos) << r.output;
 }

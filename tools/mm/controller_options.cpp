@@ -4,7 +4,8 @@
 
 namespace mm::cli {
 
-Result<std::shared_ptr<const ControllerDatabase>> load_controller_database(const std::string& path) {
+Result<std::shared_ptr<const ControllerDatabase>> load_controller_database(
+    const std::string& path) {
   Result<Database> loaded = load_database(path);
   if (!loaded) return Error{loaded.message()};
   return ControllerDatabase::create(std::make_shared<const Database>(std::move(loaded).value()));
@@ -13,7 +14,8 @@ Result<std::shared_ptr<const ControllerDatabase>> load_controller_database(const
 Status apply_set_option(const std::string* argument, ControllerSettings& settings) {
   const size_t equals = argument ? argument->find('=') : std::string::npos;
   if (equals == std::string::npos) return Error{"--set needs NAME=VALUE"};
-  return set_controller_setting(settings, argument->substr(0, equals), argument->substr(equals + 1));
+  return set_controller_setting(settings, argument->substr(0, equals),
+                                argument->substr(equals + 1));
 }
 
 }  // namespace mm::cli

@@ -18,7 +18,8 @@
 namespace mm::cli {
 namespace {
 
-const char* const kUsage = R"(usage: mm crowd-bench --db FILE.mmdb --characters N --seconds S [options]
+const char* const kUsage =
+    R"(usage: mm crowd-bench --db FILE.mmdb --characters N --seconds S [options]
 
 Updates N character controllers over one shared database at 60 Hz for S seconds of game
 time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera
@@ -70,7 +71,8 @@ int run_crowd_bench(const std::vector<std::string>& args) {
     } else if (a == "--seconds") {
       const std::string* v = value();
       const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
-      if (!s || *s <= 0.0 || *s > 3600.0) return usage_error("--seconds needs a number in (0, 3600]");
+      if (!s || *s <= 0.0 || *s > 3600.0)
+        return usage_error("--seconds needs a number in (0, 3600]");
       options.seconds = static_cast<float>(*s);
     } else if (a == "--set") {
       if (Status s = apply_set_option(value(), options.settings); !s) {

@@ -122,13 +122,11 @@ nlohmann::json to_json(const EvaluationMetrics& m) {
 }
 
 void print_table_header() {
-  std::printf(
-      "%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "skate",
-      "skate95", "rootsim", "rs_max", "facing", "speed_s", "head_s", "stand_r", "stand_f",
-      "trans/s", "accel", "accel=", "search", "update");
-  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "cm/s",
-              "cm/s", "cm", "cm", "deg", "s", "s", "cm/s", "cm/s", "", "ratio", "ratio", "us",
-              "us");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "skate",
+              "skate95", "rootsim", "rs_max", "facing", "speed_s", "head_s", "stand_r", "stand_f",
+              "trans/s", "accel", "accel=", "search", "update");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "cm/s", "cm/s",
+              "cm", "cm", "deg", "s", "s", "cm/s", "cm/s", "", "ratio", "ratio", "us", "us");
 }
 
 void print_table_row(const std::string& name, const EvaluationMetrics& m) {
@@ -136,10 +134,10 @@ void print_table_row(const std::string& name, const EvaluationMetrics& m) {
       "%-22s %7.2f %7.2f %7.2f %7.2f %7.2f %7.3f %7.3f %7.2f %7.2f %7.2f %7.3f %7.3f %7.2f "
       "%7.2f\n",
       name.c_str(), m.foot_skate_cm_s_mean, m.foot_skate_cm_s_p95, m.root_sim_distance_cm_mean,
-      m.root_sim_distance_cm_max, m.facing_error_deg_mean, m.speed_response_s,
-      m.heading_response_s, m.stand_root_speed_cm_s_mean, m.stand_foot_speed_cm_s_mean,
-      m.transitions_per_s, m.transition_accel_ratio, m.transition_accel_ratio_same_sampling,
-      m.search_us_mean, m.update_us_mean);
+      m.root_sim_distance_cm_max, m.facing_error_deg_mean, m.speed_response_s, m.heading_response_s,
+      m.stand_root_speed_cm_s_mean, m.stand_foot_speed_cm_s_mean, m.transitions_per_s,
+      m.transition_accel_ratio, m.transition_accel_ratio_same_sampling, m.search_us_mean,
+      m.update_us_mean);
 }
 
 void print_metrics(const EvaluationMetrics& m) {
@@ -156,10 +154,11 @@ void print_metrics(const EvaluationMetrics& m) {
               m.stand_root_speed_cm_s_mean, m.stand_frames);
   std::printf("stand_foot_speed_cm_s_mean  %10.3f\n", m.stand_foot_speed_cm_s_mean);
   std::printf("transitions_per_s           %10.3f\n", m.transitions_per_s);
-  std::printf("transition_accel_ratio      %10.3f   (%.1f / %.1f m/s^2; %.3f against the data "
-              "played with the controller's sampling, %.1f m/s^2)\n",
-              m.transition_accel_ratio, m.transition_accel_p99, m.database_accel_p99,
-              m.transition_accel_ratio_same_sampling, m.database_accel_p99_same_sampling);
+  std::printf(
+      "transition_accel_ratio      %10.3f   (%.1f / %.1f m/s^2; %.3f against the data "
+      "played with the controller's sampling, %.1f m/s^2)\n",
+      m.transition_accel_ratio, m.transition_accel_p99, m.database_accel_p99,
+      m.transition_accel_ratio_same_sampling, m.database_accel_p99_same_sampling);
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
 }
@@ -169,8 +168,7 @@ int run_eval(const std::vector<std::string>& args) {
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
   arguments.options.keep_frames = !arguments.dump_path.empty();
 
-  Result<std::shared_ptr<const ControllerDatabase>> shared =
-      load_controller_database(arguments.db);
+  Result<std::shared_ptr<const ControllerDatabase>> shared = load_controller_database(arguments.db);
   if (!shared) {
     std::fprintf(stderr, "mm eval: %s\n", shared.message().c_str());
     return 1;

@@ -9,10 +9,10 @@
 
 #include "command.hpp"
 #include "database_summary.hpp"
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 
 namespace mm::cli {
 namespace {

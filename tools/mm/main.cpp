@@ -18,12 +18,15 @@ bool register_command(const Command& command) {
   return true;
 }
 
-const std::vector<Command>& commands() { return table(); }
+const std::vector<Command>& commands() {
+  return table();
+}
 
 }  // namespace mm::cli
 
 static void print_usage(FILE* out) {
-  std::fprintf(out, "usage: mm <command> [arguments]   (mm <command> --help for details)\n\ncommands:\n");
+  std::fprintf(
+      out, "usage: mm <command> [arguments]   (mm <command> --help for details)\n\ncommands:\n");
   auto list = mm::cli::commands();
   std::sort(list.begin(), list.end(),
             [](const auto& a, const auto& b) { return std::strcmp(a.name, b.name) < 0; });
@@ -37,7 +40,8 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   for (const auto& c : mm::cli::commands()) {
-    if (!std::strcmp(c.name, argv[1])) return c.run(std::vector<std::string>(argv + 2, argv + argc));
+    if (!std::strcmp(c.name, argv[1]))
+      return c.run(std::vector<std::string>(argv + 2, argv + argc));
   }
   std::fprintf(stderr, "mm: unknown command '%s'\n\n", argv[1]);
   print_usage(stderr);

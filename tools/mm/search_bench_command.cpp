@@ -184,7 +184,8 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     } else if (a == "--clock" && i + 1 < args.size()) {
       const std::string& clock = args[++i];
       if (clock != "wall" && clock != "cpu") {
-        std::fprintf(stderr, "mm search-bench: --clock expects wall or cpu, got '%s'\n", clock.c_str());
+        std::fprintf(stderr, "mm search-bench: --clock expects wall or cpu, got '%s'\n",
+                     clock.c_str());
         return 2;
       }
       out.cpu_clock = clock == "cpu";
@@ -224,7 +225,8 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     const auto known = search_method_names();
     if (std::find(known.begin(), known.end(), name) == known.end()) {
       std::fprintf(stderr, "mm search-bench: unknown method '%s' (known:", name.c_str());
-      for (std::string_view k : known) std::fprintf(stderr, " %.*s", static_cast<int>(k.size()), k.data());
+      for (std::string_view k : known)
+        std::fprintf(stderr, " %.*s", static_cast<int>(k.size()), k.data());
       std::fprintf(stderr, ")\n");
       return 2;
     }
@@ -345,7 +347,8 @@ Neighbourhood measure_neighbourhood(const SearchInput& input, const NoisyQueries
                                     Progress& progress) {
   std::vector<const float*> rows;
   for (int f = 0; f < input.frame_count(); ++f) {
-    const uint64_t tags = input.clips[static_cast<size_t>(input.frame_clip[static_cast<size_t>(f)])].tags;
+    const uint64_t tags =
+        input.clips[static_cast<size_t>(input.frame_clip[static_cast<size_t>(f)])].tags;
     if (input.searchable[static_cast<size_t>(f)] && (tags & include_tags) == include_tags &&
         (tags & exclude_tags) == 0) {
       rows.push_back(input.features.data() + static_cast<size_t>(f) * input.dims);
@@ -365,8 +368,8 @@ Neighbourhood measure_neighbourhood(const SearchInput& input, const NoisyQueries
     }
     for (int k = 0; k < 2; ++k) {
       const auto limit = static_cast<float>(nearest * Neighbourhood::kFactors[k]);
-      const auto within = std::count_if(distances.begin(), distances.end(),
-                                        [&](float d) { return d <= limit; });
+      const auto within =
+          std::count_if(distances.begin(), distances.end(), [&](float d) { return d <= limit; });
       out.shares[k].push_back(static_cast<double>(within) / static_cast<double>(rows.size()));
     }
   }
@@ -427,7 +430,8 @@ int run_search_bench(const std::vector<std::string>& args) {
       (names == &arguments.include ? include_tags : exclude_tags) |= bit;
     }
   }
-  const int candidates = static_cast<int>(std::count(input.searchable.begin(), input.searchable.end(), 1));
+  const int candidates =
+      static_cast<int>(std::count(input.searchable.begin(), input.searchable.end(), 1));
   const NoisyQueries queries =
       make_noisy_queries(input, arguments.queries, arguments.noise, arguments.seed);
   if (queries.count() == 0) {
@@ -446,13 +450,14 @@ int run_search_bench(const std::vector<std::string>& args) {
     c.exclude_tags = exclude_tags;
   }
 
-  std::printf("search-bench: %s\n  %d frames, %d candidates, %d dims; %d queries, noise %g, %s; "
-              "scan kernel %s; %s clock, fastest of %d run%s per query (rounds over all methods)\n",
-              source.c_str(), input.frame_count(), candidates, input.dims, queries.count(),
-              static_cast<double>(arguments.noise),
-              arguments.playing ? "playing the source frame" : "nothing playing",
-              search_kernels::scan_blocks_isa(), arguments.cpu_clock ? "thread CPU" : "wall",
-              arguments.repeat, arguments.repeat == 1 ? "" : "s");
+  std::printf(
+      "search-bench: %s\n  %d frames, %d candidates, %d dims; %d queries, noise %g, %s; "
+      "scan kernel %s; %s clock, fastest of %d run%s per query (rounds over all methods)\n",
+      source.c_str(), input.frame_count(), candidates, input.dims, queries.count(),
+      static_cast<double>(arguments.noise),
+      arguments.playing ? "playing the source frame" : "nothing playing",
+      search_kernels::scan_blocks_isa(), arguments.cpu_clock ? "thread CPU" : "wall",
+      arguments.repeat, arguments.repeat == 1 ? "" : "s");
 
   // Every structure is built first (timed), then the queries run in `repeat` rounds, each
   // round one pass per method: a slow spell of a shared machine then hits every method alike,
@@ -466,7 +471,8 @@ int run_search_bench(const std::vector<std::string>& args) {
     progress.show(name + ": building", 0, 1);
     const auto build_start = Clock::now();
     auto made = make_searcher(name, input, arguments.options);
-    method.report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    method.report.build_ms =
+        std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
     progress.clear();
     if (!made) {
       std::fprintf(stderr, "mm search-bench: %s\n", made.message().c_str());
@@ -499,10 +505,12 @@ int run_search_bench(const std::vector<std::string>& args) {
     }
     const auto build_start = Clock::now();
     plain_index = std::make_unique<flann::KDTreeSingleIndex<flann::L2<float>>>(
-        flann::Matrix<float>(plain_rows.data(), plain_row_frame.size(), static_cast<size_t>(input.dims)),
+        flann::Matrix<float>(plain_rows.data(), plain_row_frame.size(),
+                             static_cast<size_t>(input.dims)),
         flann::KDTreeSingleIndexParams());
     plain_index->buildIndex();
-    method.report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
+    method.report.build_ms =
+        std::chrono::duration<double, std::milli>(Clock::now() - build_start).count();
     progress.clear();
     method.report.memory_bytes =
         plain_rows.size() * sizeof(float) * 2 + static_cast<size_t>(plain_index->usedMemory());
@@ -527,7 +535,8 @@ int run_search_bench(const std::vector<std::string>& args) {
   for (int round = 0; round < arguments.repeat; ++round) {
     for (TimedMethod& method : methods) {
       std::string stage = method.report.name + ": queries";
-      if (arguments.repeat > 1) stage += ", round " + std::to_string(round + 1) + "/" + std::to_string(arguments.repeat);
+      if (arguments.repeat > 1)
+        stage += ", round " + std::to_string(round + 1) + "/" + std::to_string(arguments.repeat);
       time_pass(method, queries.count(), arguments.cpu_clock, progress, stage);
     }
   }
@@ -573,11 +582,15 @@ int run_search_bench(const std::vector<std::string>& args) {
   const Neighbourhood neighbourhood =
       measure_neighbourhood(input, queries, include_tags, exclude_tags, progress);
   if (!neighbourhood.shares[0].empty()) {
-    std::printf("\nneighbourhood: share of the candidates within 1.2x / 1.5x of the nearest row's "
-                "distance:\n  median %.2f %% / %.2f %%, p90 %.2f %% / %.2f %%, p99 %.2f %% / %.2f %%\n",
-                100 * percentile(neighbourhood.shares[0], 0.5), 100 * percentile(neighbourhood.shares[1], 0.5),
-                100 * percentile(neighbourhood.shares[0], 0.9), 100 * percentile(neighbourhood.shares[1], 0.9),
-                100 * percentile(neighbourhood.shares[0], 0.99), 100 * percentile(neighbourhood.shares[1], 0.99));
+    std::printf(
+        "\nneighbourhood: share of the candidates within 1.2x / 1.5x of the nearest row's "
+        "distance:\n  median %.2f %% / %.2f %%, p90 %.2f %% / %.2f %%, p99 %.2f %% / %.2f %%\n",
+        100 * percentile(neighbourhood.shares[0], 0.5),
+        100 * percentile(neighbourhood.shares[1], 0.5),
+        100 * percentile(neighbourhood.shares[0], 0.9),
+        100 * percentile(neighbourhood.shares[1], 0.9),
+        100 * percentile(neighbourhood.shares[0], 0.99),
+        100 * percentile(neighbourhood.shares[1], 0.99));
   }
 
   nlohmann::json json;
@@ -648,8 +661,9 @@ int run_search_bench(const std::vector<std::string>& args) {
   return 0;
 }
 
-const bool registered = register_command(
-    {"search-bench", "benchmark the search structures on a database (headless)", &run_search_bench});
+const bool registered =
+    register_command({"search-bench", "benchmark the search structures on a database (headless)",
+                      &run_search_bench});
 
 }  // namespace
 }  // namespace mm::cli

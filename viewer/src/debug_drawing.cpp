@@ -16,7 +16,9 @@ const glm::vec3 kAir{0.45f, 0.45f, 0.45f};
 const glm::vec3 kLock{0.9f, 0.1f, 0.1f};
 constexpr float kLift = 0.01f;  // lines on the ground are lifted so the grid does not hide them
 
-glm::vec3 ground(glm::vec3 p) { return {p.x, kLift, p.z}; }
+glm::vec3 ground(glm::vec3 p) {
+  return {p.x, kLift, p.z};
+}
 
 glm::vec3 facing(const glm::quat& q, float length) {
   return q * glm::vec3(0.0f, 0.0f, length);
@@ -51,7 +53,9 @@ void draw_roots(const Controller& controller, DebugLines& lines) {
 void draw_feature_row(const Database& db, const Transform& root, const float* row, int dims,
                       const glm::vec3& colour, DebugLines& lines) {
   const FeatureSchema& schema = db.schema;
-  auto raw = [&](int column) { return row[column] * db.feature_scale[column] + db.feature_offset[column]; };
+  auto raw = [&](int column) {
+    return row[column] * db.feature_scale[column] + db.feature_offset[column];
+  };
   for (int c = 0; c < static_cast<int>(schema.channels.size()); ++c) {
     const FeatureChannel& channel = schema.channels[c];
     const int first = schema.offset(c);
@@ -64,7 +68,8 @@ void draw_feature_row(const Database& db, const Transform& root, const float* ro
       case FeatureKind::BoneVelocity: {
         // Drawn from the hips' height for the hips, from the ground for the feet.
         const glm::vec3 v{raw(first), raw(first + 1), raw(first + 2)};
-        const glm::vec3 from = transform_point(root, {0.0f, channel.bone == "hips" ? 1.0f : kLift, 0.0f});
+        const glm::vec3 from =
+            transform_point(root, {0.0f, channel.bone == "hips" ? 1.0f : kLift, 0.0f});
         lines.line(from, from + transform_vector(root, v * 0.1f), colour);
         break;
       }
@@ -85,7 +90,8 @@ void draw_feature_row(const Database& db, const Transform& root, const float* ro
     if (channel.kind != FeatureKind::TrajectoryDirection) continue;
     for (int p = 0; p < static_cast<int>(schema.channels.size()); ++p) {
       const FeatureChannel& positions = schema.channels[p];
-      if (positions.kind != FeatureKind::TrajectoryPosition || positions.times != channel.times) continue;
+      if (positions.kind != FeatureKind::TrajectoryPosition || positions.times != channel.times)
+        continue;
       for (size_t t = 0; t < channel.times.size(); ++t) {
         const int k = schema.offset(c) + 2 * static_cast<int>(t);
         const int q = schema.offset(p) + 2 * static_cast<int>(t);
@@ -143,7 +149,8 @@ void draw_skeleton(const Controller& controller, DebugLines& lines) {
     if (parent <= 0 || glm::distance(globals[parent].translation, ground_root) < 0.01f) continue;
     lines.line(globals[parent].translation, globals[j].translation, {0.1f, 0.1f, 0.1f});
   }
-  for (int j = 1; j < skeleton.joint_count(); ++j) lines.cross(globals[j].translation, 0.015f, {0.9f, 0.9f, 0.2f});
+  for (int j = 1; j < skeleton.joint_count(); ++j)
+    lines.cross(globals[j].translation, 0.015f, {0.9f, 0.9f, 0.2f});
 }
 
 }  // namespace mm::viewer

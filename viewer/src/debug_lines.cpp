@@ -21,14 +21,14 @@ void DebugLines::circle(const glm::vec3& centre, float radius, const glm::vec3& 
                         int segments) {
   for (int i = 0; i < segments; ++i) {
     const float a0 = glm::two_pi<float>() * static_cast<float>(i) / static_cast<float>(segments);
-    const float a1 = glm::two_pi<float>() * static_cast<float>(i + 1) / static_cast<float>(segments);
+    const float a1 =
+        glm::two_pi<float>() * static_cast<float>(i + 1) / static_cast<float>(segments);
     line(centre + radius * glm::vec3(std::cos(a0), 0, std::sin(a0)),
          centre + radius * glm::vec3(std::cos(a1), 0, std::sin(a1)), colour);
   }
 }
 
-void DebugLines::arrow(const glm::vec3& from, const glm::vec3& direction,
-                       const glm::vec3& colour) {
+void DebugLines::arrow(const glm::vec3& from, const glm::vec3& direction, const glm::vec3& colour) {
   const glm::vec3 to = from + direction;
   line(from, to, colour);
   const glm::vec3 flat(direction.x, 0.0f, direction.z);

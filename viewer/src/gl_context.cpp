@@ -126,7 +126,7 @@ class HeadlessContext final : public GlContext {
   EGLContext context_;
   int width_ = 0;
   int height_ = 0;
-  GLuint framebuffers_[2] = {0, 0};   // multisampled, resolved
+  GLuint framebuffers_[2] = {0, 0};      // multisampled, resolved
   GLuint renderbuffers_[3] = {0, 0, 0};  // colour, depth (multisampled), resolved colour
 };
 
@@ -134,8 +134,8 @@ Result<EGLDisplay> open_surfaceless_display() {
   auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
       eglGetProcAddress("eglGetPlatformDisplayEXT"));
   if (!get_platform_display) return Error{"headless: EGL has no eglGetPlatformDisplayEXT"};
-  EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY,
-                                            nullptr);
+  EGLDisplay display =
+      get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
   if (display == EGL_NO_DISPLAY) {
     return Error{"headless: no EGL surfaceless display (Mesa's EGL_MESA_platform_surfaceless)"};
   }
@@ -180,8 +180,10 @@ Result<std::unique_ptr<GlContext>> GlContext::create_headless(int width, int hei
     eglTerminate(*display);
     return Error{"headless: no EGL configuration for desktop OpenGL"};
   }
-  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3,
-                                       EGL_CONTEXT_MINOR_VERSION, 3,
+  const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                       3,
+                                       EGL_CONTEXT_MINOR_VERSION,
+                                       3,
                                        EGL_CONTEXT_OPENGL_PROFILE_MASK,
                                        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                        EGL_NONE};

@@ -8,10 +8,10 @@
 namespace mm::viewer {
 namespace {
 
-constexpr float kStickDeadzone = 0.15f;    // for the camera orbit (the controller has its own)
-constexpr float kTriggerPressed = 0.3f;    // triggers rest at -1 and go to +1
-constexpr float kOrbitYawSpeed = 2.5f;     // rad/s at full right stick or Q/E
-constexpr float kOrbitPitchSpeed = 1.2f;   // rad/s
+constexpr float kStickDeadzone = 0.15f;   // for the camera orbit (the controller has its own)
+constexpr float kTriggerPressed = 0.3f;   // triggers rest at -1 and go to +1
+constexpr float kOrbitYawSpeed = 2.5f;    // rad/s at full right stick or Q/E
+constexpr float kOrbitPitchSpeed = 1.2f;  // rad/s
 constexpr float kMouseRadiansPerPixel = 0.006f;
 
 glm::vec2 clamp_to_disc(glm::vec2 v) {
@@ -19,7 +19,9 @@ glm::vec2 clamp_to_disc(glm::vec2 v) {
   return length > 1.0f ? v / length : v;
 }
 
-bool key(GLFWwindow* window, int k) { return glfwGetKey(window, k) == GLFW_PRESS; }
+bool key(GLFWwindow* window, int k) {
+  return glfwGetKey(window, k) == GLFW_PRESS;
+}
 
 }  // namespace
 

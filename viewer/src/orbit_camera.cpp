@@ -46,7 +46,8 @@ CameraMatrices OrbitCamera::matrices(int width, int height) const {
   CameraMatrices m;
   m.eye = eye();
   m.view = glm::lookAt(m.eye, target, glm::vec3(0.0f, 1.0f, 0.0f));
-  const float aspect = static_cast<float>(std::max(width, 1)) / static_cast<float>(std::max(height, 1));
+  const float aspect =
+      static_cast<float>(std::max(width, 1)) / static_cast<float>(std::max(height, 1));
   m.projection = glm::perspective(fov_y, aspect, 0.05f, 200.0f);
   return m;
 }

@@ -10,10 +10,10 @@
 namespace mm::viewer {
 
 struct OrbitCamera {
-  float yaw = 0.0f;        // radians about +Y
-  float pitch = 0.30f;     // radians looking down, in [kMinPitch, kMaxPitch]
-  float distance = 3.6f;   // metres from the target, in [kMinDistance, kMaxDistance]
-  float fov_y = 0.75f;     // radians
+  float yaw = 0.0f;       // radians about +Y
+  float pitch = 0.30f;    // radians looking down, in [kMinPitch, kMaxPitch]
+  float distance = 3.6f;  // metres from the target, in [kMinDistance, kMaxDistance]
+  float fov_y = 0.75f;    // radians
   glm::vec3 target{0.0f, 0.9f, 0.0f};
   glm::vec3 target_velocity{0.0f};  // of the spring that follows the character
 

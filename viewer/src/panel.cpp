@@ -57,9 +57,12 @@ void last_search(const Scene& scene) {
 void settings(Scene& scene, PanelState& state) {
   ControllerSettings s = scene.controller().settings();
   bool changed = false;
-  changed |= ImGui::SliderFloat("velocity halflife", &s.simulation_velocity_halflife, 0.05f, 1.0f, "%.2f s");
-  changed |= ImGui::SliderFloat("rotation halflife", &s.simulation_rotation_halflife, 0.05f, 1.0f, "%.2f s");
-  changed |= ImGui::SliderFloat("inertialization", &s.inertialization_halflife, 0.02f, 0.5f, "%.2f s");
+  changed |= ImGui::SliderFloat("velocity halflife", &s.simulation_velocity_halflife, 0.05f, 1.0f,
+                                "%.2f s");
+  changed |= ImGui::SliderFloat("rotation halflife", &s.simulation_rotation_halflife, 0.05f, 1.0f,
+                                "%.2f s");
+  changed |=
+      ImGui::SliderFloat("inertialization", &s.inertialization_halflife, 0.02f, 0.5f, "%.2f s");
   changed |= ImGui::SliderFloat("adjustment", &s.adjustment_halflife, 0.02f, 0.5f, "%.2f s");
   changed |= ImGui::SliderFloat("search interval", &s.search_interval, 0.02f, 0.5f, "%.2f s");
   changed |= ImGui::SliderFloat("transition cost", &s.transition_cost, 0.0f, 5.0f, "%.2f");
@@ -84,8 +87,9 @@ void settings(Scene& scene, PanelState& state) {
 
 void feature_weights(Scene& scene, PanelState& state) {
   const FeatureSchema& schema = scene.database().schema;
-  ImGui::TextWrapped("A new weight rebuilds the normalized features and the search, and starts "
-                     "the character again where it stands.");
+  ImGui::TextWrapped(
+      "A new weight rebuilds the normalized features and the search, and starts "
+      "the character again where it stands.");
   for (int c = 0; c < static_cast<int>(schema.channels.size()); ++c) {
     float weight = schema.channels[c].weight;
     ImGui::SliderFloat(schema.channels[c].name.c_str(), &weight, 0.05f, 5.0f, "%.2f",
@@ -99,7 +103,8 @@ void feature_weights(Scene& scene, PanelState& state) {
 
 void body(Scene& scene, PanelState& state) {
   int skinning = state.skinning == SkinningMethod::LinearBlend ? 0 : 1;
-  if (ImGui::RadioButton("linear blend", &skinning, 0)) state.skinning = SkinningMethod::LinearBlend;
+  if (ImGui::RadioButton("linear blend", &skinning, 0))
+    state.skinning = SkinningMethod::LinearBlend;
   ImGui::SameLine();
   if (ImGui::RadioButton("dual quaternion", &skinning, 1)) {
     state.skinning = SkinningMethod::DualQuaternion;
@@ -162,7 +167,8 @@ void draw_panel(Scene& scene, PanelState& state) {
   if (ImGui::CollapsingHeader("settings")) settings(scene, state);
   if (ImGui::CollapsingHeader("feature weights")) feature_weights(scene, state);
   if (ImGui::CollapsingHeader("body", ImGuiTreeNodeFlags_DefaultOpen)) body(scene, state);
-  if (ImGui::CollapsingHeader("debug drawing", ImGuiTreeNodeFlags_DefaultOpen)) debug_toggles(scene);
+  if (ImGui::CollapsingHeader("debug drawing", ImGuiTreeNodeFlags_DefaultOpen))
+    debug_toggles(scene);
   if (ImGui::CollapsingHeader("run", ImGuiTreeNodeFlags_DefaultOpen)) recording(scene, state);
   if (!state.message.empty()) ImGui::TextWrapped("%s", state.message.c_str());
   ImGui::End();

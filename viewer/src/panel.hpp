@@ -19,8 +19,8 @@ struct PanelState {
   float time_scale = 1.0f;
   InputRecorder* recorder = nullptr;  // null: no recording (replaying a script)
   std::string record_path;
-  std::string input_source;           // "gamepad: ...", "keyboard and mouse", "script: FILE"
-  std::string message;                // the outcome of the last action, shown until replaced
+  std::string input_source;  // "gamepad: ...", "keyboard and mouse", "script: FILE"
+  std::string message;       // the outcome of the last action, shown until replaced
 };
 
 void draw_panel(Scene& scene, PanelState& state);

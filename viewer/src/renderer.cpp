@@ -144,7 +144,9 @@ Result<GLuint> link(const char* vertex, const char* fragment, const char* name) 
   return Error{std::string("renderer: the ") + name + " program does not link: " + log};
 }
 
-GLint uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+GLint uniform(GLuint program, const char* name) {
+  return glGetUniformLocation(program, name);
+}
 
 void set_matrix(GLuint program, const char* name, const glm::mat4& m) {
   glUniformMatrix4fv(uniform(program, name), 1, GL_FALSE, glm::value_ptr(m));
@@ -216,7 +218,9 @@ Status Renderer::build() {
   return Status::success();
 }
 
-Renderer::Renderer(Renderer&& other) noexcept { *this = std::move(other); }
+Renderer::Renderer(Renderer&& other) noexcept {
+  *this = std::move(other);
+}
 
 Renderer& Renderer::operator=(Renderer&& other) noexcept {
   if (this == &other) return *this;
@@ -236,7 +240,9 @@ Renderer& Renderer::operator=(Renderer&& other) noexcept {
   return *this;
 }
 
-Renderer::~Renderer() { release(); }
+Renderer::~Renderer() {
+  release();
+}
 
 void Renderer::release() {
   // Zero names are silently ignored by glDelete*, so a moved-from renderer frees nothing.
@@ -321,8 +327,7 @@ void Renderer::draw_body(const CameraMatrices& camera, std::span<const glm::vec3
   glBindVertexArray(0);
 }
 
-void Renderer::draw_lines(const CameraMatrices& camera, const DebugLines& lines,
-                          bool over_scene) {
+void Renderer::draw_lines(const CameraMatrices& camera, const DebugLines& lines, bool over_scene) {
   const auto& vertices = lines.vertices();
   if (vertices.empty()) return;
   glBindVertexArray(line_vao_);

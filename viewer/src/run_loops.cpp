@@ -115,9 +115,10 @@ void print_summary(const Scene& scene, double wall_seconds) {
   const ControllerDebug& d = scene.controller().debug();
   std::printf("run:         %zu frames, %.2f s of game time in %.2f s of wall time\n", run.size(),
               scene.time(), wall_seconds);
-  std::printf("character:   walked %.2f m, %d transitions (%.2f per s), %d of %zu frames standing\n",
-              walked, transitions, scene.time() > 0 ? transitions / scene.time() : 0.0, standing,
-              run.size());
+  std::printf(
+      "character:   walked %.2f m, %d transitions (%.2f per s), %d of %zu frames standing\n",
+      walked, transitions, scene.time() > 0 ? transitions / scene.time() : 0.0, standing,
+      run.size());
   std::printf("controller:  %d searches, update %.1f us and search %.1f us (running means)\n",
               d.searches, scene.times().update * 1e6, scene.times().search * 1e6);
 }
@@ -127,8 +128,8 @@ void print_character_box(const Stage& stage, const Scene& scene) {
   int width = 0, height = 0;
   stage.context->framebuffer_size(width, height);
   const glm::vec4 box = scene.screen_box(stage.camera, width, height);
-  std::printf("character in the last screenshot: pixels x %.0f..%.0f, y %.0f..%.0f\n", box.x,
-              box.z, box.y, box.w);
+  std::printf("character in the last screenshot: pixels x %.0f..%.0f, y %.0f..%.0f\n", box.x, box.z,
+              box.y, box.w);
 }
 
 Status write_plot(const ViewerOptions& options, const Scene& scene) {
@@ -149,7 +150,8 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
     return 1;
   }
   Stage stage;
-  Result<std::unique_ptr<GlContext>> context = GlContext::create_headless(options.width, options.height);
+  Result<std::unique_ptr<GlContext>> context =
+      GlContext::create_headless(options.width, options.height);
   if (!context) {
     std::fprintf(stderr, "mm-viewer: %s\n", context.message().c_str());
     return 1;
@@ -188,7 +190,8 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
     }
     ++written;
   }
-  print_summary(scene, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  print_summary(scene,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   if (written > 0) {
     std::printf("wrote %d screenshot%s, the last as %s\n", written, written > 1 ? "s" : "",
                 options.screenshot_path.c_str());
@@ -242,7 +245,8 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
   Result<std::unique_ptr<GlContext>> context =
       GlContext::create_window(options.width, options.height, "mm-viewer");
   if (!context) {
-    std::fprintf(stderr, "mm-viewer: %s (without a display, use --headless)\n", context.message().c_str());
+    std::fprintf(stderr, "mm-viewer: %s (without a display, use --headless)\n",
+                 context.message().c_str());
     return 1;
   }
   stage.context = std::move(*context);
@@ -256,7 +260,8 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
   InputRecorder recorder;
   if (!script) {
     stage.panel.recorder = &recorder;
-    stage.panel.record_path = options.record_path.empty() ? "mm-viewer-input.txt" : options.record_path;
+    stage.panel.record_path =
+        options.record_path.empty() ? "mm-viewer-input.txt" : options.record_path;
     if (!options.record_path.empty()) recorder.start(0.0f);
   }
 
@@ -280,8 +285,9 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
       input = script->at(scene.time());
       stage.camera.yaw = input.camera_yaw;
     }
-    const float dt = stage.panel.paused ? 0.0f
-                                        : (options.dt > 0.0f ? options.dt : wall_dt) * stage.panel.time_scale;
+    const float dt = stage.panel.paused
+                         ? 0.0f
+                         : (options.dt > 0.0f ? options.dt : wall_dt) * stage.panel.time_scale;
     if (dt > 0.0f) {
       // Stamped with the time it takes effect, as a script's line is read (script.hpp).
       recorder.record(scene.time(), input);
@@ -292,9 +298,10 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
     ++frame;
     const bool done = options.frames > 0 && frame >= options.frames;
     if (keys.screenshot || (done && !options.screenshot_path.empty())) {
-      const std::string path = done && !options.screenshot_path.empty()
-                                   ? options.screenshot_path
-                                   : "mm-viewer-" + std::to_string(static_cast<long>(now * 1000)) + ".png";
+      const std::string path =
+          done && !options.screenshot_path.empty()
+              ? options.screenshot_path
+              : "mm-viewer-" + std::to_string(static_cast<long>(now * 1000)) + ".png";
       const Status s = save_screenshot(*stage.context, path);
       stage.panel.message = s ? "saved " + path : s.message();
       std::printf("mm-viewer: %s\n", stage.panel.message.c_str());
@@ -307,8 +314,9 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
   int code = 0;
   if (recorder.active()) {
     const Status s = recorder.save(stage.panel.record_path);
-    std::printf("mm-viewer: %s\n", s ? ("recorded the input into " + stage.panel.record_path).c_str()
-                                     : s.message().c_str());
+    std::printf(
+        "mm-viewer: %s\n",
+        s ? ("recorded the input into " + stage.panel.record_path).c_str() : s.message().c_str());
     if (!s) code = 1;
   }
   if (Status s = write_plot(options, scene); !s) {

@@ -1,7 +1,7 @@
 #include "scene.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "mm/runtime/interpolation.hpp"
@@ -16,8 +16,8 @@ void smooth(float& mean, float sample, float frames = 60.0f) {
   mean += (sample - mean) / frames;
 }
 
-Result<std::unique_ptr<Controller>> make_controller(std::shared_ptr<const ControllerDatabase> shared,
-                                                    const ControllerSettings& settings) {
+Result<std::unique_ptr<Controller>> make_controller(
+    std::shared_ptr<const ControllerDatabase> shared, const ControllerSettings& settings) {
   Result<Controller> controller = Controller::create(std::move(shared), settings);
   if (!controller) return controller.error();
   return std::make_unique<Controller>(std::move(*controller));
@@ -26,9 +26,8 @@ Result<std::unique_ptr<Controller>> make_controller(std::shared_ptr<const Contro
 }  // namespace
 
 Result<std::unique_ptr<Scene>> Scene::create(std::shared_ptr<const Database> database,
-                                             const ControllerSettings& settings,
-                                             SkinnedMesh body, WeightMethod body_weights,
-                                             ReweighFunction reweigh) {
+                                             const ControllerSettings& settings, SkinnedMesh body,
+                                             WeightMethod body_weights, ReweighFunction reweigh) {
   if (!body.bind_global.empty() &&
       body.bind_global.size() != static_cast<size_t>(database->joint_count())) {
     return Error{"viewer: the body has " + std::to_string(body.bind_global.size()) +
@@ -149,7 +148,8 @@ Status Scene::set_channel_weight(int channel, float weight) {
   Result<std::shared_ptr<const ControllerDatabase>> shared =
       ControllerDatabase::create(reweighted, shared_->options());
   if (!shared) return Error{shared.message()};
-  Result<std::unique_ptr<Controller>> controller = make_controller(*shared, controller_->settings());
+  Result<std::unique_ptr<Controller>> controller =
+      make_controller(*shared, controller_->settings());
   if (!controller) return Error{controller.message()};
   const Transform root = controller_->root_transform();
   (*controller)->teleport(root.translation, quat_yaw(root.rotation));

@@ -32,9 +32,8 @@ struct FrameTimes {
 class Scene {
  public:
   static Result<std::unique_ptr<Scene>> create(std::shared_ptr<const Database> database,
-                                               const ControllerSettings& settings,
-                                               SkinnedMesh body, WeightMethod body_weights,
-                                               ReweighFunction reweigh);
+                                               const ControllerSettings& settings, SkinnedMesh body,
+                                               WeightMethod body_weights, ReweighFunction reweigh);
 
   // One controller update (timed), the body's skinning and the run's sample.
   void step(float dt, const ControllerInput& input, SkinningMethod skinning);

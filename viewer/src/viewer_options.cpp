@@ -76,25 +76,38 @@ bool parse_debug(const std::string& text, DebugToggles& toggles) {
   std::stringstream list(text);
   std::string item;
   while (std::getline(list, item, ',')) {
-    if (item == "trajectory") toggles.trajectory = true;
-    else if (item == "roots") toggles.roots = true;
-    else if (item == "features") toggles.features = true;
-    else if (item == "contacts") toggles.contacts = true;
-    else if (item == "skeleton") toggles.skeleton = true;
-    else if (item != "none") return false;
+    if (item == "trajectory")
+      toggles.trajectory = true;
+    else if (item == "roots")
+      toggles.roots = true;
+    else if (item == "features")
+      toggles.features = true;
+    else if (item == "contacts")
+      toggles.contacts = true;
+    else if (item == "skeleton")
+      toggles.skeleton = true;
+    else if (item != "none")
+      return false;
   }
   return true;
 }
 
 // Options that take a value; returns an exit code, or -1 when the value was taken.
 int parse_valued(const std::string& a, const std::string& v, ViewerOptions& out) {
-  if (a == "--db") out.db_path = v;
-  else if (a == "--data") out.data_path = v;
-  else if (a == "--body") out.body_path = v;
-  else if (a == "--script") out.script_path = v;
-  else if (a == "--record") out.record_path = v;
-  else if (a == "--screenshot") out.screenshot_path = v;
-  else if (a == "--plot") out.plot_path = v;
+  if (a == "--db")
+    out.db_path = v;
+  else if (a == "--data")
+    out.data_path = v;
+  else if (a == "--body")
+    out.body_path = v;
+  else if (a == "--script")
+    out.script_path = v;
+  else if (a == "--record")
+    out.record_path = v;
+  else if (a == "--screenshot")
+    out.screenshot_path = v;
+  else if (a == "--plot")
+    out.plot_path = v;
   else if (a == "--weights") {
     const auto method = parse_weight_method(v);
     if (!method) return usage_error("--weights needs distance, envelope, heat or geodesic");
@@ -132,12 +145,14 @@ int parse_valued(const std::string& a, const std::string& v, ViewerOptions& out)
 }
 
 int check(const ViewerOptions& out) {
-  if (!out.db_path.empty() && !out.data_path.empty()) return usage_error("give --db or --data, not both");
+  if (!out.db_path.empty() && !out.data_path.empty())
+    return usage_error("give --db or --data, not both");
   if (out.headless && out.script_path.empty()) return usage_error("--headless needs --script");
   if (!out.script_path.empty() && !out.record_path.empty()) {
     return usage_error("--record records live input; it cannot be used with --script");
   }
-  if (out.every > 0 && out.screenshot_path.empty()) return usage_error("--every needs --screenshot");
+  if (out.every > 0 && out.screenshot_path.empty())
+    return usage_error("--every needs --screenshot");
   if (Status s = out.settings.validate(); !s) return usage_error(s.message());
   return -1;
 }

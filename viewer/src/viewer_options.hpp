@@ -23,7 +23,7 @@ struct ViewerOptions {
   bool headless = false;
   int frames = 0;  // 0: windowed runs until closed; headless runs the script and 2 s more
   std::string screenshot_path;
-  int every = 0;   // also a screenshot every K frames
+  int every = 0;  // also a screenshot every K frames
   std::string plot_path;
   int width = 1280, height = 720;
   float dt = 0.0f;  // seconds per update; 0: the wall clock (windowed), 1/60 (headless)

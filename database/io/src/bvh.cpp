@@ -1,4 +1,4 @@
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -42,7 +42,9 @@ inline bool is_space(char c) {
 inline bool is_line_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
-inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
+inline bool is_digit(char c) {
+  return static_cast<unsigned char>(c - '0') < 10;
+}
 
 enum class NumberStatus { kOk, kNotANumber, kOutOfRange, kNotFinite };
 
@@ -138,10 +140,14 @@ NumberStatus parse_number_token(std::string_view token, float& out) {
 
 const char* describe_status(NumberStatus status) {
   switch (status) {
-    case NumberStatus::kNotANumber: return "a number";
-    case NumberStatus::kOutOfRange: return "a number within float range";
-    case NumberStatus::kNotFinite: return "a finite number";
-    case NumberStatus::kOk: break;
+    case NumberStatus::kNotANumber:
+      return "a number";
+    case NumberStatus::kOutOfRange:
+      return "a number within float range";
+    case NumberStatus::kNotFinite:
+      return "a finite number";
+    case NumberStatus::kOk:
+      break;
   }
   return "a number";
 }
@@ -149,12 +155,12 @@ const char* describe_status(NumberStatus status) {
 // How one joint's channels map into a frame's values, precomputed from its CHANNELS line so
 // the per-frame work is a few indexed loads and one quaternion product per rotation channel.
 struct JointLayout {
-  int first_value = 0;                      // index of the joint's first channel in a frame
-  int8_t position_slot[3] = {-1, -1, -1};   // per axis X, Y, Z: channel offset, or -1
-  int8_t rotation_slot[3] = {-1, -1, -1};   // k-th listed rotation channel: channel offset
-  int8_t rotation_axis[3] = {0, 0, 0};      // k-th listed rotation channel: axis 0, 1 or 2
+  int first_value = 0;                     // index of the joint's first channel in a frame
+  int8_t position_slot[3] = {-1, -1, -1};  // per axis X, Y, Z: channel offset, or -1
+  int8_t rotation_slot[3] = {-1, -1, -1};  // k-th listed rotation channel: channel offset
+  int8_t rotation_axis[3] = {0, 0, 0};     // k-th listed rotation channel: axis 0, 1 or 2
   int8_t rotation_count = 0;
-  glm::vec3 offset{0.0f};                   // OFFSET in metres
+  glm::vec3 offset{0.0f};  // OFFSET in metres
 };
 
 // One open '{' of the hierarchy: the explicit stack that replaces recursion.
@@ -166,12 +172,16 @@ struct OpenJoint {
 class BvhParser {
  public:
   BvhParser(std::string_view text, std::string_view path, const BvhOptions& options)
-      : p_(text.data()), end_(text.data() + text.size()), text_size_(text.size()), path_(path),
+      : p_(text.data()),
+        end_(text.data() + text.size()),
+        text_size_(text.size()),
+        path_(path),
         scale_(options.scale) {}
 
   Result<Clip> run() {
     if (!std::isfinite(scale_) || !(scale_ > 0.0f)) {
-      return Error{std::string(path_) + ": expected BvhOptions::scale to be finite and > 0, found " +
+      return Error{std::string(path_) +
+                   ": expected BvhOptions::scale to be finite and > 0, found " +
                    std::to_string(scale_)};
     }
     if (auto error = parse_hierarchy()) return std::move(*error);
@@ -228,8 +238,8 @@ class BvhParser {
   MaybeError expect_keyword(std::string_view keyword, const Context& context) {
     const std::string_view token = next_token();
     if (token == keyword) return nullptr;
-    return fail(token_line_, "expected '" + std::string(keyword) + "' " + context() +
-                                 ", found " + describe(token));
+    return fail(token_line_, "expected '" + std::string(keyword) + "' " + context() + ", found " +
+                                 describe(token));
   }
 
   // Reads the OFFSET line of `owner` (a callable naming the joint or End Site, for messages).
@@ -241,9 +251,9 @@ class BvhParser {
       float value = 0.0f;
       const NumberStatus status = parse_number_token(token, value);
       if (status != NumberStatus::kOk) {
-        return fail(token_line_, "expected OFFSET value " + std::to_string(axis + 1) +
-                                     " of 3 of " + owner() + " (" + describe_status(status) +
-                                     "), found " + describe(token));
+        return fail(token_line_, "expected OFFSET value " + std::to_string(axis + 1) + " of 3 of " +
+                                     owner() + " (" + describe_status(status) + "), found " +
+                                     describe(token));
       }
       offset[axis] = value * scale_;
       if (!std::isfinite(offset[axis])) {
@@ -281,8 +291,8 @@ class BvhParser {
                                    "', found " + describe(name));
     }
     if (static_cast<int>(names_.size()) >= kMaxJoints) {
-      return fail(token_line_, "expected at most " + std::to_string(kMaxJoints) +
-                                   " joints, found more");
+      return fail(token_line_,
+                  "expected at most " + std::to_string(kMaxJoints) + " joints, found more");
     }
     const int joint = static_cast<int>(names_.size());
     auto [it, inserted] = joint_lines_.emplace(name, token_line_);
@@ -304,8 +314,9 @@ class BvhParser {
     int64_t count = -1;
     auto [ptr, ec] =
         std::from_chars(count_token.data(), count_token.data() + count_token.size(), count);
-    if (count_token.empty() || ec != std::errc() || ptr != count_token.data() + count_token.size() ||
-        count < 0 || count > kMaxChannelsPerJoint) {
+    if (count_token.empty() || ec != std::errc() ||
+        ptr != count_token.data() + count_token.size() || count < 0 ||
+        count > kMaxChannelsPerJoint) {
       return fail(token_line_, "expected a channel count from 0 to 6 after 'CHANNELS' of " +
                                    owner() + ", found " + describe(count_token));
     }
@@ -317,15 +328,15 @@ class BvhParser {
       if (index < 0) {
         if (channel.empty() || is_structure_keyword(channel)) {
           return fail(channels_line, "expected " + std::to_string(count) +
-                                         " channel names after 'CHANNELS " +
-                                         std::to_string(count) + "' of " + owner() +
-                                         ", found only " + std::to_string(slot) + " before " +
-                                         describe(channel) + " on line " +
-                                         std::to_string(token_line_));
+                                         " channel names after 'CHANNELS " + std::to_string(count) +
+                                         "' of " + owner() + ", found only " +
+                                         std::to_string(slot) + " before " + describe(channel) +
+                                         " on line " + std::to_string(token_line_));
         }
-        return fail(token_line_, "expected a channel name (Xposition, Yposition, Zposition, "
-                                 "Xrotation, Yrotation or Zrotation) for " + owner() +
-                                     ", found " + describe(channel));
+        return fail(token_line_,
+                    "expected a channel name (Xposition, Yposition, Zposition, "
+                    "Xrotation, Yrotation or Zrotation) for " +
+                        owner() + ", found " + describe(channel));
       }
       if (seen[index]) {
         return fail(token_line_, "expected each channel at most once in " + owner() + ", found " +
@@ -367,8 +378,8 @@ class BvhParser {
   }
 
   MaybeError parse_hierarchy() {
-    if (auto error = expect_keyword("HIERARCHY",
-                                    [] { return std::string("at the start of a BVH file"); })) {
+    if (auto error =
+            expect_keyword("HIERARCHY", [] { return std::string("at the start of a BVH file"); })) {
       return error;
     }
     std::string_view token = next_token();
@@ -402,9 +413,10 @@ class BvhParser {
       token = next_token();
       if (token == "MOTION") break;
       if (token != "ROOT") {
-        return fail(token_line_, "expected 'MOTION' (or another 'ROOT') after the hierarchy, "
-                                 "found " + describe(token) +
-                                     (token == "}" ? " (unbalanced braces)" : ""));
+        return fail(token_line_,
+                    "expected 'MOTION' (or another 'ROOT') after the hierarchy, "
+                    "found " +
+                        describe(token) + (token == "}" ? " (unbalanced braces)" : ""));
       }
     }
     motion_line_ = token_line_;
@@ -425,8 +437,8 @@ class BvhParser {
         std::from_chars(count_token.data(), count_token.data() + count_token.size(), count);
     const bool whole = !count_token.empty() && ptr == count_token.data() + count_token.size();
     if (!whole || ec == std::errc::invalid_argument) {
-      return fail(token_line_,
-                  "expected a whole number of frames after 'Frames:', found " + describe(count_token));
+      return fail(token_line_, "expected a whole number of frames after 'Frames:', found " +
+                                   describe(count_token));
     }
     if (ec == std::errc::result_out_of_range || count > std::numeric_limits<int>::max()) {
       return fail(token_line_, "expected at most " +
@@ -434,8 +446,8 @@ class BvhParser {
                                    " frames after 'Frames:', found " + describe(count_token));
     }
     if (count <= 0) {
-      return fail(token_line_,
-                  "expected a positive frame count after 'Frames:', found " + describe(count_token));
+      return fail(token_line_, "expected a positive frame count after 'Frames:', found " +
+                                   describe(count_token));
     }
     declared_frames_ = static_cast<int>(count);
 
@@ -448,8 +460,10 @@ class BvhParser {
     const std::string_view time_token = next_token();
     const NumberStatus status = parse_number_token(time_token, frame_time_);
     if (status != NumberStatus::kOk || !(frame_time_ > 0.0f)) {
-      return fail(token_line_, "expected a positive frame time in seconds after 'Frame Time:', "
-                               "found " + describe(time_token));
+      return fail(token_line_,
+                  "expected a positive frame time in seconds after 'Frame Time:', "
+                  "found " +
+                      describe(time_token));
     }
     // Frames start on the next line: anything else on this one is a format error.
     while (p_ < end_ && is_line_space(*p_)) ++p_;
@@ -472,12 +486,12 @@ class BvhParser {
         std::min(static_cast<size_t>(declared_frames_), max_frames_in_text);
     const size_t reserve_transforms = reserve_frames * static_cast<size_t>(joint_count);
     if (reserve_transforms > kMaxTransformsPerByte * text_size_ + kTransformAllowance) {
-      return fail(motion_line_,
-                  "expected at most " + std::to_string(kMaxTransformsPerByte) +
-                      " joint transforms per byte of the file, found " +
-                      std::to_string(joint_count) + " joints but only " +
-                      std::to_string(value_count) + " channels per frame for up to " +
-                      std::to_string(reserve_frames) + " frames (too many joints without channels)");
+      return fail(motion_line_, "expected at most " + std::to_string(kMaxTransformsPerByte) +
+                                    " joint transforms per byte of the file, found " +
+                                    std::to_string(joint_count) + " joints but only " +
+                                    std::to_string(value_count) + " channels per frame for up to " +
+                                    std::to_string(reserve_frames) +
+                                    " frames (too many joints without channels)");
     }
     local_.resize(reserve_transforms);
     std::vector<float> values(static_cast<size_t>(value_count));
@@ -592,9 +606,15 @@ class BvhParser {
         // Right-multiplying by the axis quaternion applies the listed order: R = R1 * R2 * R3.
         const float w = rotation.w, x = rotation.x, y = rotation.y, z = rotation.z;
         switch (layout.rotation_axis[k]) {
-          case 0: rotation = glm::quat(w * c - x * s, x * c + w * s, y * c + z * s, z * c - y * s); break;
-          case 1: rotation = glm::quat(w * c - y * s, x * c - z * s, y * c + w * s, z * c + x * s); break;
-          default: rotation = glm::quat(w * c - z * s, x * c + y * s, y * c - x * s, z * c + w * s); break;
+          case 0:
+            rotation = glm::quat(w * c - x * s, x * c + w * s, y * c + z * s, z * c - y * s);
+            break;
+          case 1:
+            rotation = glm::quat(w * c - y * s, x * c - z * s, y * c + w * s, z * c + x * s);
+            break;
+          default:
+            rotation = glm::quat(w * c - z * s, x * c + y * s, y * c - x * s, z * c + w * s);
+            break;
         }
       }
       t.rotation = rotation;
@@ -604,8 +624,10 @@ class BvhParser {
       for (size_t j = 0; j < joint_count; ++j) {
         const glm::vec3& tr = out[j].translation;
         if (!std::isfinite(tr.x) || !std::isfinite(tr.y) || !std::isfinite(tr.z)) {
-          return fail(line, "expected position values that stay finite in metres, found an "
-                            "overflow for joint " + describe(names_[j]));
+          return fail(line,
+                      "expected position values that stay finite in metres, found an "
+                      "overflow for joint " +
+                          describe(names_[j]));
         }
       }
     }
@@ -615,7 +637,8 @@ class BvhParser {
   Result<Clip> build_clip() {
     std::vector<Transform> rest(layouts_.size());
     for (size_t j = 0; j < layouts_.size(); ++j) rest[j].translation = layouts_[j].offset;
-    Result<Skeleton> skeleton = Skeleton::create(std::move(names_), std::move(parents_), std::move(rest));
+    Result<Skeleton> skeleton =
+        Skeleton::create(std::move(names_), std::move(parents_), std::move(rest));
     if (!skeleton) return Error{std::string(path_) + ": " + skeleton.message()};
     Clip clip;
     clip.name = std::filesystem::path(path_).stem().string();
@@ -667,7 +690,8 @@ namespace {
 
 Result<Clip> read_and_parse(const std::filesystem::path& path, const std::string& name,
                             const BvhOptions& options) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"), &std::fclose);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
+                                                       &std::fclose);
   if (!file) {
     return Error{name + ": cannot open the file for reading (" + std::strerror(errno) + ")"};
   }

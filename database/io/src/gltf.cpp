@@ -1,4 +1,4 @@
-#include "mm/database/gltf.hpp"
+#include "mm/database/io/gltf.hpp"
 
 #include <tiny_gltf.h>
 

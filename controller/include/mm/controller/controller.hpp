@@ -131,7 +131,7 @@ struct ControllerSettings {
 
   // ---- Simulation object (halflives as in spring.hpp: a spring at rest closes half the
   // distance to its goal in one halflife).
-  float simulation_velocity_halflife = 0.3f;  // s
+  float simulation_velocity_halflife = 0.3f;   // s
   float simulation_rotation_halflife = 0.15f;  // s
 
   // ---- Matching.
@@ -174,8 +174,8 @@ struct ControllerSettings {
   float clamp_max_angle = 0.6f;
 
   // ---- Foot locking and IK.
-  bool ik_enabled = true;        // false: the animation's feet as they are
-  bool foot_lock_enabled = true; // hold a foot's toe where it landed while in contact
+  bool ik_enabled = true;         // false: the animation's feet as they are
+  bool foot_lock_enabled = true;  // hold a foot's toe where it landed while in contact
   // A locked toe is released when the animation drags it farther than this (m), or out of the
   // leg's reach; during a contact it then steps (lifted) to the animation.
   float foot_unlock_radius = 0.5f;
@@ -207,8 +207,8 @@ inline constexpr int kMaxDebugChannels = 16;
 // What a debug drawing, a panel or an evaluation reads after update().
 struct ControllerDebug {
   // Desired motion.
-  glm::vec3 desired_velocity{0.0f};                       // m/s, world
-  glm::quat desired_rotation{1.0f, 0.0f, 0.0f, 0.0f};     // the desired facing
+  glm::vec3 desired_velocity{0.0f};                    // m/s, world
+  glm::quat desired_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // the desired facing
   // The simulation object.
   glm::vec3 simulation_position{0.0f};
   glm::vec3 simulation_velocity{0.0f};
@@ -233,11 +233,11 @@ struct ControllerDebug {
   bool standing = false;      // the desired speed is zero
 
   // The last search.
-  int searches = 0;                   // since create()
-  bool searched = false;              // this update searched
-  float search_seconds = 0.0f;        // wall time of this update's search (0 when none)
+  int searches = 0;             // since create()
+  bool searched = false;        // this update searched
+  float search_seconds = 0.0f;  // wall time of this update's search (0 when none)
   int channel_count = 0;
-  float last_cost = 0.0f;             // the chosen candidate's cost (transition cost included)
+  float last_cost = 0.0f;  // the chosen candidate's cost (transition cost included)
   float last_channel_costs[kMaxDebugChannels] = {};
   int last_best_frame = -1;
   static constexpr int kMaxQueryDims = 64;
@@ -245,10 +245,10 @@ struct ControllerDebug {
   float last_query[kMaxQueryDims] = {};  // normalized; the first kMaxQueryDims columns
 
   // Feet: 0 left, 1 right.
-  bool contact[2] = {false, false};     // the playing frame's contact, false while stepping
-  bool locked[2] = {false, false};      // the toe is held by the foot lock
-  glm::vec3 lock_position[2] = {};      // where a locked toe is held
-  glm::vec3 ik_target[2] = {};          // where IK put the toe (equals the animation when free)
+  bool contact[2] = {false, false};  // the playing frame's contact, false while stepping
+  bool locked[2] = {false, false};   // the toe is held by the foot lock
+  glm::vec3 lock_position[2] = {};   // where a locked toe is held
+  glm::vec3 ik_target[2] = {};       // where IK put the toe (equals the animation when free)
 };
 
 class Controller {
@@ -322,7 +322,8 @@ class Controller {
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
   void refresh_subtree(int joint);
-  float leg_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of a joint and its descendants from the locals
+  float leg_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of a
+                                     // joint and its descendants from the locals
   void finish_pose();
   void refresh_outputs(float dt);
   uint64_t resolve_tag(std::string_view tag) const;
@@ -336,13 +337,14 @@ class Controller {
   // Schema facts resolved at create().
   std::vector<float> trajectory_times_;  // unique trajectory times of the schema (s)
   struct TrajectoryColumn {
-    int column = 0;       // first column in the feature row
-    int time_index = 0;   // index into trajectory_times_
+    int column = 0;      // first column in the feature row
+    int time_index = 0;  // index into trajectory_times_
     bool direction = false;
   };
   std::vector<TrajectoryColumn> trajectory_columns_;
   std::vector<int> leg_joints_[2];
-  std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)  // upper leg, lower leg, foot, toe per side
+  std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)  //
+                                    // upper leg, lower leg, foot, toe per side
 
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
@@ -378,7 +380,7 @@ class Controller {
   std::vector<Transform> other_;  // the other side of a transition
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;
-  std::vector<Transform> locals_;  // displayed: inertialized, adjusted, with IK
+  std::vector<Transform> locals_;       // displayed: inertialized, adjusted, with IK
   glm::vec3 displayed_velocity_{0.0f};  // of the root
   glm::vec3 displayed_angular_velocity_{0.0f};
   std::vector<Transform> globals_;
@@ -389,10 +391,10 @@ class Controller {
   // Foot locks: 0 left, 1 right.
   struct FootLock {
     bool locked = false;
-    glm::vec3 position{0.0f};        // the held toe position
-    glm::vec3 offset{0.0f};          // target - (lock point or animation), decaying
+    glm::vec3 position{0.0f};  // the held toe position
+    glm::vec3 offset{0.0f};    // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
-    glm::vec3 target{0.0f};          // the toe's target last update (without a step's lift)
+    glm::vec3 target{0.0f};  // the toe's target last update (without a step's lift)
     bool has_target = false;
     bool previous_contact = false;
     bool stepping = false;  // released during a contact: stepping, in the air until it lands

@@ -22,20 +22,20 @@ InputScript varied_input_script(uint32_t seed, float seconds);
 
 struct CrowdOptions {
   int characters = 100;
-  float seconds = 10.0f;   // of game time
+  float seconds = 10.0f;  // of game time
   float dt = 1.0f / 60.0f;
-  int threads = 1;         // >= 1; characters are split into contiguous slices
+  int threads = 1;  // >= 1; characters are split into contiguous slices
   ControllerSettings settings;
 };
 
 struct CrowdResult {
   int threads = 0;
   int frames = 0;
-  double wall_seconds = 0.0;          // the whole run, all threads
-  double update_us_mean = 0.0;        // per character per frame (each update timed)
+  double wall_seconds = 0.0;    // the whole run, all threads
+  double update_us_mean = 0.0;  // per character per frame (each update timed)
   double update_us_p99 = 0.0;
-  double search_share = 0.0;          // time in search / time in update
-  double frame_ms_mean = 0.0;         // wall time per frame for the whole crowd
+  double search_share = 0.0;   // time in search / time in update
+  double frame_ms_mean = 0.0;  // wall time per frame for the whole crowd
   // Characters one frame of 1/60 s could update at this run's rate per character and thread
   // count: characters * (1/60 s) / frame time.
   int max_characters_60hz = 0;

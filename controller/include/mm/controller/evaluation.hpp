@@ -61,9 +61,9 @@ struct EvaluationMetrics {
   int stand_frames = 0;
   double transitions_per_s = 0.0;
   double transition_accel_ratio = 0.0;
-  double transition_accel_p99 = 0.0;  // m/s^2
-  double database_accel_p99 = 0.0;    // m/s^2, linear interpolation
-  double database_accel_p99_same_sampling = 0.0;    // m/s^2, the controller's sampling
+  double transition_accel_p99 = 0.0;              // m/s^2
+  double database_accel_p99 = 0.0;                // m/s^2, linear interpolation
+  double database_accel_p99_same_sampling = 0.0;  // m/s^2, the controller's sampling
   double transition_accel_ratio_same_sampling = 0.0;
   double search_us_mean = 0.0;
   double update_us_mean = 0.0;

@@ -26,10 +26,10 @@ namespace mm {
 
 // One line of a script.
 struct ScriptEvent {
-  float time = 0.0f;       // seconds
-  ControllerInput input;   // camera_yaw in radians; input.tag views `tag` below
-  std::string tag;         // owns the tag text (empty: none)
-  int line = 0;            // line number in the source, for messages
+  float time = 0.0f;      // seconds
+  ControllerInput input;  // camera_yaw in radians; input.tag views `tag` below
+  std::string tag;        // owns the tag text (empty: none)
+  int line = 0;           // line number in the source, for messages
 };
 
 class InputScript {

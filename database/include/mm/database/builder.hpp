@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "mm/database/bvh.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/clip.hpp"
 #include "mm/database/database.hpp"
 #include "mm/database/features.hpp"

@@ -14,9 +14,9 @@
 namespace mm {
 
 struct Clip {
-  std::string name;         // the source file's stem, e.g. "dataset-2_walk_normal_001"
-  std::string source_path;  // where it was read from (empty for generated clips)
-  Skeleton skeleton;        // depth-first joint order, rest transforms in metres
+  std::string name;                 // the source file's stem, e.g. "dataset-2_walk_normal_001"
+  std::string source_path;          // where it was read from (empty for generated clips)
+  Skeleton skeleton;                // depth-first joint order, rest transforms in metres
   float frame_time = 1.0f / 30.0f;  // seconds between frames, > 0
   int frame_count = 0;
   // frame_count * joint_count local transforms, frame-major: local[f * joint_count + j].

@@ -20,10 +20,10 @@ namespace mm {
 // One source take inside the database. Frames [start, end) belong to it; nothing is ever
 // matched or blended across a clip boundary.
 struct ClipRange {
-  std::string name;     // source file stem; mirrored copies end in "_mirror"
-  int start = 0;        // first database frame of the clip
-  int end = 0;          // one past the last frame
-  uint64_t tags = 0;    // bit i set when the clip carries Database::tag_names[i]
+  std::string name;   // source file stem; mirrored copies end in "_mirror"
+  int start = 0;      // first database frame of the clip
+  int end = 0;        // one past the last frame
+  uint64_t tags = 0;  // bit i set when the clip carries Database::tag_names[i]
   bool mirrored = false;
   int frame_count() const { return end - start; }
 };

@@ -52,7 +52,7 @@ inline constexpr uint32_t kDatabaseFormatVersion = 1;
 // byte order.
 inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
 // The 8 magic bytes at the start of every database file.
-inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M', 'M', 'D',
+inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M',  'M',  'D',
                                                                 '\r', '\n', 0x1A, '\n'};
 
 // The sections of a version-1 file, in the order they appear in the table and in the file.

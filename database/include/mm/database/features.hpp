@@ -21,12 +21,12 @@ enum class FeatureKind : uint8_t {
 };
 
 struct FeatureChannel {
-  std::string name;          // unique, e.g. "left_foot_position"
+  std::string name;  // unique, e.g. "left_foot_position"
   FeatureKind kind = FeatureKind::BonePosition;
   std::string bone;          // role or joint name for bone kinds (empty for trajectory kinds)
   std::vector<float> times;  // seconds relative to the frame, for trajectory kinds (may be < 0)
   glm::vec3 axis{0.0f, 0.0f, 1.0f};  // the bone-local axis for BoneDirection
-  float weight = 1.0f;       // > 0; larger means the channel matters more in the distance
+  float weight = 1.0f;               // > 0; larger means the channel matters more in the distance
 
   int dims() const;
 };

@@ -14,23 +14,23 @@ namespace mm {
 
 // What to generate.
 struct SyntheticSearchSpec {
-  int clip_count = 200;           // clips in total
-  int min_clip_frames = 60;       // shortest clip
-  int max_clip_frames = 300;      // longest clip
-  int dims = 27;                  // feature columns
-  float standing_fraction = 0.5f; // share of clips that are low-variance standing clips
-  int excluded_tail_frames = 30;  // last frames of each clip that are not searchable
-  int tag_count = 4;              // tags 1..tag_count-1 are random; tag 0 marks standing clips
-  uint64_t seed = 1;              // the generator is deterministic for a given seed
+  int clip_count = 200;            // clips in total
+  int min_clip_frames = 60;        // shortest clip
+  int max_clip_frames = 300;       // longest clip
+  int dims = 27;                   // feature columns
+  float standing_fraction = 0.5f;  // share of clips that are low-variance standing clips
+  int excluded_tail_frames = 30;   // last frames of each clip that are not searchable
+  int tag_count = 4;               // tags 1..tag_count-1 are random; tag 0 marks standing clips
+  uint64_t seed = 1;               // the generator is deterministic for a given seed
 };
 
 // Generated arrays, laid out like a Database's search arrays.
 struct SyntheticSearchData {
   int dims = 0;
-  std::vector<float> features;     // frame_count * dims
-  std::vector<uint8_t> searchable; // per frame
-  std::vector<int> frame_clip;     // per frame
-  std::vector<ClipRange> clips;    // ranges and tag masks
+  std::vector<float> features;      // frame_count * dims
+  std::vector<uint8_t> searchable;  // per frame
+  std::vector<int> frame_clip;      // per frame
+  std::vector<ClipRange> clips;     // ranges and tag masks
 
   int frame_count() const { return static_cast<int>(searchable.size()); }
   // Views for make_searcher() (valid while this object lives).

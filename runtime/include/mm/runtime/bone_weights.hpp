@@ -74,14 +74,14 @@ std::optional<WeightMethod> parse_weight_method(std::string_view name);
 // How to compute the weights; each field is used by the methods named in its comment.
 struct BoneWeightOptions {
   WeightMethod method = WeightMethod::HeatDiffusion;
-  float distance_power = 4.0f;       // Distance: > 0; larger makes blends between bones sharper
-  float distance_softness = 0.05f;   // Distance: metres, > 0; how far apart two bones blend
-  float envelope_falloff = 0.05f;    // Envelope: metres, > 0; width of the falloff outside
-  float heat_constant = 1.0f;        // HeatDiffusion: > 0; larger holds weights nearer the bone
-  float heat_tolerance = 1e-6f;      // HeatDiffusion: > 0; relative residual to stop the solve
-  int heat_max_iterations = 5000;    // HeatDiffusion: > 0; conjugate-gradient iterations per joint
-  float geodesic_falloff = 0.1f;     // Geodesic: metres, > 0; surface distance a weight reaches
-  float min_weight = 0.01f;          // all: in [0, 0.25); smaller weights are dropped
+  float distance_power = 4.0f;      // Distance: > 0; larger makes blends between bones sharper
+  float distance_softness = 0.05f;  // Distance: metres, > 0; how far apart two bones blend
+  float envelope_falloff = 0.05f;   // Envelope: metres, > 0; width of the falloff outside
+  float heat_constant = 1.0f;       // HeatDiffusion: > 0; larger holds weights nearer the bone
+  float heat_tolerance = 1e-6f;     // HeatDiffusion: > 0; relative residual to stop the solve
+  int heat_max_iterations = 5000;   // HeatDiffusion: > 0; conjugate-gradient iterations per joint
+  float geodesic_falloff = 0.1f;    // Geodesic: metres, > 0; surface distance a weight reaches
+  float min_weight = 0.01f;         // all: in [0, 0.25); smaller weights are dropped
 };
 
 // One VertexInfluences per mesh vertex: at most four influences, every weight >= 0, the

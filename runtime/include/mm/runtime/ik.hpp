@@ -25,9 +25,9 @@ struct TwoBoneIkInput {
   Transform mid;   // global transform of the middle joint (knee); its parent is the root joint
   Transform end;   // global transform of the end joint (ankle); its parent is the middle joint
   glm::quat root_parent_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // global rotation of the hip's parent
-  glm::vec3 target{0.0f};                   // where the end joint should go
-  glm::vec3 pole{0.0f, 0.0f, 1.0f};         // direction the knee should bend toward
-  float extension_epsilon = 1e-4f;          // fraction of full reach kept as a minimal bend
+  glm::vec3 target{0.0f};                                  // where the end joint should go
+  glm::vec3 pole{0.0f, 0.0f, 1.0f};                        // direction the knee should bend toward
+  float extension_epsilon = 1e-4f;  // fraction of full reach kept as a minimal bend
 };
 
 // The solved chain. Rotations are unit quaternions; positions are where FK will put the joints.

@@ -60,8 +60,8 @@ void inertialize_transition(InertializationOffsets& offsets, const PoseMotion& o
 // to out_local, and the output's velocities and angular velocities when those spans are
 // non-empty. `incoming` is the incoming animation at the new time. Scale is passed through.
 // A non-finite dt or halflife leaves the offsets as they are (see spring.hpp).
-void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming,
-                        float halflife, float dt, std::span<Transform> out_local,
+void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming, float halflife,
+                        float dt, std::span<Transform> out_local,
                         std::span<glm::vec3> out_velocities,
                         std::span<glm::vec3> out_angular_velocities);
 

@@ -156,7 +156,7 @@ Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
 // Times exactly on a keyframe copy it; between keyframes the two neighbours are interpolated.
 // A non-finite time samples frame 0. Does not allocate. Requires joint_count > 0, frames
 // non-empty and a multiple of joint_count, frame_time > 0 and out.size() == joint_count.
-void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time,
-                 float time, InterpolationMethod method, WrapMode wrap, std::span<Transform> out);
+void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time, float time,
+                 InterpolationMethod method, WrapMode wrap, std::span<Transform> out);
 
 }  // namespace mm

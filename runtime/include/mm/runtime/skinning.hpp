@@ -25,8 +25,8 @@ namespace mm {
 
 // Up to four joints influencing one vertex, with their weights.
 struct VertexInfluences {
-  glm::ivec4 joints{0};      // joint (skinning transform) indices
-  glm::vec4 weights{0.0f};   // non-negative weights, ideally summing to 1
+  glm::ivec4 joints{0};     // joint (skinning transform) indices
+  glm::vec4 weights{0.0f};  // non-negative weights, ideally summing to 1
 };
 
 // inverse_bind[i] = inverse(bind_global[i]): from model space into joint i's bind-pose frame.
@@ -39,12 +39,11 @@ void skinning_matrices(std::span<const Transform> global, std::span<const Transf
 
 // skin[i] = to_matrix(global[i]) * inverse_bind_matrices[i], for matrices from a file (glTF).
 void skinning_matrices(std::span<const Transform> global,
-                       std::span<const glm::mat4> inverse_bind_matrices,
-                       std::span<glm::mat4> skin);
+                       std::span<const glm::mat4> inverse_bind_matrices, std::span<glm::mat4> skin);
 
 // skin[i] = dual quaternion of the rigid part of global[i] * inverse_bind[i] (scale ignored).
-void skinning_dual_quats(std::span<const Transform> global,
-                         std::span<const Transform> inverse_bind, std::span<DualQuat> skin);
+void skinning_dual_quats(std::span<const Transform> global, std::span<const Transform> inverse_bind,
+                         std::span<DualQuat> skin);
 
 // Linear blend skinning of rest (bind-pose) positions, and normals when `rest_normals` is
 // non-empty (then `out_normals` must have the same size; normals use the blended matrix's
@@ -56,8 +55,7 @@ void skin_linear_blend(std::span<const glm::mat4> skin, std::span<const glm::vec
 
 // Dual-quaternion skinning of rest positions, and normals when `rest_normals` is non-empty
 // (rotated by the blended rotation).
-void skin_dual_quaternion(std::span<const DualQuat> skin,
-                          std::span<const glm::vec3> rest_positions,
+void skin_dual_quaternion(std::span<const DualQuat> skin, std::span<const glm::vec3> rest_positions,
                           std::span<const glm::vec3> rest_normals,
                           std::span<const VertexInfluences> influences,
                           std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals);

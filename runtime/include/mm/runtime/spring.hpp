@@ -77,8 +77,8 @@ void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
 // the rotation error e = angle*axis of rotation * inverse(goal) (world frame, |e| <= pi) and
 // angular_velocity = de/dt (rad/s, axis times rate), which is the true angular velocity
 // whenever the rotation stays about one axis (a facing about +Y, for instance).
-void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity,
-                            const glm::quat& goal, float halflife, float dt);
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
+                            float halflife, float dt);
 
 // Predicts a 3D spring at future times (seconds from now, each >= 0) without changing it:
 // positions[i] and velocities[i] are the state after times[i]. Either output may be empty;

@@ -11,8 +11,8 @@ namespace mm {
 // rotation * (scale * p) + translation.
 struct Transform {
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // unit quaternion
-  glm::vec3 translation{0.0f};                  // metres
-  glm::vec3 scale{1.0f};                        // per-axis; 1 for rigid joints
+  glm::vec3 translation{0.0f};                 // metres
+  glm::vec3 scale{1.0f};                       // per-axis; 1 for rigid joints
 
   static Transform identity() { return {}; }
 };
