@@ -30,6 +30,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 
 namespace {
@@ -49,11 +50,10 @@ const std::vector<BvhFile>& files() {
     std::vector<BvhFile> out;
     std::error_code error;
     for (const auto& entry : std::filesystem::directory_iterator(data_dir(), error)) {
-      if (entry.path().extension() != ".bvh") continue;
-      std::ifstream in(entry.path(), std::ios::binary);
-      std::ostringstream buffer;
-      buffer << in.rdbuf();
-      out.push_back({entry.path(), buffer.str()});
+      if (!mm::has_extension(entry.path(), {".bvh"})) continue;
+      if (auto contents = mm::read_whole_file(entry.path())) {
+        out.push_back({entry.path(), std::string(contents->text())});
+      }
     }
     std::sort(out.begin(), out.end(),
               [](const BvhFile& a, const BvhFile& b) { return a.path < b.path; });

@@ -1,5 +1,7 @@
 #include "mm/controller/script.hpp"
 
+#include "mm/database/files.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cerrno>
@@ -235,27 +237,9 @@ Result<InputScript> parse_input_script(std::string_view text, std::string_view n
 }
 
 Result<InputScript> load_input_script(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) {
-    return Error{name + ": is a folder, not an input script"};
-  }
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
-                                                       &std::fclose);
-  if (!file) return Error{name + ": cannot open the input script (" + std::strerror(errno) + ")"};
-  std::string text;
-  char chunk[1 << 14];
-  for (;;) {
-    const size_t got = std::fread(chunk, 1, sizeof chunk, file.get());
-    text.append(chunk, got);
-    if (got < sizeof chunk) {
-      if (std::ferror(file.get())) {
-        return Error{name + ": cannot read the input script (" + std::strerror(errno) + ")"};
-      }
-      break;
-    }
-  }
-  return parse_input_script(text, name);
+  auto contents = read_whole_file(path, "input script");
+  if (!contents) return contents.error();
+  return parse_input_script(std::string(contents->text()), path.string());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -10,14 +10,11 @@
 #include <mutex>
 #include <set>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/database/files.hpp"
 #include "mm/database/idle.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "workers.hpp"
 
 namespace mm {
@@ -31,37 +28,20 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::string lower_extension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 bool is_motion_file(const fs::path& path) {
-  const std::string ext = lower_extension(path);
-  return ext == ".bvh" || ext == ".gltf" || ext == ".glb";
+  return has_extension(path, {".bvh", ".gltf", ".glb"});
 }
 
 bool is_gltf_file(const fs::path& path) {
-  const std::string ext = lower_extension(path);
-  return ext == ".gltf" || ext == ".glb";
+  return has_extension(path, {".gltf", ".glb"});
 }
 
-// Grows an empty vector to n value-initialized elements. On Linux the block is first marked for
-// transparent huge pages: the database arrays are hundreds of MB, and faulting them in 4 KB
-// pages costs more than filling them (measured 2-3x slower on this project's machines).
+// Grows an empty vector to n value-initialized elements, its block first marked for huge pages:
+// the database arrays are hundreds of MB.
 template <class T>
 void resize_large(std::vector<T>& v, size_t n) {
   v.reserve(n);
-#ifdef __linux__
-  constexpr uintptr_t kHuge = uintptr_t{1} << 21;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
-  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + n) & ~(kHuge - 1);
-  if (end > begin) {
-    // Only advice: failure (e.g. THP disabled) just means ordinary pages.
-    (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-  }
-#endif
+  advise_huge_pages(v.data(), n * sizeof(T));
   v.resize(n);
 }
 

@@ -17,6 +17,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "mm/database/files.hpp"
+
 namespace mm {
 
 namespace {
@@ -416,22 +418,6 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
                                          const DatabaseFileInfo& info, DatabaseSection s) {
   const DatabaseFileSection& sec = info.section(s);
   return file.subspan(static_cast<size_t>(sec.offset), static_cast<size_t>(sec.length));
-}
-
-// Asks the kernel to back [data, data + bytes) with 2 MiB pages where it can. Filling a fresh
-// array costs a page fault per 4 KiB page, more than copying the bytes; 2 MiB pages cut the
-// faults 512-fold and measured twice as fast here. Only a hint: failure changes nothing.
-void advise_huge_pages(void* data, size_t bytes) {
-#ifdef MADV_HUGEPAGE
-  constexpr uintptr_t kHugePage = uintptr_t{2} << 20;
-  if (bytes < 4 * kHugePage) return;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHugePage - 1) & ~(kHugePage - 1);
-  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHugePage - 1);
-  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data;
-  (void)bytes;
-#endif
 }
 
 // Copies a fixed-size section whose length parse_header() already matched to the counts.

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
-#include <fstream>
-#include <sstream>
+
+#include "mm/database/files.hpp"
 
 namespace mm {
 
@@ -102,12 +102,9 @@ Result<std::vector<TagRule>> parse_tag_manifest(std::string_view text,
 }
 
 Result<std::vector<TagRule>> load_tag_manifest(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open the tag manifest"};
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) return Error{path.string() + ": cannot read the tag manifest"};
-  return parse_tag_manifest(buffer.str(), path.string());
+  auto contents = read_whole_file(path, "tag manifest");
+  if (!contents) return contents.error();
+  return parse_tag_manifest(contents->text(), path.string());
 }
 
 std::vector<std::string> tags_from_name(std::string_view clip_name) {

@@ -525,7 +525,8 @@ TEST(InputScript, LoadOfAMissingFileOrAFolderNamesThePath) {
 
   Result<InputScript> from_folder = load_input_script(dir);
   ASSERT_FALSE(from_folder.ok());
-  EXPECT_EQ(from_folder.message(), dir.string() + ": is a folder, not an input script");
+  EXPECT_EQ(from_folder.message(),
+            dir.string() + ": cannot read the input script (it is a folder)");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -11,11 +11,11 @@
 
 #include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
-#include "mm/database/io/bvh.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
-#include "mm/database/io/gltf.hpp"
 #include "mm/database/idle.hpp"
+#include "mm/database/io/bvh.hpp"
+#include "mm/database/io/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 

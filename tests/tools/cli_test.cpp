@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mm/database/io/bvh.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
 #include "run_tool.hpp"
 #include "test_support.hpp"

@@ -11,6 +11,7 @@
 #include "database_summary.hpp"
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/files.hpp"
 #include "progress_bar.hpp"
 
 namespace mm::cli {
@@ -202,7 +203,7 @@ int run_build(const std::vector<std::string>& args) {
     const uintmax_t size = std::filesystem::file_size(output, ec);
     std::printf("wrote %s\n", output.c_str());
     std::printf("input:       %d files, %s read, %d refused\n", report.inputs,
-                human_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
+                format_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
     const std::string idle_source =
         report.idle_frames > 0
             ? "frame " + std::to_string(report.idle_source_frame) + " of " + report.idle_source_clip

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "mm/database/files.hpp"
 #include "mm/database/idle.hpp"
 
 namespace mm::cli {
@@ -32,18 +33,6 @@ std::string role_name(const Database& db, int joint) {
 }
 
 }  // namespace
-
-std::string human_bytes(uint64_t bytes) {
-  char buffer[32];
-  if (bytes >= 1000000) {
-    std::snprintf(buffer, sizeof buffer, "%.1f MB", bytes / 1e6);
-  } else if (bytes >= 1000) {
-    std::snprintf(buffer, sizeof buffer, "%.1f KB", bytes / 1e3);
-  } else {
-    std::snprintf(buffer, sizeof buffer, "%llu B", static_cast<unsigned long long>(bytes));
-  }
-  return buffer;
-}
 
 void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
                             const std::string& idle_source) {
@@ -88,7 +77,7 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
     }
     std::fprintf(out, "  %-24s %5d clips %8lld frames\n", db.tag_names[t].c_str(), clips, frames);
   }
-  if (file_bytes > 0) std::fprintf(out, "file size:   %s\n", human_bytes(file_bytes).c_str());
+  if (file_bytes > 0) std::fprintf(out, "file size:   %s\n", format_bytes(file_bytes).c_str());
 }
 
 void print_feature_statistics(FILE* out, const Database& db) {

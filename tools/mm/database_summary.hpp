@@ -24,7 +24,4 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
 // per-column mean and standard deviation (the normalization's offset and scale * weight).
 void print_feature_statistics(FILE* out, const Database& db);
 
-// "1.5 MB", "820 KB", "12 B".
-std::string human_bytes(uint64_t bytes);
-
 }  // namespace mm::cli

@@ -9,9 +9,10 @@
 
 #include "command.hpp"
 #include "database_summary.hpp"
-#include "mm/database/io/bvh.hpp"
 #include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/files.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
 
 namespace mm::cli {
@@ -47,12 +48,6 @@ exit status: 0 written, 1 bad input or clip not found, 2 bad usage
 int usage_error(const std::string& message) {
   std::fprintf(stderr, "mm export: %s\n\n%s", message.c_str(), kUsage);
   return 2;
-}
-
-std::string lower_extension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
 }
 
 // The index of the clip `selector` names among `names` (an index or an exact name), or an error

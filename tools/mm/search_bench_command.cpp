@@ -23,6 +23,7 @@
 
 #include "command.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/files.hpp"
 #include "mm/database/search.hpp"
 #include "mm/database/search_kernels.hpp"
 #include "mm/database/search_synthetic.hpp"
@@ -377,16 +378,6 @@ Neighbourhood measure_neighbourhood(const SearchInput& input, const NoisyQueries
   return out;
 }
 
-std::string human_bytes(size_t bytes) {
-  char text[32];
-  if (bytes >= (size_t{1} << 20)) {
-    std::snprintf(text, sizeof text, "%.1f MiB", static_cast<double>(bytes) / (1 << 20));
-  } else {
-    std::snprintf(text, sizeof text, "%.1f KiB", static_cast<double>(bytes) / (1 << 10));
-  }
-  return text;
-}
-
 int run_search_bench(const std::vector<std::string>& args) {
   Arguments arguments;
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
@@ -575,7 +566,7 @@ int run_search_bench(const std::vector<std::string>& args) {
               "median us", "p99 us", "exact", "cost ratio", "x brute", "x brute-simd");
   for (const MethodReport& r : reports) {
     std::printf("%-11s %10.1f %11s %10.2f %10.2f %8.4f %10.5f %9.1f %11.2f\n", r.name.c_str(),
-                r.build_ms, human_bytes(r.memory_bytes).c_str(), r.median_us, r.p99_us,
+                r.build_ms, format_bytes(r.memory_bytes).c_str(), r.median_us, r.p99_us,
                 r.exact_match_rate, r.cost_ratio, r.speedup_brute, r.speedup_brute_simd);
   }
 

@@ -14,6 +14,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mm/database/files.hpp"
+
 namespace mm {
 namespace {
 
@@ -690,36 +692,9 @@ namespace {
 
 Result<Clip> read_and_parse(const std::filesystem::path& path, const std::string& name,
                             const BvhOptions& options) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "rb"),
-                                                       &std::fclose);
-  if (!file) {
-    return Error{name + ": cannot open the file for reading (" + std::strerror(errno) + ")"};
-  }
-  // Size the buffer from the file size, but keep reading until EOF in case it changed.
-  std::error_code size_error;
-  const uintmax_t size_hint = std::filesystem::file_size(path, size_error);
-  size_t capacity = size_error ? 1 << 16 : static_cast<size_t>(size_hint) + 1;
-  auto buffer = std::make_unique_for_overwrite<char[]>(capacity);
-  size_t used = 0;
-  for (;;) {
-    if (used == capacity) {
-      const size_t grown = capacity * 2;
-      auto bigger = std::make_unique_for_overwrite<char[]>(grown);
-      std::memcpy(bigger.get(), buffer.get(), used);
-      buffer = std::move(bigger);
-      capacity = grown;
-    }
-    const size_t wanted = capacity - used;
-    const size_t got = std::fread(buffer.get() + used, 1, wanted, file.get());
-    used += got;
-    if (got < wanted) {
-      if (std::ferror(file.get())) {
-        return Error{name + ": cannot read the file (" + std::strerror(errno) + ")"};
-      }
-      break;
-    }
-  }
-  return parse_bvh(std::string_view(buffer.get(), used), name, options);
+  auto contents = read_whole_file(path);
+  if (!contents) return contents.error();
+  return parse_bvh(contents->text(), name, options);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "mm/database/files.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm {
@@ -1122,10 +1123,7 @@ Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
     loaded = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
                                          static_cast<unsigned int>(*length), base_dir);
   } else {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".glb") {
+    if (lower_extension(path) == ".glb") {
       return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
     }
     loaded =
@@ -1333,9 +1331,7 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
                   float frame_time, std::string_view name, const SkinnedMesh* body,
                   const std::filesystem::path& out) {
   const std::string where = out.string() + ": ";
-  std::string ext = out.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lower_extension(out);
   if (ext != ".glb" && ext != ".gltf") {
     return Error{where + "unknown extension '" + ext + "', expected .glb (binary) or .gltf (JSON)"};
   }
@@ -1533,12 +1529,11 @@ Result<GltfAsset> parse_gltf(std::span<const unsigned char> bytes,
 }
 
 Result<GltfAsset> load_gltf(const std::filesystem::path& path, const GltfImportOptions& options) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return Error{path.string() + ": cannot open file"};
-  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)),
-                                   std::istreambuf_iterator<char>());
-  if (file.bad()) return Error{path.string() + ": reading failed"};
-  return parse_gltf(bytes, path, options);
+  auto contents = read_whole_file(path, "glTF file");
+  if (!contents) return contents.error();
+  return parse_gltf(
+      std::span(reinterpret_cast<const unsigned char*>(contents->data.get()), contents->size), path,
+      options);
 }
 
 Status save_gltf(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,

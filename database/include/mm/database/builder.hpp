@@ -31,10 +31,10 @@
 #include <string>
 #include <vector>
 
-#include "mm/database/io/bvh.hpp"
 #include "mm/database/clip.hpp"
 #include "mm/database/database.hpp"
 #include "mm/database/features.hpp"
+#include "mm/database/io/bvh.hpp"
 #include "mm/database/preprocess.hpp"
 #include "mm/database/tags.hpp"
 #include "mm/runtime/result.hpp"
