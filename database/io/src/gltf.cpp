@@ -13,6 +13,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -597,24 +598,12 @@ struct SkeletonResult {
   std::vector<glm::mat4> inverse_bind_matrices;
 };
 
-Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_index) {
-  if (model.skins.empty()) {
-    return Error{"the file has no skin, so no skeleton to import (glTF \"skins\" is empty)"};
-  }
-  if (skin_index < 0 || static_cast<size_t>(skin_index) >= model.skins.size()) {
-    return Error{"skin " + std::to_string(skin_index) + " requested but the file has " +
-                 std::to_string(model.skins.size()) + " skins"};
-  }
-  const tinygltf::Skin& skin = model.skins[static_cast<size_t>(skin_index)];
-  const std::string skin_label = "skin " + std::to_string(skin_index) + quoted_name(skin.name);
-  if (skin.joints.empty()) return Error{skin_label + " has no joints"};
-
-  auto parents = node_parents(model);
-  if (!parents) return parents.error();
-  const std::vector<int>& parent = *parents;
+// Node -> its index in skin.joints (-1 for nodes that are not joints), refusing out-of-range
+// and repeated joints.
+Result<std::vector<int>> skin_slots(const tinygltf::Model& model, const tinygltf::Skin& skin,
+                                    const std::string& skin_label) {
   const size_t n = model.nodes.size();
-
-  std::vector<int> skin_slot(n, -1);  // node -> its index in skin.joints
+  std::vector<int> skin_slot(n, -1);
   for (size_t i = 0; i < skin.joints.size(); ++i) {
     const int j = skin.joints[i];
     if (j < 0 || static_cast<size_t>(j) >= n) {
@@ -626,9 +615,14 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
     }
     skin_slot[static_cast<size_t>(j)] = static_cast<int>(i);
   }
+  return skin_slot;
+}
 
-  // A non-joint node between two joints becomes a joint too, or the hierarchy would break.
-  std::vector<bool> in_skeleton(n, false);
+// Which nodes become skeleton joints: the skin's, plus any non-joint node between two joints,
+// or the hierarchy would break.
+std::vector<bool> skeleton_nodes(const tinygltf::Skin& skin, const std::vector<int>& parent,
+                                 const std::vector<int>& skin_slot) {
+  std::vector<bool> in_skeleton(parent.size(), false);
   for (int j : skin.joints) in_skeleton[static_cast<size_t>(j)] = true;
   std::vector<int> between;
   for (int j : skin.joints) {
@@ -642,10 +636,14 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
       for (int b : between) in_skeleton[static_cast<size_t>(b)] = true;
     }
   }
+  return in_skeleton;
+}
 
-  // Depth-first order, roots in the order their first joint appears in the skin.
-  SkeletonLayout layout;
-  layout.slot_of_node.assign(n, -1);
+// The joints in depth-first order, roots in the order their first joint appears in the skin.
+void order_joints_depth_first(const tinygltf::Model& model, const tinygltf::Skin& skin,
+                              const std::vector<int>& parent, const std::vector<bool>& in_skeleton,
+                              SkeletonLayout& layout) {
+  layout.slot_of_node.assign(parent.size(), -1);
   std::vector<int> stack;
   for (int j : skin.joints) {
     int root = j;
@@ -666,13 +664,16 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
       }
     }
   }
-  const size_t joint_count = layout.joint_nodes.size();
+}
 
-  // Ancestors of the roots get slots after the joints; each root remembers its chain.
+// Ancestors of the roots get slots after the joints; each root remembers its chain, so its
+// animation can fold theirs in.
+void chain_root_ancestors(const std::vector<int>& parent, const std::vector<bool>& in_skeleton,
+                          SkeletonLayout& layout) {
+  const size_t joint_count = layout.joint_nodes.size();
   layout.root_chain.resize(joint_count);
   for (size_t i = 0; i < joint_count; ++i) {
-    const int node = layout.joint_nodes[i];
-    const int p = parent[static_cast<size_t>(node)];
+    const int p = parent[static_cast<size_t>(layout.joint_nodes[i])];
     if (p >= 0 && in_skeleton[static_cast<size_t>(p)]) continue;
     std::vector<int>& chain = layout.root_chain[i];
     for (int a = p; a >= 0; a = parent[static_cast<size_t>(a)]) {
@@ -685,7 +686,10 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
     }
     std::reverse(chain.begin(), chain.end());
   }
+}
 
+Status read_slot_rest(const tinygltf::Model& model, SkeletonLayout& layout) {
+  const size_t joint_count = layout.joint_nodes.size();
   const size_t slot_count = joint_count + layout.ancestor_nodes.size();
   layout.slot_rest.resize(slot_count);
   for (size_t s = 0; s < slot_count; ++s) {
@@ -695,8 +699,14 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
     if (!rest) return rest.error();
     layout.slot_rest[s] = *rest;
   }
+  return {};
+}
 
-  // Names: the node's, made unique with the node index when empty or repeated.
+// The skeleton: names (the node's, made unique with the node index when empty or repeated),
+// parents, and rest transforms, a root's folding in its ancestors' (scene space).
+Result<Skeleton> skeleton_from_layout(const tinygltf::Model& model, const std::vector<int>& parent,
+                                      const SkeletonLayout& layout, const std::string& skin_label) {
+  const size_t joint_count = layout.joint_nodes.size();
   std::unordered_map<std::string, int> name_uses;
   for (int node : layout.joint_nodes) ++name_uses[model.nodes[static_cast<size_t>(node)].name];
   std::vector<std::string> names;
@@ -716,7 +726,6 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
     const int p = parent[static_cast<size_t>(node)];
     skeleton_parents.push_back(p >= 0 ? layout.slot_of_node[static_cast<size_t>(p)] : -1);
     if (skeleton_parents.back() >= static_cast<int>(joint_count)) skeleton_parents.back() = -1;
-    // A root's rest folds in its ancestors' rest transforms (scene space).
     Transform local = layout.slot_rest[i];
     for (auto it = layout.root_chain[i].rbegin(); it != layout.root_chain[i].rend(); ++it) {
       local = compose(layout.slot_rest[static_cast<size_t>(*it)], local);
@@ -725,15 +734,17 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
   }
   auto skeleton = Skeleton::create(std::move(names), std::move(skeleton_parents), rest);
   if (!skeleton) return Error{skin_label + ": " + skeleton.message()};
+  return std::move(*skeleton);
+}
 
-  SkeletonResult result;
-  result.skeleton = std::move(*skeleton);
-  result.layout = std::move(layout);
-
-  // Inverse bind matrices: the skin's for its joints, the inverse rest global for the rest.
+// Inverse bind matrices: the skin's for its joints, the inverse rest global for joints the
+// importer added.
+Result<std::vector<glm::mat4>> inverse_bind_matrices(
+    const tinygltf::Model& model, const tinygltf::Skin& skin, const std::vector<int>& skin_slot,
+    const Skeleton& skeleton, const SkeletonLayout& layout, const std::string& skin_label) {
+  const size_t joint_count = layout.joint_nodes.size();
   std::vector<Transform> globals(joint_count);
-  forward_kinematics(result.skeleton.parents(), result.skeleton.rest(), globals);
-  result.inverse_bind_matrices.resize(joint_count);
+  forward_kinematics(skeleton.parents(), skeleton.rest(), globals);
   std::vector<float> matrices;
   if (skin.inverseBindMatrices >= 0) {
     auto read = read_accessor(model, skin.inverseBindMatrices, TINYGLTF_TYPE_MAT4, false,
@@ -745,18 +756,51 @@ Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_ind
                    std::to_string(matrices.size() / 16) + " inverse bind matrices"};
     }
   }
+  std::vector<glm::mat4> inverse_binds(joint_count);
   for (size_t i = 0; i < joint_count; ++i) {
-    const int k = skin_slot[static_cast<size_t>(result.layout.joint_nodes[i])];
+    const int k = skin_slot[static_cast<size_t>(layout.joint_nodes[i])];
     if (k < 0) {
-      result.inverse_bind_matrices[i] = glm::inverse(to_matrix(globals[i]));
+      inverse_binds[i] = glm::inverse(to_matrix(globals[i]));
     } else if (matrices.empty()) {
-      result.inverse_bind_matrices[i] = glm::mat4(1.0f);
+      inverse_binds[i] = glm::mat4(1.0f);
     } else {
-      glm::mat4 m;
-      std::memcpy(&m[0][0], matrices.data() + static_cast<size_t>(k) * 16, sizeof(float) * 16);
-      result.inverse_bind_matrices[i] = m;
+      std::memcpy(&inverse_binds[i][0][0], matrices.data() + static_cast<size_t>(k) * 16,
+                  sizeof(float) * 16);
     }
   }
+  return inverse_binds;
+}
+
+Result<SkeletonResult> build_skeleton(const tinygltf::Model& model, int skin_index) {
+  if (model.skins.empty()) {
+    return Error{"the file has no skin, so no skeleton to import (glTF \"skins\" is empty)"};
+  }
+  if (skin_index < 0 || static_cast<size_t>(skin_index) >= model.skins.size()) {
+    return Error{"skin " + std::to_string(skin_index) + " requested but the file has " +
+                 std::to_string(model.skins.size()) + " skins"};
+  }
+  const tinygltf::Skin& skin = model.skins[static_cast<size_t>(skin_index)];
+  const std::string skin_label = "skin " + std::to_string(skin_index) + quoted_name(skin.name);
+  if (skin.joints.empty()) return Error{skin_label + " has no joints"};
+
+  auto parent = node_parents(model);
+  if (!parent) return parent.error();
+  auto skin_slot = skin_slots(model, skin, skin_label);
+  if (!skin_slot) return skin_slot.error();
+
+  SkeletonResult result;
+  const std::vector<bool> in_skeleton = skeleton_nodes(skin, *parent, *skin_slot);
+  order_joints_depth_first(model, skin, *parent, in_skeleton, result.layout);
+  chain_root_ancestors(*parent, in_skeleton, result.layout);
+  if (Status rest = read_slot_rest(model, result.layout); !rest) return Error{rest.message()};
+
+  auto skeleton = skeleton_from_layout(model, *parent, result.layout, skin_label);
+  if (!skeleton) return skeleton.error();
+  result.skeleton = std::move(*skeleton);
+  auto inverse_binds =
+      inverse_bind_matrices(model, skin, *skin_slot, result.skeleton, result.layout, skin_label);
+  if (!inverse_binds) return inverse_binds.error();
+  result.inverse_bind_matrices = std::move(*inverse_binds);
   return result;
 }
 
@@ -1326,78 +1370,79 @@ tinygltf::Primitive body_primitive(BufferWriter& writer, const SkinnedMesh& body
   return primitive;
 }
 
-// `body` may be null: the skeleton's rest pose is the bind pose and an anchor triangle the mesh.
-Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
-                  float frame_time, std::string_view name, const SkinnedMesh* body,
-                  const std::filesystem::path& out) {
-  const std::string where = out.string() + ": ";
-  const std::string ext = lower_extension(out);
+// What save_model accepts: a known extension, frames matching the skeleton, finite transforms
+// with usable rotations, a positive frame time, and a body consistent with the skeleton.
+Status check_export(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
+                    float frame_time, const SkinnedMesh* body, const std::string& ext) {
   if (ext != ".glb" && ext != ".gltf") {
-    return Error{where + "unknown extension '" + ext + "', expected .glb (binary) or .gltf (JSON)"};
+    return Error{"unknown extension '" + ext + "', expected .glb (binary) or .gltf (JSON)"};
   }
-  const bool binary = ext == ".glb";
   const size_t joints = static_cast<size_t>(skeleton.joint_count());
-  if (joints == 0) return Error{where + "the skeleton has no joints"};
+  if (joints == 0) return Error{"the skeleton has no joints"};
   if (frame_count < 1)
-    return Error{where + "nothing to write: frame count is " + std::to_string(frame_count)};
+    return Error{"nothing to write: frame count is " + std::to_string(frame_count)};
   if (!(frame_time > 0.0f) || !std::isfinite(frame_time)) {
-    return Error{where + "frame time must be a positive finite number of seconds"};
+    return Error{"frame time must be a positive finite number of seconds"};
   }
   const size_t frames_n = static_cast<size_t>(frame_count);
   if (frames.size() != frames_n * joints) {
-    return Error{where + "expected " + std::to_string(frames_n * joints) + " transforms (" +
+    return Error{"expected " + std::to_string(frames_n * joints) + " transforms (" +
                  std::to_string(frame_count) + " frames x " + std::to_string(joints) +
                  " joints), got " + std::to_string(frames.size())};
   }
   if (body) {
-    if (Status b = check_body(*body, joints); !b) return Error{where + b.message()};
+    if (Status b = check_body(*body, joints); !b) return b;
   }
-  auto check = [&](const Transform& t, const std::string& what) -> Status {
+  auto usable = [](const Transform& t) {
     const float n = glm::length(t.rotation);
-    if (!finite(t.translation) || !finite(t.scale) || !std::isfinite(n) || !(n > 1e-6f)) {
-      return Error{where + what + ": non-finite transform or zero rotation"};
-    }
-    return Status::success();
+    return finite(t.translation) && finite(t.scale) && std::isfinite(n) && n > 1e-6f;
   };
+  const std::string problem = ": non-finite transform or zero rotation";
   for (size_t j = 0; j < joints; ++j) {
-    if (Status s = check(skeleton.rest(static_cast<int>(j)),
-                         "rest of joint '" + skeleton.name(static_cast<int>(j)) + "'");
-        !s)
-      return s;
+    if (!usable(skeleton.rest(static_cast<int>(j)))) {
+      return Error{"rest of joint '" + skeleton.name(static_cast<int>(j)) + "'" + problem};
+    }
   }
   for (size_t i = 0; i < frames.size(); ++i) {
-    if (Status s = check(frames[i], "frame " + std::to_string(i / joints) + ", joint '" +
-                                        skeleton.name(static_cast<int>(i % joints)) + "'");
-        !s) {
-      return s;
+    if (!usable(frames[i])) {
+      return Error{"frame " + std::to_string(i / joints) + ", joint '" +
+                   skeleton.name(static_cast<int>(i % joints)) + "'" + problem};
     }
   }
+  return Status::success();
+}
 
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "mm motion matching: mm::save_gltf";
-  BufferWriter writer(model);
+// The bind pose: the body's, else the rest pose; as globals and as the nodes' locals.
+struct BindPose {
+  std::vector<Transform> global;
+  std::vector<Transform> local;
+};
 
-  // The bind pose: the body's, else the rest pose; as globals and as the nodes' locals.
-  std::vector<Transform> globals(joints);
-  std::vector<Transform> bind_local(skeleton.rest());
+BindPose bind_pose(const Skeleton& skeleton, const SkinnedMesh* body) {
+  const size_t joints = static_cast<size_t>(skeleton.joint_count());
+  BindPose bind{std::vector<Transform>(joints), skeleton.rest()};
   if (body) {
-    globals = body->bind_global;
+    bind.global = body->bind_global;
     for (size_t j = 0; j < joints; ++j) {
       const int p = skeleton.parent(static_cast<int>(j));
-      bind_local[j] =
-          p < 0 ? globals[j] : compose(inverse(globals[static_cast<size_t>(p)]), globals[j]);
+      bind.local[j] = p < 0 ? bind.global[j]
+                            : compose(inverse(bind.global[static_cast<size_t>(p)]), bind.global[j]);
     }
   } else {
-    forward_kinematics(skeleton.parents(), skeleton.rest(), globals);
+    forward_kinematics(skeleton.parents(), skeleton.rest(), bind.global);
   }
+  return bind;
+}
 
-  // Joint nodes with their bind TRS, children listed by their parents.
+// Joint nodes with their bind TRS, children listed by their parents. Returns the roots.
+std::vector<int> add_joint_nodes(tinygltf::Model& model, const Skeleton& skeleton,
+                                 const BindPose& bind) {
+  const size_t joints = static_cast<size_t>(skeleton.joint_count());
   model.nodes.resize(joints);
   std::vector<int> roots;
   for (size_t j = 0; j < joints; ++j) {
     tinygltf::Node& node = model.nodes[j];
-    const Transform& r = bind_local[j];
+    const Transform& r = bind.local[j];
     const glm::quat q = glm::normalize(r.rotation);
     node.name = skeleton.name(static_cast<int>(j));
     node.translation = {r.translation.x, r.translation.y, r.translation.z};
@@ -1410,11 +1455,18 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
       roots.push_back(static_cast<int>(j));
     }
   }
+  return roots;
+}
 
-  // Skin: every joint, bound in the bind pose.
+// The skin (every joint, bound in the bind pose), the mesh it deforms (the body, or an anchor
+// triangle), the node carrying both, and the scene.
+void add_skin_mesh_and_scene(tinygltf::Model& model, BufferWriter& writer, const BindPose& bind,
+                             const std::vector<int>& roots, const SkinnedMesh* body,
+                             std::string_view name) {
+  const size_t joints = bind.global.size();
   std::vector<float> inverse_binds(joints * 16);
   for (size_t j = 0; j < joints; ++j) {
-    const glm::mat4 m = glm::inverse(to_matrix(globals[j]));
+    const glm::mat4 m = glm::inverse(to_matrix(bind.global[j]));
     std::memcpy(inverse_binds.data() + j * 16, &m[0][0], sizeof(float) * 16);
   }
   tinygltf::Skin skin;
@@ -1426,11 +1478,10 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
   if (roots.size() == 1) skin.skeleton = roots.front();
   model.skins.push_back(std::move(skin));
 
-  tinygltf::Primitive primitive =
-      body ? body_primitive(writer, *body) : anchor_primitive(writer, globals[0].translation);
   tinygltf::Mesh mesh;
   mesh.name = std::string(name) + (body ? "_body" : "_skin_anchor");
-  mesh.primitives.push_back(std::move(primitive));
+  mesh.primitives.push_back(body ? body_primitive(writer, *body)
+                                 : anchor_primitive(writer, bind.global[0].translation));
   model.meshes.push_back(std::move(mesh));
   tinygltf::Node mesh_node;
   mesh_node.name = model.meshes.back().name;
@@ -1444,11 +1495,30 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
   scene.nodes.push_back(static_cast<int>(joints));
   model.scenes.push_back(std::move(scene));
   model.defaultScene = 0;
+}
 
-  // Animation: one key per frame, LINEAR; all samplers share the key times.
+// One joint's per-frame values of one TRS path, flattened.
+template <class Value>
+std::vector<float> joint_track(std::span<const Transform> frames, size_t joints, size_t joint,
+                               Value value) {
+  std::vector<float> values;
+  for (size_t f = 0; f * joints < frames.size(); ++f) {
+    const auto v = value(frames[f * joints + joint]);
+    for (int c = 0; c < v.length(); ++c) values.push_back(v[c]);
+  }
+  return values;
+}
+
+// The animation: one key per frame, LINEAR, all samplers sharing the key times. Scale gets a
+// channel only for joints whose scale leaves the bind pose's.
+void add_animation(tinygltf::Model& model, BufferWriter& writer, std::span<const Transform> frames,
+                   const BindPose& bind, float frame_time, std::string_view name) {
+  const size_t joints = bind.local.size();
+  const size_t frames_n = frames.size() / joints;
   std::vector<float> times(frames_n);
-  for (size_t f = 0; f < frames_n; ++f)
+  for (size_t f = 0; f < frames_n; ++f) {
     times[f] = static_cast<float>(static_cast<double>(f) * frame_time);
+  }
   const int time_accessor =
       writer.add(times.data(), times.size() * sizeof(float), TINYGLTF_COMPONENT_TYPE_FLOAT,
                  TINYGLTF_TYPE_SCALAR, frames_n, 0, {times.front()}, {times.back()});
@@ -1468,46 +1538,55 @@ Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, i
     channel.target_path = path;
     animation.channels.push_back(std::move(channel));
   };
-  std::vector<float> values;
   for (size_t j = 0; j < joints; ++j) {
-    values.clear();
-    for (size_t f = 0; f < frames_n; ++f) {
-      const glm::vec3& t = frames[f * joints + j].translation;
-      values.insert(values.end(), {t.x, t.y, t.z});
-    }
-    add_channel(j, "translation", values, TINYGLTF_TYPE_VEC3);
-
+    add_channel(j, "translation",
+                joint_track(frames, joints, j, [](const Transform& t) { return t.translation; }),
+                TINYGLTF_TYPE_VEC3);
     // Consecutive keys in one hemisphere, so importers that blend components see no flips.
-    values.clear();
-    glm::quat previous(1.0f, 0.0f, 0.0f, 0.0f);
-    for (size_t f = 0; f < frames_n; ++f) {
-      glm::quat q = glm::normalize(frames[f * joints + j].rotation);
-      if (f > 0 && glm::dot(q, previous) < 0.0f) q = -q;
+    std::optional<glm::quat> previous;
+    auto continuous_rotation = [&previous](const Transform& t) {
+      glm::quat q = glm::normalize(t.rotation);
+      if (previous && glm::dot(q, *previous) < 0.0f) q = -q;
       previous = q;
-      values.insert(values.end(), {q.x, q.y, q.z, q.w});
-    }
-    add_channel(j, "rotation", values, TINYGLTF_TYPE_VEC4);
-
-    const glm::vec3 rest_scale = bind_local[j].scale;
+      return glm::vec4(q.x, q.y, q.z, q.w);
+    };
+    add_channel(j, "rotation", joint_track(frames, joints, j, continuous_rotation),
+                TINYGLTF_TYPE_VEC4);
     bool scale_moves = false;
     for (size_t f = 0; f < frames_n && !scale_moves; ++f) {
-      scale_moves = frames[f * joints + j].scale != rest_scale;
+      scale_moves = frames[f * joints + j].scale != bind.local[j].scale;
     }
     if (scale_moves) {
-      values.clear();
-      for (size_t f = 0; f < frames_n; ++f) {
-        const glm::vec3& s = frames[f * joints + j].scale;
-        values.insert(values.end(), {s.x, s.y, s.z});
-      }
-      add_channel(j, "scale", values, TINYGLTF_TYPE_VEC3);
+      add_channel(j, "scale",
+                  joint_track(frames, joints, j, [](const Transform& t) { return t.scale; }),
+                  TINYGLTF_TYPE_VEC3);
     }
   }
   model.animations.push_back(std::move(animation));
+}
+
+// `body` may be null: the skeleton's rest pose is the bind pose and an anchor triangle the mesh.
+Status save_model(const Skeleton& skeleton, std::span<const Transform> frames, int frame_count,
+                  float frame_time, std::string_view name, const SkinnedMesh* body,
+                  const std::filesystem::path& out) {
+  const std::string where = out.string() + ": ";
+  const std::string ext = lower_extension(out);
+  if (Status s = check_export(skeleton, frames, frame_count, frame_time, body, ext); !s) {
+    return Error{where + s.message()};
+  }
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "mm motion matching: mm::save_gltf";
+  BufferWriter writer(model);
+  const BindPose bind = bind_pose(skeleton, body);
+  const std::vector<int> roots = add_joint_nodes(model, skeleton, bind);
+  add_skin_mesh_and_scene(model, writer, bind, roots, body, name);
+  add_animation(model, writer, frames, bind, frame_time, name);
   writer.finish();
 
   std::ostringstream stream;
   tinygltf::TinyGLTF serializer;
-  if (!serializer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/true, binary)) {
+  if (!serializer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/true, ext == ".glb")) {
     return Error{where + "tinygltf could not serialize the model"};
   }
   return write_file(out, stream.str());
