@@ -55,9 +55,14 @@ float yaw_degrees(const glm::quat& rotation) {
   return glm::degrees(std::atan2(forward.x, forward.z));
 }
 
-}  // namespace
+struct Options {
+  const char* database_path = nullptr;
+  int characters = 100;
+  float seconds = 3.0f;
+};
 
-int main(int argc, char** argv) {
+// The command line: returns -1 to go on, else the exit code (0 after --help, 2 after a misuse).
+int parse_arguments(int argc, char** argv, Options& options) {
   if (argc == 2 && (std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h")) {
     std::fputs(kUsage, stdout);
     return 0;
@@ -66,71 +71,72 @@ int main(int argc, char** argv) {
     std::fputs(kUsage, stderr);
     return 2;
   }
-  int characters = 100;
-  float seconds = 3.0f;
-  if (argc > 2 && (!parse_number(argv[2], characters) || characters < 1 || characters > 100000)) {
+  options.database_path = argv[1];
+  if (argc > 2 && (!parse_number(argv[2], options.characters) || options.characters < 1 ||
+                   options.characters > 100000)) {
     std::fprintf(
         stderr,
         "mm-crowd-example: characters must be a whole number in [1, 100000], not '%s'\n\n%s",
         argv[2], kUsage);
     return 2;
   }
-  if (argc > 3 && (!parse_number(argv[3], seconds) || !(seconds > 0.0f) || !(seconds <= 3600.0f))) {
+  if (argc > 3 && (!parse_number(argv[3], options.seconds) || !(options.seconds > 0.0f) ||
+                   !(options.seconds <= 3600.0f))) {
     std::fprintf(stderr, "mm-crowd-example: seconds must be a number in (0, 3600], not '%s'\n\n%s",
                  argv[3], kUsage);
     return 2;
   }
+  return -1;
+}
 
-  // ---- Loading (once, at level load; nothing here belongs in a frame).
-  // Everything that can fail in mm (files, settings) returns a Result: test it, and on failure
-  // its message says what went wrong and where (the file, the section). Nothing throws.
-  mm::Result<mm::Database> loaded = mm::load_database(argv[1]);
-  if (!loaded) {
-    std::fprintf(stderr, "mm-crowd-example: %s\n", loaded.message().c_str());
-    return 1;
-  }
+// ---- Loading (once, at level load; nothing here belongs in a frame).
+// Everything that can fail in mm (files, settings) returns a Result: test it, and on failure
+// its message says what went wrong and where (the file, the section). Nothing throws.
+mm::Result<std::shared_ptr<const mm::ControllerDatabase>> load_shared_database(
+    const char* path, const mm::ControllerSettings& settings) {
+  mm::Result<mm::Database> loaded = mm::load_database(path);
+  if (!loaded) return loaded.error();
   // The ControllerDatabase holds what every character reads and nobody writes: the animation
   // data, the search structures and the speeds measured on the data. Make one and share it, so
   // a hundred characters cost one copy of the animation, not a hundred.
   mm::Result<std::shared_ptr<const mm::ControllerDatabase>> shared = mm::ControllerDatabase::create(
       std::make_shared<const mm::Database>(std::move(loaded).value()));
-  if (!shared) {
-    std::fprintf(stderr, "mm-crowd-example: %s\n", shared.message().c_str());
-    return 1;
-  }
-  // Every tunable (speeds, blend times, foot locking...) with its unit and default is a field
-  // of ControllerSettings (controller.hpp). This example keeps the defaults.
-  const mm::ControllerSettings settings;
+  if (!shared) return shared.error();
   // The search structure is built on first use. Build it now, during loading, so that the
   // first game frame does not pay for it.
   if (mm::Result<const mm::Searcher*> searcher = (*shared)->searcher(settings.search_method);
       !searcher) {
-    std::fprintf(stderr, "mm-crowd-example: %s\n", searcher.message().c_str());
-    return 1;
+    return searcher.error();
   }
+  return shared;
+}
 
-  // ---- Spawning. One Controller per character: it owns that character's state (where it is,
-  // which clip it plays, its transition) and every buffer update() needs, allocated here.
-  // Characters stand on a square grid 3 m apart so that none starts inside another.
-  const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<float>(characters))));
-  constexpr float kSpacing = 3.0f;  // metres
+// ---- Spawning. One Controller per character: it owns that character's state (where it is,
+// which clip it plays, its transition) and every buffer update() needs, allocated here.
+// Characters stand on a square grid 3 m apart so that none starts inside another.
+struct Crowd {
   std::vector<mm::Controller> controllers;
   std::vector<glm::vec3> start_positions;
   std::vector<mm::InputScript> inputs;
-  controllers.reserve(static_cast<size_t>(characters));
-  start_positions.reserve(static_cast<size_t>(characters));
-  inputs.reserve(static_cast<size_t>(characters));
+};
+
+mm::Result<Crowd> spawn_crowd(const std::shared_ptr<const mm::ControllerDatabase>& shared,
+                              const mm::ControllerSettings& settings, int characters,
+                              float seconds) {
+  const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<float>(characters))));
+  constexpr float kSpacing = 3.0f;  // metres
+  Crowd crowd;
+  crowd.controllers.reserve(static_cast<size_t>(characters));
+  crowd.start_positions.reserve(static_cast<size_t>(characters));
+  crowd.inputs.reserve(static_cast<size_t>(characters));
   for (int i = 0; i < characters; ++i) {
-    mm::Result<mm::Controller> controller = mm::Controller::create(*shared, settings);
-    if (!controller) {
-      std::fprintf(stderr, "mm-crowd-example: %s\n", controller.message().c_str());
-      return 1;
-    }
+    mm::Result<mm::Controller> controller = mm::Controller::create(shared, settings);
+    if (!controller) return controller.error();
     const glm::vec3 spot(static_cast<float>(i % columns) * kSpacing, 0.0f,
                          static_cast<float>(i / columns) * kSpacing);
     controller->teleport(spot, 0.0f);  // facing +Z (yaw 0)
-    controllers.push_back(std::move(controller).value());
-    start_positions.push_back(spot);
+    crowd.controllers.push_back(std::move(controller).value());
+    crowd.start_positions.push_back(spot);
     // Stand-in for players or AI: a reproducible script per character that changes direction
     // every 0.5 to 3 s, sometimes stops, runs or strafes. In a game you fill the
     // mm::ControllerInput yourself each frame instead, for example:
@@ -138,36 +144,39 @@ int main(int argc, char** argv) {
     //   input.left_stick = {pad.left_x, pad.left_y};  // x right, y away from the camera
     //   input.camera_yaw = camera.yaw;                 // sticks are read relative to the camera
     //   input.run = pad.held(Button::A);
-    inputs.push_back(mm::varied_input_script(static_cast<uint32_t>(i), seconds));
+    crowd.inputs.push_back(mm::varied_input_script(static_cast<uint32_t>(i), seconds));
   }
+  return crowd;
+}
 
-  // ---- The game loop: a fixed 60 Hz step. Each update() advances one character by dt of game
-  // time: it reads the input, searches the database for the frame that best continues the
-  // motion when needed, blends into it, moves the character and plants its feet. update() never
-  // allocates, locks or touches files, and characters do not share mutable state, so a game can
-  // split the controllers over its worker threads; this example keeps to one thread.
-  constexpr float kDt = 1.0f / 60.0f;
-  const int frames = static_cast<int>(std::lround(seconds / kDt));
+// ---- The game loop: a fixed step of dt. Each update() advances one character by dt of game
+// time: it reads the input, searches the database for the frame that best continues the
+// motion when needed, blends into it, moves the character and plants its feet. update() never
+// allocates, locks or touches files, and characters do not share mutable state, so a game can
+// split the controllers over its worker threads; this example keeps to one thread.
+// Returns the wall-clock seconds the frames took.
+double run_game_loop(Crowd& crowd, int frames, float dt) {
   const auto wall_start = std::chrono::steady_clock::now();
   for (int frame = 0; frame < frames; ++frame) {
-    const float game_time = static_cast<float>(frame) * kDt;
-    for (size_t i = 0; i < controllers.size(); ++i) {
-      const mm::ControllerInput input = inputs[i].at(game_time);
-      controllers[i].update(kDt, input);
+    const float game_time = static_cast<float>(frame) * dt;
+    for (size_t i = 0; i < crowd.controllers.size(); ++i) {
+      const mm::ControllerInput input = crowd.inputs[i].at(game_time);
+      crowd.controllers[i].update(dt, input);
       // This is where a game reads the pose back for rendering: global_transforms() (one
       // world transform per joint of the database's skeleton) or skinning_matrices().
     }
   }
-  const double wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+}
 
-  // ---- Results. root_transform() is joint 0, the "simulation root": the character's ground
-  // position (y = 0) and facing, the thing gameplay code cares about.
+// ---- Results. root_transform() is joint 0, the "simulation root": the character's ground
+// position (y = 0) and facing, the thing gameplay code cares about.
+void print_results(const Crowd& crowd, int frames, float dt, double wall_seconds) {
   int moved = 0;
   double total_distance = 0.0;
-  for (size_t i = 0; i < controllers.size(); ++i) {
-    const mm::Transform& root = controllers[i].root_transform();
-    const glm::vec3& start = start_positions[i];
+  for (size_t i = 0; i < crowd.controllers.size(); ++i) {
+    const mm::Transform& root = crowd.controllers[i].root_transform();
+    const glm::vec3& start = crowd.start_positions[i];
     const float distance =
         glm::length(glm::vec2(root.translation.x - start.x, root.translation.z - start.z));
     total_distance += distance;
@@ -176,10 +185,36 @@ int main(int argc, char** argv) {
                 root.translation.x, root.translation.z, yaw_degrees(root.rotation), start.x,
                 start.z);
   }
+  const double characters = static_cast<double>(crowd.controllers.size());
   std::printf(
-      "summary: %d characters, %d frames at 60 Hz (%.2f s of game time); %d moved more than "
+      "summary: %zu characters, %d frames at 60 Hz (%.2f s of game time); %d moved more than "
       "0.1 m, %.2f m from the start on average; %.1f us per character update\n",
-      characters, frames, static_cast<double>(frames) * kDt, moved, total_distance / characters,
+      crowd.controllers.size(), frames, static_cast<double>(frames) * dt, moved,
+      total_distance / characters,
       frames > 0 ? wall_seconds * 1e6 / (static_cast<double>(frames) * characters) : 0.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  if (const int code = parse_arguments(argc, argv, options); code >= 0) return code;
+  // Every tunable (speeds, blend times, foot locking...) with its unit and default is a field
+  // of ControllerSettings (controller.hpp). This example keeps the defaults.
+  const mm::ControllerSettings settings;
+  auto shared = load_shared_database(options.database_path, settings);
+  if (!shared) {
+    std::fprintf(stderr, "mm-crowd-example: %s\n", shared.message().c_str());
+    return 1;
+  }
+  auto crowd = spawn_crowd(*shared, settings, options.characters, options.seconds);
+  if (!crowd) {
+    std::fprintf(stderr, "mm-crowd-example: %s\n", crowd.message().c_str());
+    return 1;
+  }
+  constexpr float kDt = 1.0f / 60.0f;
+  const int frames = static_cast<int>(std::lround(options.seconds / kDt));
+  const double wall_seconds = run_game_loop(*crowd, frames, kDt);
+  print_results(*crowd, frames, kDt, wall_seconds);
   return 0;
 }
