@@ -20,6 +20,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtx/quaternion.hpp>
 
+#include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
@@ -100,11 +101,10 @@ int last_line_number(const std::string& text) {
   return 1 + static_cast<int>(std::count(text.begin(), text.end(), '\n'));
 }
 
+// The file's text, or "" when it cannot be read (the assertions on the text then fail).
 std::string read_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  auto contents = read_whole_file(path);
+  return contents ? std::string(contents->text()) : std::string();
 }
 
 void write_file(const std::filesystem::path& path, const std::string& text) {
@@ -446,169 +446,99 @@ TEST(BvhMalformed, TruncatedRealFilesInHierarchyAndMotion) {
   }
 }
 
-TEST(BvhMalformed, MotionLineWithTooFewValues) {
-  expect_refused(fixture_with_line(19, "0 90 0 0 0 0 0 0"), 19,
-                 {"expected 9 values", "frame 1", "found 8"});
+// Every refusal of a one-line change to the fixture: which line is replaced (the replacement
+// may be empty or span two lines), the line the message must name, and what it must say.
+struct LineChange {
+  const char* name;
+  int replaced_line;
+  const char* replacement;
+  int error_line;
+  std::vector<std::string> words;
+};
+
+// clang-format off
+const LineChange kRefusedLineChanges[] = {
+    {"MotionLineWithTooFewValues", 19, "0 90 0 0 0 0 0 0", 19,
+     {"expected 9 values", "frame 1", "found 8"}},
+    {"MotionLineWithTooManyValues", 20, "1 91 2 10 20 30 40 50 60 70", 20,
+     {"expected 9 values", "frame 2", "found more"}},
+    {"FrameSpreadOverTwoLines", 19, "0 90 0 0 0\n0 0 0 0", 19, {"expected 9 values", "found 5"}},
+    {"NonNumericMotionValue", 20, "1 91 2 10 abc 30 40 50 60", 20,
+     {"expected a number", "value 5 of 9", "'abc'"}},
+    {"NumberGluedToText", 19, "0 90 0 0 0 0 0 0 1.5x", 19, {"expected a number", "'1.5x'"}},
+    {"NanMotionValue", 19, "0 90 nan 0 0 0 0 0 0", 19, {"expected a finite number", "'nan'"}},
+    {"InfinityMotionValue", 20, "1 91 2 10 20 30 40 50 -inf", 20,
+     {"expected a finite number", "'-inf'"}},
+    {"OutOfRangeMotionValue1", 19, "0 1e999 0 0 0 0 0 0 0", 19,
+     {"expected a number within float range", "'1e999'"}},
+    // Finite as a double but not as a float.
+    {"OutOfRangeMotionValue2", 19, "0 90 0 0 0 0 0 0 1e39", 19,
+     {"expected a number within float range", "'1e39'"}},
+    {"NonFiniteOffset1", 8, "\t\tOFFSET 0 inf 0", 8,
+     {"expected OFFSET value 2 of 3", "finite", "'inf'"}},
+    {"NonFiniteOffset2", 4, "\tOFFSET 0 1e999 0", 4, {"expected OFFSET value 2 of 3", "'1e999'"}},
+    {"NonFiniteOrZeroFrameTime1", 18, "Frame Time: nan", 18, {"expected a positive frame time"}},
+    {"NonFiniteOrZeroFrameTime2", 18, "Frame Time: 1e999", 18, {"expected a positive frame time"}},
+    {"UnknownChannelName", 9, "\t\tCHANNELS 3 Zrotation Wrotation Yrotation", 9,
+     {"expected a channel name", "'Wrotation'", "'Spine'"}},
+    {"RepeatedChannelName", 9, "\t\tCHANNELS 3 Zrotation Zrotation Yrotation", 9,
+     {"expected each channel at most once", "'Zrotation'"}},
+    {"ChannelCountLargerThanTheNames", 9, "\t\tCHANNELS 4 Zrotation Xrotation Yrotation", 9,
+     {"expected 4 channel names", "found only 3", "'End'", "line 10"}},
+    {"ChannelCountSmallerThanTheNames", 9, "\t\tCHANNELS 2 Zrotation Xrotation Yrotation", 9,
+     {"expected 'JOINT', 'End Site' or '}'", "'Yrotation'", "'CHANNELS 2'"}},
+    {"ChannelCountOutOfRangeOrNotANumber1", 9, "\t\tCHANNELS 7 Zrotation Xrotation Yrotation", 9,
+     {"expected a channel count from 0 to 6", "'7'"}},
+    {"ChannelCountOutOfRangeOrNotANumber2", 9, "\t\tCHANNELS -1", 9,
+     {"expected a channel count from 0 to 6", "'-1'"}},
+    {"ChannelCountOutOfRangeOrNotANumber3", 9, "\t\tCHANNELS Zrotation Xrotation Yrotation", 9,
+     {"expected a channel count from 0 to 6", "'Zrotation'"}},
+    // Without line 15's '}', MOTION (now line 15) arrives while Hips is still open.
+    {"UnbalancedBracesMissingClose", 15, "", 15,
+     {"expected 'JOINT', 'End Site' or '}'", "'Hips'", "opened on line 2", "'MOTION'"}},
+    {"UnbalancedBracesExtraClose", 15, "}\n}", 16, {"expected 'MOTION'", "unbalanced braces"}},
+    {"MissingOpeningBrace", 7, "", 7, {"expected '{'", "'Spine'", "'OFFSET'"}},
+    {"EndSiteWithAJointInside", 13, "\t\t\tJOINT Inner", 13,
+     {"expected '}'", "End Site of joint 'Spine'", "'JOINT'"}},
+    {"DuplicateJointNames", 6, "\tJOINT Hips", 6,
+     {"expected unique joint names", "'Hips'", "first on line 2"}},
+    {"MissingJointName", 6, "\tJOINT", 7, {"expected a joint name", "'{'"}},
+    {"FrameCountSmallerThanTheData", 17, "Frames: 1", 20,
+     {"expected 1 frames", "line 17", "found more", "frame 2"}},
+    {"FrameCountLargerThanTheData", 17, "Frames: 3", 21, {"expected 3 frames", "found 2"}},
+    {"ZeroFrameTime", 18, "Frame Time: 0", 18, {"expected a positive frame time", "'0'"}},
+    {"NegativeFrameTime", 18, "Frame Time: -0.0333", 18,
+     {"expected a positive frame time", "'-0.0333'"}},
+    {"ZeroFrameCount", 17, "Frames: 0", 17, {"expected a positive frame count", "'0'"}},
+    {"NegativeFrameCount", 17, "Frames: -5", 17, {"expected a positive frame count", "'-5'"}},
+    {"NonIntegerOrHugeFrameCount1", 17, "Frames: 2.5", 17, {"expected a whole number of frames"}},
+    {"NonIntegerOrHugeFrameCount2", 17, "Frames: 2147483648", 17,
+     {"expected at most 2147483647 frames"}},
+    {"NonIntegerOrHugeFrameCount3", 17, "Frames: 99999999999999999999999", 17,
+     {"expected at most 2147483647 frames"}},
+    {"MissingFrameTimeLine", 18, "", 18, {"expected 'Frame'", "'0'"}},
+    {"TextAfterFrameTime", 18, "Frame Time: 0.03 0 90 0", 18,
+     {"expected the end of the line after the frame time"}},
+};
+// clang-format on
+
+class BvhMalformedLine : public testing::TestWithParam<LineChange> {};
+
+TEST_P(BvhMalformedLine, IsRefusedWithTheLineAndWhatWasExpected) {
+  const LineChange& change = GetParam();
+  expect_refused(fixture_with_line(change.replaced_line, change.replacement), change.error_line,
+                 change.words);
 }
 
-TEST(BvhMalformed, MotionLineWithTooManyValues) {
-  expect_refused(fixture_with_line(20, "1 91 2 10 20 30 40 50 60 70"), 20,
-                 {"expected 9 values", "frame 2", "found more"});
-}
-
-TEST(BvhMalformed, FrameSpreadOverTwoLines) {
-  expect_refused(fixture_with_line(19, "0 90 0 0 0\n0 0 0 0"), 19,
-                 {"expected 9 values", "found 5"});
-}
-
-TEST(BvhMalformed, NonNumericMotionValue) {
-  expect_refused(fixture_with_line(20, "1 91 2 10 abc 30 40 50 60"), 20,
-                 {"expected a number", "value 5 of 9", "'abc'"});
-}
-
-TEST(BvhMalformed, NumberGluedToText) {
-  expect_refused(fixture_with_line(19, "0 90 0 0 0 0 0 0 1.5x"), 19,
-                 {"expected a number", "'1.5x'"});
-}
-
-TEST(BvhMalformed, NanMotionValue) {
-  expect_refused(fixture_with_line(19, "0 90 nan 0 0 0 0 0 0"), 19,
-                 {"expected a finite number", "'nan'"});
-}
-
-TEST(BvhMalformed, InfinityMotionValue) {
-  expect_refused(fixture_with_line(20, "1 91 2 10 20 30 40 50 -inf"), 20,
-                 {"expected a finite number", "'-inf'"});
-}
-
-TEST(BvhMalformed, OutOfRangeMotionValue) {
-  expect_refused(fixture_with_line(19, "0 1e999 0 0 0 0 0 0 0"), 19,
-                 {"expected a number within float range", "'1e999'"});
-  // Finite as a double but not as a float.
-  expect_refused(fixture_with_line(19, "0 90 0 0 0 0 0 0 1e39"), 19,
-                 {"expected a number within float range", "'1e39'"});
-}
-
-TEST(BvhMalformed, NonFiniteOffset) {
-  expect_refused(fixture_with_line(8, "\t\tOFFSET 0 inf 0"), 8,
-                 {"expected OFFSET value 2 of 3", "finite", "'inf'"});
-  expect_refused(fixture_with_line(4, "\tOFFSET 0 1e999 0"), 4,
-                 {"expected OFFSET value 2 of 3", "'1e999'"});
-}
-
-TEST(BvhMalformed, NonFiniteOrZeroFrameTime) {
-  expect_refused(fixture_with_line(18, "Frame Time: nan"), 18, {"expected a positive frame time"});
-  expect_refused(fixture_with_line(18, "Frame Time: 1e999"), 18,
-                 {"expected a positive frame time"});
-}
-
-TEST(BvhMalformed, UnknownChannelName) {
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS 3 Zrotation Wrotation Yrotation"), 9,
-                 {"expected a channel name", "'Wrotation'", "'Spine'"});
-}
-
-TEST(BvhMalformed, RepeatedChannelName) {
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS 3 Zrotation Zrotation Yrotation"), 9,
-                 {"expected each channel at most once", "'Zrotation'"});
-}
-
-TEST(BvhMalformed, ChannelCountLargerThanTheNames) {
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS 4 Zrotation Xrotation Yrotation"), 9,
-                 {"expected 4 channel names", "found only 3", "'End'", "line 10"});
-}
-
-TEST(BvhMalformed, ChannelCountSmallerThanTheNames) {
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS 2 Zrotation Xrotation Yrotation"), 9,
-                 {"expected 'JOINT', 'End Site' or '}'", "'Yrotation'", "'CHANNELS 2'"});
-}
-
-TEST(BvhMalformed, ChannelCountOutOfRangeOrNotANumber) {
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS 7 Zrotation Xrotation Yrotation"), 9,
-                 {"expected a channel count from 0 to 6", "'7'"});
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS -1"), 9,
-                 {"expected a channel count from 0 to 6", "'-1'"});
-  expect_refused(fixture_with_line(9, "\t\tCHANNELS Zrotation Xrotation Yrotation"), 9,
-                 {"expected a channel count from 0 to 6", "'Zrotation'"});
-}
-
-TEST(BvhMalformed, UnbalancedBracesMissingClose) {
-  // Without line 15's '}', MOTION (now line 15) arrives while Hips is still open.
-  expect_refused(fixture_with_line(15, ""), 15,
-                 {"expected 'JOINT', 'End Site' or '}'", "'Hips'", "opened on line 2", "'MOTION'"});
-}
-
-TEST(BvhMalformed, UnbalancedBracesExtraClose) {
-  expect_refused(fixture_with_line(15, "}\n}"), 16, {"expected 'MOTION'", "unbalanced braces"});
-}
-
-TEST(BvhMalformed, MissingOpeningBrace) {
-  expect_refused(fixture_with_line(7, ""), 7, {"expected '{'", "'Spine'", "'OFFSET'"});
-}
-
-TEST(BvhMalformed, EndSiteWithAJointInside) {
-  expect_refused(fixture_with_line(13, "\t\t\tJOINT Inner"), 13,
-                 {"expected '}'", "End Site of joint 'Spine'", "'JOINT'"});
-}
-
-TEST(BvhMalformed, DuplicateJointNames) {
-  expect_refused(fixture_with_line(6, "\tJOINT Hips"), 6,
-                 {"expected unique joint names", "'Hips'", "first on line 2"});
-}
-
-TEST(BvhMalformed, MissingJointName) {
-  expect_refused(fixture_with_line(6, "\tJOINT"), 7, {"expected a joint name", "'{'"});
-}
-
-TEST(BvhMalformed, FrameCountSmallerThanTheData) {
-  expect_refused(fixture_with_line(17, "Frames: 1"), 20,
-                 {"expected 1 frames", "line 17", "found more", "frame 2"});
-}
-
-TEST(BvhMalformed, FrameCountLargerThanTheData) {
-  expect_refused(fixture_with_line(17, "Frames: 3"), 21, {"expected 3 frames", "found 2"});
-}
-
-TEST(BvhMalformed, ZeroFrameTime) {
-  expect_refused(fixture_with_line(18, "Frame Time: 0"), 18,
-                 {"expected a positive frame time", "'0'"});
-}
-
-TEST(BvhMalformed, NegativeFrameTime) {
-  expect_refused(fixture_with_line(18, "Frame Time: -0.0333"), 18,
-                 {"expected a positive frame time", "'-0.0333'"});
-}
-
-TEST(BvhMalformed, ZeroFrameCount) {
-  expect_refused(fixture_with_line(17, "Frames: 0"), 17,
-                 {"expected a positive frame count", "'0'"});
-}
-
-TEST(BvhMalformed, NegativeFrameCount) {
-  expect_refused(fixture_with_line(17, "Frames: -5"), 17,
-                 {"expected a positive frame count", "'-5'"});
-}
-
-TEST(BvhMalformed, NonIntegerOrHugeFrameCount) {
-  expect_refused(fixture_with_line(17, "Frames: 2.5"), 17, {"expected a whole number of frames"});
-  expect_refused(fixture_with_line(17, "Frames: 2147483648"), 17,
-                 {"expected at most 2147483647 frames"});
-  expect_refused(fixture_with_line(17, "Frames: 99999999999999999999999"), 17,
-                 {"expected at most 2147483647 frames"});
-}
+INSTANTIATE_TEST_SUITE_P(BvhMalformed, BvhMalformedLine, testing::ValuesIn(kRefusedLineChanges),
+                         [](const testing::TestParamInfo<LineChange>& param) {
+                           return std::string(param.param.name);
+                         });
 
 TEST(BvhMalformed, NoMotionSection) {
   std::string text = join(fixture_lines());
   text = text.substr(0, text.find("MOTION"));
   expect_refused(text, 16, {"expected 'MOTION'", "end of file"});
-}
-
-TEST(BvhMalformed, MissingFrameTimeLine) {
-  expect_refused(fixture_with_line(18, ""), 18, {"expected 'Frame'", "'0'"});
-}
-
-TEST(BvhMalformed, TextAfterFrameTime) {
-  expect_refused(fixture_with_line(18, "Frame Time: 0.03 0 90 0"), 18,
-                 {"expected the end of the line after the frame time"});
 }
 
 TEST(BvhMalformed, NoChannelsAtAll) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "base64.hpp"
+#include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
 #include "mm/runtime/pose.hpp"
@@ -29,9 +30,12 @@ namespace fs = std::filesystem;
 // ---------------------------------------------------------------------------------------------
 // Helpers
 
+// The file's bytes, or none when it cannot be read (the assertions on them then fail).
 std::vector<unsigned char> read_bytes(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  auto contents = read_whole_file(path);
+  if (!contents) return {};
+  const auto* bytes = reinterpret_cast<const unsigned char*>(contents->data.get());
+  return {bytes, bytes + contents->size};
 }
 
 void write_bytes(const fs::path& path, const void* data, size_t size) {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mm/database/database_file.hpp"
+#include "mm/database/files.hpp"
 #include "run_tool.hpp"
 #include "test_support.hpp"
 
@@ -24,11 +25,10 @@ namespace fs = std::filesystem;
 using test::CommandRun;
 using test::run_mm;
 
+// The file's text, or "" when it cannot be read (the assertions on the text then fail).
 std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
+  auto contents = read_whole_file(path);
+  return contents ? std::string(contents->text()) : std::string();
 }
 
 // A small real database (walks, turns, runs, a wave and the idle clip), built once per test
