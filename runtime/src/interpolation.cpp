@@ -178,20 +178,26 @@ DualQuat dual_quat_sclerp(const DualQuat& a, const DualQuat& b, float t) {
   return a * dual_quat_pow(dual_quat_conjugate(a) * b, t);
 }
 
-Transform transform_nlerp(const Transform& a, const Transform& b, float t) {
+namespace {
+
+// Translation and scale mixed linearly, with the rotation the caller interpolated.
+Transform mixed_with_rotation(const Transform& a, const Transform& b, float t,
+                              const glm::quat& rotation) {
   Transform out;
-  out.rotation = quat_nlerp(a.rotation, b.rotation, t);
+  out.rotation = rotation;
   out.translation = glm::mix(a.translation, b.translation, t);
   out.scale = glm::mix(a.scale, b.scale, t);
   return out;
 }
 
+}  // namespace
+
+Transform transform_nlerp(const Transform& a, const Transform& b, float t) {
+  return mixed_with_rotation(a, b, t, quat_nlerp(a.rotation, b.rotation, t));
+}
+
 Transform transform_slerp(const Transform& a, const Transform& b, float t) {
-  Transform out;
-  out.rotation = quat_slerp(a.rotation, b.rotation, t);
-  out.translation = glm::mix(a.translation, b.translation, t);
-  out.scale = glm::mix(a.scale, b.scale, t);
-  return out;
+  return mixed_with_rotation(a, b, t, quat_slerp(a.rotation, b.rotation, t));
 }
 
 Transform transform_sclerp(const Transform& a, const Transform& b, float t) {

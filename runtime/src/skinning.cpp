@@ -16,16 +16,28 @@ bool normalized_weights(const glm::vec4& raw, glm::vec4& weights) {
   return true;
 }
 
-// Asserts the span sizes the skinning functions require (compiled out in release builds).
-void check_sizes([[maybe_unused]] std::span<const glm::vec3> rest_positions,
-                 [[maybe_unused]] std::span<const glm::vec3> rest_normals,
-                 [[maybe_unused]] std::span<const VertexInfluences> influences,
-                 [[maybe_unused]] std::span<glm::vec3> out_positions,
-                 [[maybe_unused]] std::span<glm::vec3> out_normals) {
+// The loop both skinning methods share: sizes asserted (compiled out in release builds), each
+// vertex's weights normalized, and a vertex without usable weights left at its rest place.
+// `skin_vertex(v, weights)` writes vertex v's outputs.
+template <class SkinVertex>
+void for_each_skinned_vertex(std::span<const glm::vec3> rest_positions,
+                             std::span<const glm::vec3> rest_normals,
+                             std::span<const VertexInfluences> influences,
+                             std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals,
+                             SkinVertex skin_vertex) {
   assert(influences.size() == rest_positions.size());
   assert(out_positions.size() == rest_positions.size());
   assert(rest_normals.empty() || rest_normals.size() == rest_positions.size());
   assert(rest_normals.empty() || out_normals.size() == rest_positions.size());
+  for (size_t v = 0; v < rest_positions.size(); ++v) {
+    glm::vec4 w;
+    if (normalized_weights(influences[v].weights, w)) {
+      skin_vertex(v, w);
+    } else {
+      out_positions[v] = rest_positions[v];
+      if (!rest_normals.empty()) out_normals[v] = rest_normals[v];
+    }
+  }
 }
 
 glm::vec3 unit_or(const glm::vec3& v, const glm::vec3& fallback) {
@@ -71,15 +83,8 @@ void skin_linear_blend(std::span<const glm::mat4> skin, std::span<const glm::vec
                        std::span<const glm::vec3> rest_normals,
                        std::span<const VertexInfluences> influences,
                        std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals) {
-  check_sizes(rest_positions, rest_normals, influences, out_positions, out_normals);
   const bool with_normals = !rest_normals.empty();
-  for (size_t v = 0; v < rest_positions.size(); ++v) {
-    glm::vec4 w;
-    if (!normalized_weights(influences[v].weights, w)) {
-      out_positions[v] = rest_positions[v];
-      if (with_normals) out_normals[v] = rest_normals[v];
-      continue;
-    }
+  auto skin_vertex = [&](size_t v, const glm::vec4& w) {
     glm::mat4 m(0.0f);
     for (int k = 0; k < 4; ++k) {
       if (w[k] == 0.0f) continue;
@@ -95,22 +100,17 @@ void skin_linear_blend(std::span<const glm::mat4> skin, std::span<const glm::vec
       const glm::mat3 cofactor(glm::cross(c1, c2), glm::cross(c2, c0), glm::cross(c0, c1));
       out_normals[v] = unit_or(cofactor * rest_normals[v], rest_normals[v]);
     }
-  }
+  };
+  for_each_skinned_vertex(rest_positions, rest_normals, influences, out_positions, out_normals,
+                          skin_vertex);
 }
 
 void skin_dual_quaternion(std::span<const DualQuat> skin, std::span<const glm::vec3> rest_positions,
                           std::span<const glm::vec3> rest_normals,
                           std::span<const VertexInfluences> influences,
                           std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals) {
-  check_sizes(rest_positions, rest_normals, influences, out_positions, out_normals);
   const bool with_normals = !rest_normals.empty();
-  for (size_t v = 0; v < rest_positions.size(); ++v) {
-    glm::vec4 w;
-    if (!normalized_weights(influences[v].weights, w)) {
-      out_positions[v] = rest_positions[v];
-      if (with_normals) out_normals[v] = rest_normals[v];
-      continue;
-    }
+  auto skin_vertex = [&](size_t v, const glm::vec4& w) {
     // Align every influence's sign with the heaviest one so the blend takes the short way.
     int pivot = 0;
     for (int k = 1; k < 4; ++k) {
@@ -130,7 +130,9 @@ void skin_dual_quaternion(std::span<const DualQuat> skin, std::span<const glm::v
     const DualQuat unit = dual_quat_normalize(blend);
     out_positions[v] = dual_quat_transform_point(unit, rest_positions[v]);
     if (with_normals) out_normals[v] = unit_or(unit.real * rest_normals[v], rest_normals[v]);
-  }
+  };
+  for_each_skinned_vertex(rest_positions, rest_normals, influences, out_positions, out_normals,
+                          skin_vertex);
 }
 
 }  // namespace mm
