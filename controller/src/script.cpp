@@ -137,6 +137,106 @@ ControllerInput InputScript::at(float t) const {
 // ---------------------------------------------------------------------------------------------
 // Parsing
 
+namespace {
+
+// One line's tokens: comments ('#' to the end) and a Windows line end dropped, split at
+// separators.
+void split_tokens(std::string_view line, std::vector<std::string_view>& tokens) {
+  if (const size_t hash = line.find('#'); hash != std::string_view::npos) {
+    line = line.substr(0, hash);
+  }
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  tokens.clear();
+  for (size_t i = 0; i < line.size();) {
+    while (i < line.size() && is_separator(line[i])) ++i;
+    const size_t start = i;
+    while (i < line.size() && !is_separator(line[i])) ++i;
+    if (i > start) tokens.push_back(line.substr(start, i - start));
+  }
+}
+
+// One line's tokens and how to name them in messages ("file:line: ").
+struct ScriptLine {
+  const std::vector<std::string_view>& tokens;
+  std::string where;
+
+  std::string found(size_t index) const {
+    return index < tokens.size() ? quoted(tokens[index]) : std::string("the end of the line");
+  }
+};
+
+// The time (never before the previous line's) and the four stick values.
+Status parse_time_and_sticks(const ScriptLine& line, const std::vector<ScriptEvent>& events,
+                             ScriptEvent& event) {
+  if (!parse_finite(line.tokens[0], event.time) || event.time < 0.0f) {
+    return Error{line.where + "expected the time in seconds (a number >= 0), found " +
+                 line.found(0)};
+  }
+  if (!events.empty() && event.time < events.back().time) {
+    return Error{line.where + "expected a time >= " + shortest(events.back().time) +
+                 " (the time of line " + std::to_string(events.back().line) + "), found " +
+                 line.found(0)};
+  }
+  float sticks[4] = {};
+  for (size_t k = 0; k < 4; ++k) {
+    const size_t index = k + 1;
+    if (index >= line.tokens.size() || !parse_finite(line.tokens[index], sticks[k]) ||
+        sticks[k] < -1.0f || sticks[k] > 1.0f) {
+      return Error{line.where + "expected " + std::string(kStickNames[k]) +
+                   " (a number in [-1, 1]), found " + line.found(index)};
+    }
+  }
+  event.input.left_stick = {sticks[0], sticks[1]};
+  event.input.right_stick = {sticks[2], sticks[3]};
+  return Status::success();
+}
+
+// The optional flags after the sticks, each at most once: run, strafe, tag=NAME,
+// camera=DEGREES.
+Status parse_flags(const ScriptLine& line, ScriptEvent& event) {
+  bool seen_run = false, seen_strafe = false, seen_tag = false, seen_camera = false;
+  // True the second time a flag is seen on this line.
+  auto repeated = [](bool& seen) { return std::exchange(seen, true); };
+  for (size_t index = 5; index < line.tokens.size(); ++index) {
+    const std::string_view token = line.tokens[index];
+    auto twice = [&](std::string_view flag) {
+      return Error{line.where + "expected " + std::string(flag) +
+                   " at most once on a line, found " + quoted(token) + " again"};
+    };
+    if (token == "run") {
+      if (repeated(seen_run)) return twice("run");
+      event.input.run = true;
+    } else if (token == "strafe") {
+      if (repeated(seen_strafe)) return twice("strafe");
+      event.input.strafe = true;
+    } else if (token.starts_with("tag=")) {
+      if (repeated(seen_tag)) return twice("tag=NAME");
+      const std::string_view name = token.substr(4);
+      if (name.empty() || !std::all_of(name.begin(), name.end(), is_tag_char)) {
+        return Error{line.where +
+                     "expected tag=NAME with a name of letters, digits and _-.:+, found " +
+                     quoted(token)};
+      }
+      event.tag = name;
+    } else if (token.starts_with("camera=")) {
+      if (repeated(seen_camera)) return twice("camera=DEGREES");
+      float degrees = 0.0f;
+      if (!parse_finite(token.substr(7), degrees)) {
+        return Error{line.where +
+                     "expected camera=DEGREES with a finite number of degrees, found " +
+                     quoted(token)};
+      }
+      event.input.camera_yaw = static_cast<float>(degrees * kRadiansPerDegree);
+    } else {
+      return Error{line.where + "expected run, strafe, tag=NAME or camera=DEGREES, found " +
+                   quoted(token)};
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace
+
 Result<InputScript> parse_input_script(std::string_view text, std::string_view name_for_messages) {
   // Some Windows editors start a UTF-8 file with an invisible byte order mark; it is no token.
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
@@ -147,90 +247,17 @@ Result<InputScript> parse_input_script(std::string_view text, std::string_view n
   while (line_start <= text.size()) {
     size_t line_end = text.find('\n', line_start);
     if (line_end == std::string_view::npos) line_end = text.size();
-    std::string_view line = text.substr(line_start, line_end - line_start);
+    split_tokens(text.substr(line_start, line_end - line_start), tokens);
     line_start = line_end + 1;
     ++line_number;
-
-    if (const size_t hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
-    }
-    // A file saved with Windows line ends still reads the same.
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-
-    tokens.clear();
-    for (size_t i = 0; i < line.size();) {
-      while (i < line.size() && is_separator(line[i])) ++i;
-      const size_t start = i;
-      while (i < line.size() && !is_separator(line[i])) ++i;
-      if (i > start) tokens.push_back(line.substr(start, i - start));
-    }
     if (tokens.empty()) continue;
 
-    const std::string where =
-        std::string(name_for_messages) + ":" + std::to_string(line_number) + ": ";
-    auto found = [&](size_t index) {
-      return index < tokens.size() ? quoted(tokens[index]) : std::string("the end of the line");
-    };
-
+    const ScriptLine line{
+        tokens, std::string(name_for_messages) + ":" + std::to_string(line_number) + ": "};
     ScriptEvent event;
     event.line = line_number;
-    if (!parse_finite(tokens[0], event.time) || event.time < 0.0f) {
-      return Error{where + "expected the time in seconds (a number >= 0), found " + found(0)};
-    }
-    if (!events.empty() && event.time < events.back().time) {
-      return Error{where + "expected a time >= " + shortest(events.back().time) +
-                   " (the time of line " + std::to_string(events.back().line) + "), found " +
-                   found(0)};
-    }
-    float sticks[4] = {};
-    for (size_t k = 0; k < 4; ++k) {
-      const size_t index = k + 1;
-      if (index >= tokens.size() || !parse_finite(tokens[index], sticks[k]) || sticks[k] < -1.0f ||
-          sticks[k] > 1.0f) {
-        return Error{where + "expected " + std::string(kStickNames[k]) +
-                     " (a number in [-1, 1]), found " + found(index)};
-      }
-    }
-    event.input.left_stick = {sticks[0], sticks[1]};
-    event.input.right_stick = {sticks[2], sticks[3]};
-
-    bool seen_run = false, seen_strafe = false, seen_tag = false, seen_camera = false;
-    // True the second time a flag is seen on this line.
-    auto repeated = [](bool& seen) { return std::exchange(seen, true); };
-    for (size_t index = 5; index < tokens.size(); ++index) {
-      const std::string_view token = tokens[index];
-      auto twice = [&](std::string_view flag) {
-        return Error{where + "expected " + std::string(flag) + " at most once on a line, found " +
-                     quoted(token) + " again"};
-      };
-      if (token == "run") {
-        if (repeated(seen_run)) return twice("run");
-        event.input.run = true;
-      } else if (token == "strafe") {
-        if (repeated(seen_strafe)) return twice("strafe");
-        event.input.strafe = true;
-      } else if (token.starts_with("tag=")) {
-        if (repeated(seen_tag)) return twice("tag=NAME");
-        const std::string_view name = token.substr(4);
-        if (name.empty() || !std::all_of(name.begin(), name.end(), is_tag_char)) {
-          return Error{where +
-                       "expected tag=NAME with a name of letters, digits and _-.:+, found " +
-                       quoted(token)};
-        }
-        event.tag = name;
-      } else if (token.starts_with("camera=")) {
-        if (repeated(seen_camera)) return twice("camera=DEGREES");
-        float degrees = 0.0f;
-        if (!parse_finite(token.substr(7), degrees)) {
-          return Error{where + "expected camera=DEGREES with a finite number of degrees, found " +
-                       quoted(token)};
-        }
-        event.input.camera_yaw = static_cast<float>(degrees * kRadiansPerDegree);
-      } else {
-        return Error{where + "expected run, strafe, tag=NAME or camera=DEGREES, found " +
-                     quoted(token)};
-      }
-    }
+    if (Status s = parse_time_and_sticks(line, events, event); !s) return Error{s.message()};
+    if (Status s = parse_flags(line, event); !s) return Error{s.message()};
     events.push_back(std::move(event));
   }
   return InputScript(std::move(events));
@@ -239,7 +266,7 @@ Result<InputScript> parse_input_script(std::string_view text, std::string_view n
 Result<InputScript> load_input_script(const std::filesystem::path& path) {
   auto contents = read_whole_file(path, "input script");
   if (!contents) return contents.error();
-  return parse_input_script(std::string(contents->text()), path.string());
+  return parse_input_script(contents->text(), path.string());
 }
 
 // ---------------------------------------------------------------------------------------------
