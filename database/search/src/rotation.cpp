@@ -6,7 +6,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm::search_detail {
 

@@ -32,7 +32,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm::search_detail {
 
@@ -67,7 +67,7 @@ constexpr int kRotatedBoxDims = 16;
 // Depth-first, nearer child first; a subtree is entered only while its box is closer than the
 // best so far. `best` carries the threshold in and the answer out. A subtree pushed for later
 // has its children's boxes (or its first rows, for a leaf) prefetched: a traversal is a chain of
-// dependent reads, and on a busy machine each one that misses the caches costs ~150 ns.
+// dependent reads, and each one that misses the caches stalls the traversal (docs/search.md).
 __attribute__((always_inline)) inline void traverse(const TreeView& tree, const float* query,
                                                     const search_kernels::RowFilter& filter,
                                                     bool tag_filter,

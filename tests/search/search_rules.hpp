@@ -1,5 +1,5 @@
 #pragma once
-// The search rules (mm/database/search.hpp) checked on one answer, independently of any searcher:
+// The search rules (mm/search/search.hpp) checked on one answer, independently of any searcher:
 // shared by the synthetic and the real-data search tests. Header-only, because only the search
 // tests link the database library.
 
@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <span>
 
-#include "mm/database/search.hpp"
+#include "mm/search/search.hpp"
 
 namespace mm::test {
 
