@@ -1,7 +1,6 @@
 #pragma once
 // The search rules (mm/search/search.hpp) checked on one answer, independently of any searcher:
-// shared by the synthetic and the real-data search tests. Header-only, because only the search
-// tests link the database library.
+// shared by the synthetic and the real-data search tests (header-only: nothing else uses it).
 
 #include <gtest/gtest.h>
 

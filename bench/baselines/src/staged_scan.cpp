@@ -4,7 +4,6 @@
 // the fair baseline of a structure's speed-up. Rows are decided by their canonical distance
 // (ExactRanker), so the answer is exactly the reference's.
 
-#include <algorithm>
 #include <cassert>
 
 #include "detail.hpp"
@@ -22,15 +21,11 @@ class StagedScanSearcher final : public Searcher {
       : set_(make_candidate_set(input)), scan_(search_kernels::scan_blocks_staged()) {
     const int rows = set_.row_count();
     const int dims = set_.dims;
-    std::vector<float> rotated_rows(set_.rows.size());
+    std::vector<float> rotated_rows = set_.rows;
     if (rows > 0) {
-      rotation_ = principal_axes(set_.rows.data(), rows, dims, 4096);
-      float rotated[kMaxSearchDims];
-      for (int r = 0; r < rows; ++r) {
-        rotation_.apply(set_.row(r), rotated);
-        std::copy_n(rotated, dims, rotated_rows.data() + static_cast<size_t>(r) * dims);
-        max_row_norm_ = std::max(max_row_norm_, row_norm(rotated, dims));
-      }
+      rotation_ = principal_axes(rotated_rows.data(), rows, dims, 4096);
+      max_row_norm_ =
+          rotate_rows(rotation_, rotated_rows.data(), rows, dims, static_cast<size_t>(dims));
     }
     blocks_.pack(set_, rotated_rows.data());
   }

@@ -173,13 +173,7 @@ class BoxTree {
     }
     if (rotate && count > 0) {
       rotation_ = principal_axes(work.data(), count, dims, 4096);
-      float rotated[kMaxSearchDims];
-      for (int i = 0; i < count; ++i) {
-        float* row = work.data() + static_cast<size_t>(i) * row_size;
-        rotation_.apply(row, rotated);
-        std::copy_n(rotated, dims, row);
-        max_row_norm_ = std::max(max_row_norm_, row_norm(rotated, dims));
-      }
+      max_row_norm_ = rotate_rows(rotation_, work.data(), count, dims, row_size);
     }
     // The packed blocks are written last; until then their storage is the second row buffer.
     blocks_.resize(std::max(search_kernels::blocked_float_count(count, dims), work.size()));

@@ -143,6 +143,10 @@ FeatureRotation principal_axes(const float* rows, int row_count, int dims, int m
 // Euclidean norm of a row.
 float row_norm(const float* x, int dims);
 
+// Rotates `count` rows in place (each `dims` floats, `stride` floats apart) into `rotation`'s
+// axes and returns the largest norm of a rotated row (ExactRanker's max_row_norm).
+float rotate_rows(const FeatureRotation& rotation, float* rows, int count, int dims, size_t stride);
+
 // Decides rows found in a rotated space by their canonical (unrotated) distance, so a rotated
 // structure returns exactly what brute force returns. Rotation and float rounding move a
 // distance by at most `slack(d)`. Offered rows wait in a small buffer and get their canonical

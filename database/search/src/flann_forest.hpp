@@ -154,13 +154,8 @@ struct FlannForest {
       }
       if (rotate) {
         group.rotation = principal_axes(group.points.data(), count, dims, 4096);
-        float rotated[kMaxSearchDims];
-        for (int i = 0; i < count; ++i) {
-          float* point = group.points.data() + static_cast<size_t>(i) * dims;
-          group.rotation.apply(point, rotated);
-          std::copy_n(rotated, dims, point);
-          group.max_row_norm = std::max(group.max_row_norm, row_norm(rotated, dims));
-        }
+        group.max_row_norm = rotate_rows(group.rotation, group.points.data(), count, dims,
+                                         static_cast<size_t>(dims));
       }
       // Rows stop early only in principal axes (the leading columns carry the spread), and not
       // in a dense group.
