@@ -1,7 +1,8 @@
 // Google Benchmark for the search kernels and structures: the blocked scan (scalar loop,
 // portable vectors, AVX2), every method's query on the same rows, and batched queries on one and
 // two threads. After the run, each result is printed again as a ratio to its baseline measured
-// in the same run (scan: the scalar loop; search: brute and brute-simd; batch: one thread).
+// in the same run (scan: the scalar loop; search: brute, brute-simd and brute-staged; batch: one
+// thread).
 //
 // Rows: synthetic curve-like data (600 clips, ~90k searchable rows) by default, or a database
 // file named by MM_BENCH_DB (e.g. build/<you>/all.mmdb from `mm build`).
@@ -19,9 +20,11 @@
 #include <vector>
 
 #include "mm/database/database_file.hpp"
-#include "mm/database/search.hpp"
-#include "mm/database/search_kernels.hpp"
-#include "mm/database/search_synthetic.hpp"
+#include "mm/database/search_input.hpp"
+#include "mm/search/kernels.hpp"
+#include "mm/search/search.hpp"
+#include "mm/search_baselines/baselines.hpp"
+#include "mm/search_baselines/synthetic.hpp"
 
 namespace {
 
@@ -29,7 +32,8 @@ using namespace mm;
 
 // The rows every benchmark uses, loaded or generated once.
 struct BenchData {
-  Database database;  // when MM_BENCH_DB names a file
+  Database database;                                    // when MM_BENCH_DB names a file
+  std::unique_ptr<DatabaseSearchInput> database_input;  // its search views
   SyntheticSearchData synthetic;
   SearchInput input;
   NoisyQueries queries;        // 1024 queries, noise 0.1
@@ -48,7 +52,8 @@ const BenchData& data() {
       auto loaded = load_database(path);
       if (loaded) {
         out.database = std::move(loaded).value();
-        out.input = search_input(out.database);
+        out.database_input = std::make_unique<DatabaseSearchInput>(out.database);
+        out.input = out.database_input->input;
         out.source = path;
       } else {
         std::fprintf(stderr, "search_bench: %s; using synthetic data\n", loaded.message().c_str());
@@ -188,7 +193,7 @@ const Searcher& searcher(const std::string& method) {
   static std::map<std::string, std::unique_ptr<Searcher>> built;
   auto& slot = built[method];
   if (!slot) {
-    auto made = make_searcher(method, data().input);
+    auto made = make_bench_searcher(method, data().input);
     if (!made) {
       std::fprintf(stderr, "search_bench: %s\n", made.message().c_str());
       std::exit(1);
@@ -224,7 +229,7 @@ void BM_Batch(benchmark::State& state, const std::string& method) {
 }
 
 const bool registered = [] {
-  for (std::string_view name : search_method_names()) {
+  for (std::string_view name : bench_method_names()) {
     const std::string method(name);
     benchmark::RegisterBenchmark(("BM_Search/" + method).c_str(), [method](benchmark::State& st) {
       BM_Search(st, method);
@@ -289,12 +294,14 @@ int main(int argc, char** argv) {
       x > 0) {
     std::printf("  %-28s %7.2fx the full AVX2 distance\n", "BM_RowDistance_Avx2_Bounded", x);
   }
-  for (std::string_view name : search_method_names()) {
+  for (std::string_view name : bench_method_names()) {
     const std::string run = "BM_Search/" + std::string(name);
     const double over_brute = reporter.speedup(run, "BM_Search/brute");
     const double over_simd = reporter.speedup(run, "BM_Search/brute-simd");
+    const double over_staged = reporter.speedup(run, "BM_Search/brute-staged");
     if (over_brute > 0) {
-      std::printf("  %-28s %7.1fx brute, %6.2fx brute-simd\n", run.c_str(), over_brute, over_simd);
+      std::printf("  %-28s %7.1fx brute, %6.2fx brute-simd, %6.2fx brute-staged\n", run.c_str(),
+                  over_brute, over_simd, over_staged);
     }
   }
   for (const char* method : {"kdtree", "boxtree"}) {

@@ -6,6 +6,7 @@
 
 #include "mm/controller/controller.hpp"
 #include "mm/database/idle.hpp"
+#include "mm/database/search_input.hpp"
 
 namespace mm {
 
@@ -126,9 +127,9 @@ Result<const Searcher*> ControllerDatabase::searcher(std::string_view method) co
   for (const SearcherEntry& e : searchers_) {
     if (e.method == method) return static_cast<const Searcher*>(e.searcher.get());
   }
-  SearchInput input = search_input(*database_);
-  input.searchable = candidates_;
-  Result<std::unique_ptr<Searcher>> made = make_searcher(method, input, options_.search);
+  DatabaseSearchInput views(*database_);
+  views.input.searchable = candidates_;
+  Result<std::unique_ptr<Searcher>> made = make_searcher(method, views.input, options_.search);
   if (!made) return Error{made.message()};
   searchers_.push_back({std::string(method), std::move(made).value()});
   return static_cast<const Searcher*>(searchers_.back().searcher.get());

@@ -315,5 +315,14 @@ TEST(Cli, SearchBenchNeighbourhoodOfExactRowsIsTheRowItself) {
   EXPECT_DOUBLE_EQ(json["run"]["share_within_1.2x_nearest"]["median"].get<double>(), one_row);
 }
 
+// search-bench parses integers as integers: a fractional query count is a usage error that
+// names the option and the value.
+TEST(Cli, SearchBenchRefusesAFractionalQueryCount) {
+  const CommandRun run = run_mm("search-bench --synthetic --queries 1.5");
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--queries"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("'1.5' is not an integer"), std::string::npos) << run.output;
+}
+
 }  // namespace
 }  // namespace mm

@@ -34,11 +34,11 @@
 
 #include "mm/controller/input.hpp"
 #include "mm/database/database.hpp"
-#include "mm/database/search.hpp"
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/result.hpp"
 #include "mm/runtime/transform.hpp"
+#include "mm/search/search.hpp"
 
 namespace mm {
 

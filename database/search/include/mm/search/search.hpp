@@ -2,7 +2,7 @@
 // Motion-matching search: given a query vector in the normalized feature space and the
 // constraints of the character that asks, find the candidate frame of lowest cost.
 //
-// The rules every method implements (and the tests check against `brute`):
+// The rules every method implements (and the tests check against a plain reference scan):
 // - Candidates are the frames marked searchable when the database was built (every feature
 //   time of the frame lies inside its own clip), whose clip passes the tag filter: the clip
 //   must carry every tag of `include_tags` and none of `exclude_tags`.
@@ -28,7 +28,6 @@
 #include <string_view>
 #include <vector>
 
-#include "mm/database/database.hpp"
 #include "mm/runtime/result.hpp"
 
 namespace mm {
@@ -37,6 +36,14 @@ namespace mm {
 // size on the stack so that search() never allocates.
 inline constexpr int kMaxSearchDims = 256;
 
+// One clip as the search sees it: frames [start, end) and the mask of its tags. Continuations
+// never cross a clip boundary, and tag filters test the clip's mask.
+struct SearchClip {
+  int start = 0;      // first frame of the clip
+  int end = 0;        // one past its last frame
+  uint64_t tags = 0;  // bit i set when the clip carries tag i
+};
+
 // What a searcher is built from: views of the database's arrays. Searchers copy what they keep,
 // so the views only need to live while the searcher is being made.
 struct SearchInput {
@@ -44,7 +51,7 @@ struct SearchInput {
   int dims = 0;                         // columns of the feature matrix
   std::span<const uint8_t> searchable;  // frame_count flags: 1 when the frame may be matched
   std::span<const int> frame_clip;      // frame_count clip indices
-  std::span<const ClipRange> clips;     // clip ranges and their tag masks
+  std::span<const SearchClip> clips;    // clip ranges and their tag masks
 
   // Number of frames (rows of the feature matrix).
   int frame_count() const { return static_cast<int>(searchable.size()); }
@@ -52,9 +59,6 @@ struct SearchInput {
   // exists and its range contains the frame.
   Status validate() const;
 };
-
-// Views of a database's search arrays (the database must outlive the returned views).
-SearchInput search_input(const Database& database);
 
 // Per-query constraints (see the rules at the top of this file).
 struct SearchConstraints {
@@ -74,9 +78,9 @@ struct SearchResult {
 
 // Tunables of the search structures; every method reads the fields it needs.
 struct SearchOptions {
-  // Rows per leaf of the FLANN exact KD-tree (`kdtree`). 32 rather than 16: on all styles
-  // (noise 0.1) the larger leaves cut the median by about 13 % and the p99 by about 15 %, because
-  // fewer levels are backtracked; on the normal style the difference is within noise.
+  // Rows per leaf of the FLANN exact KD-tree (`kdtree`, `kdtree-eps`). 32 rather than 16:
+  // larger leaves mean fewer levels to backtrack, which pays on the many-style databases and
+  // is neutral on a single style (figures in docs/search.md).
   int kdtree_leaf_size = 32;
   // Rows per leaf of the box tree (`boxtree`): a positive multiple of 8 (one SIMD block).
   int boxtree_leaf_size = 64;
@@ -85,25 +89,21 @@ struct SearchOptions {
   // gestures), merging all others into one: one tree per group, each in the group's own
   // principal axes. A query visits groups nearest first and skips those whose bounding box is
   // farther than the best cost found. Without a dense cluster this is a single tree; 0 always
-  // builds a single tree (the default of `approx`, whose check budget would be spent per group).
-  int kdtree_group_rows = 4096;   // rows per group of `kdtree`
+  // builds a single tree.
+  int kdtree_group_rows = 4096;   // rows per group of `kdtree` and `kdtree-eps`
   int boxtree_group_rows = 4096;  // rows per group of `boxtree`
-  int approx_group_rows = 0;      // rows per group of `approx`
-  // `kdtree` and `approx` also build one index per tag class (rows whose clips carry exactly
-  // the same tags), searched when a query's tag filter leaves less than a quarter of the rows.
+  // `kdtree` and `kdtree-eps` also build one index per tag class (rows whose clips carry
+  // exactly the same tags), searched when a query's tag filter leaves less than a quarter of
+  // the rows.
   bool tag_class_indices = true;
-  // Build the trees (`kdtree`, `boxtree`, `approx`) over the principal axes of the rows
-  // instead of the raw columns. Results stay exact: rows are decided by their unrotated distance.
+  // Build the trees over the principal axes of the rows instead of the raw columns. Results
+  // stay exact: rows are decided by their unrotated distance.
   bool principal_axes = true;
-  // Randomized trees of the approximate method (`approx`).
-  int approx_trees = 1;
-  // Leaf checks per query of the approximate method (its budget; never unlimited).
-  int approx_checks = 128;
-  // eps of `kdtree-eps`: the distance found is within (1 + eps) times the best. 3: on all styles
-  // (noise 0.1) 99.95 % of the answers are exact at about 4.7 us median, against 100 % at about
-  // 5.9 us with eps 2 (same run); the bound is loose, the real mean cost ratio was 1.00005.
+  // eps of `kdtree-eps`: the distance found is within (1 + eps) times the best. 3 because the
+  // bound is loose: in practice nearly every answer is still exact, at a clearly lower median
+  // than eps 2 (figures in docs/search.md).
   float kdtree_eps = 3.0f;
-  // Threads that build the trees' groups in parallel (`kdtree`, `approx`); 0: every core.
+  // Threads that build the trees' groups in parallel (`kdtree`, `kdtree-eps`); 0: every core.
   int build_threads = 0;
 };
 
@@ -117,7 +117,7 @@ class Searcher {
   virtual std::string_view method() const = 0;
   // The feature dimension the searcher was built for (the query's length).
   virtual int dims() const = 0;
-  // True when the method returns the exact lowest cost (all but `approx`).
+  // True when the method returns the exact lowest cost (all but `kdtree-eps` here).
   virtual bool exact() const = 0;
   // Bytes the searcher owns (its copies of the rows, the index, the masks).
   virtual size_t memory_bytes() const = 0;
@@ -127,20 +127,18 @@ class Searcher {
 };
 
 // The method names make_searcher() accepts, the reference first:
-// - brute: every frame checked against the rules as written (early exit per row): the reference.
 // - brute-simd: every candidate row, in blocks of 8 rows scanned with AVX2 (or portable vector
-//   code): the fair brute-force baseline.
-// - aabb: bounding boxes over blocks of 16 and 64 consecutive rows with early exits per
-//   dimension (the structure of Daniel Holden's Motion-Matching demo).
+//   code): the brute-force reference, exact and with no structure to trust.
 // - kdtree: FLANN's exact single KD-tree (KDTreeSingleIndex) in principal axes, one per dense
 //   k-means group, plus one per tag class for selective tag filters.
 // - boxtree: k-d trees with a tight bounding box per node and SIMD-scanned leaves, in principal
 //   axes, one per dense group: the exact search for every case, including the hard ones.
-// - approx: FLANN's randomized KD-tree (KDTreeIndex) with a leaf-check budget; not exact.
 // - kdtree-eps: `kdtree` with FLANN's eps: a branch is skipped once its lower bound times
 //   (1 + eps) reaches the best distance so far, so the distance found is at most (1 + eps) times
-//   the best one; not exact, but bounded, and faster than the randomized trees here (each of
-//   their checks descends the tree anew: about 0.35 us per check on the all-styles database).
+//   the best one; not exact, but bounded, and cheaper than randomized trees with a check budget
+//   (each of their checks descends the tree anew).
+// Baselines that only serve comparison (a plain scan, bounding boxes over consecutive rows,
+// FLANN's randomized trees) live with the benchmarks, in bench/baselines/.
 std::span<const std::string_view> search_method_names();
 
 // Builds the named search structure over `input`; fails on an unknown name, invalid input or

@@ -1,4 +1,4 @@
-#include "mm/database/search_kernels.hpp"
+#include "mm/search/kernels.hpp"
 
 #include <immintrin.h>
 

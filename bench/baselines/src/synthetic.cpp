@@ -1,4 +1,4 @@
-#include "mm/database/search_synthetic.hpp"
+#include "mm/search_baselines/synthetic.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,8 +33,7 @@ SyntheticSearchData make_synthetic_search_data(const SyntheticSearchSpec& spec) 
   for (float& v : standing_center) v = 0.5f * gauss(rng);
 
   for (int c = 0; c < clip_count; ++c) {
-    ClipRange clip;
-    clip.name = "synthetic_" + std::to_string(c);
+    SearchClip clip;
     clip.start = data.frame_count();
     const int frames =
         min_frames + static_cast<int>(unit(rng) * static_cast<float>(max_frames - min_frames + 1));

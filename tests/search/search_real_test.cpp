@@ -7,13 +7,17 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "mm/database/builder.hpp"
-#include "mm/database/search.hpp"
-#include "mm/database/search_synthetic.hpp"
+#include "mm/database/search_input.hpp"
+#include "mm/search/search.hpp"
+#include "mm/search_baselines/baselines.hpp"
+#include "mm/search_baselines/synthetic.hpp"
 #include "search_rules.hpp"
 #include "test_support.hpp"
 
@@ -61,6 +65,14 @@ const Database& normal_database() {
   return db;
 }
 
+// The search views of a database (one per database, kept for the whole test program).
+const SearchInput& views(const Database& db) {
+  static std::map<const Database*, std::unique_ptr<DatabaseSearchInput>> made;
+  std::unique_ptr<DatabaseSearchInput>& entry = made[&db];
+  if (!entry) entry = std::make_unique<DatabaseSearchInput>(db);
+  return entry->input;
+}
+
 uint64_t tag(const Database& db, const std::string& name) {
   const std::string names[] = {name};
   return db.tag_mask(names);
@@ -76,7 +88,7 @@ struct Query {
 // 0 and 15; transition costs 0, 0.3 and 2; include none / walk / action / walk-turn-left (few
 // rows: the tag-class indices of kdtree and approx serve it); exclude none / run / locomotion.
 std::vector<Query> real_queries(const Database& db, int count, uint64_t seed) {
-  const SearchInput input = search_input(db);
+  const SearchInput input = views(db);
   const float noises[] = {0.02f, 0.1f, 0.25f, 0.5f};
   std::vector<Query> queries;
   std::mt19937 rng(static_cast<uint32_t>(seed));
@@ -107,7 +119,7 @@ std::vector<Query> real_queries(const Database& db, int count, uint64_t seed) {
 
 // The rules, checked independently of any searcher (cost recomputed in double).
 void expect_valid(const Database& db, const Query& q, const SearchResult& r) {
-  test::expect_obeys_search_rules(search_input(db), q.features, q.constraints, r);
+  test::expect_obeys_search_rules(views(db), q.features, q.constraints, r);
 }
 
 // A method and the options that change its structure (each variant is its own code path).
@@ -117,8 +129,8 @@ struct MethodCase {
   int group_rows = -1;  // -1: the method's default
   bool tag_class_indices = true;
 
-  SearchOptions options() const {
-    SearchOptions o;
+  BaselineSearchOptions options() const {
+    BaselineSearchOptions o;
     o.principal_axes = principal_axes;
     o.tag_class_indices = tag_class_indices;
     if (group_rows >= 0)
@@ -138,6 +150,7 @@ std::string case_name(const ::testing::TestParamInfo<MethodCase>& info) {
 
 const MethodCase kExactCases[] = {
     {"brute-simd"},
+    {"brute-staged"},
     {"aabb"},
     {"kdtree"},                    // one FLANN tree in principal axes, tag-class indices
     {"kdtree", false, -1, false},  // one FLANN tree over the raw columns, filter only
@@ -153,8 +166,8 @@ TEST_P(RealExactness, SameCostAsBruteOnTwoThousandConstrainedQueries) {
   const Database& db = subset_database();
   ASSERT_GT(db.clips.size(), 40u);
   ASSERT_GT(db.frame_count, 5000);
-  auto brute = make_searcher("brute", search_input(db));
-  auto method = make_searcher(GetParam().method, search_input(db), GetParam().options());
+  auto brute = make_bench_searcher("brute", views(db));
+  auto method = make_bench_searcher(GetParam().method, views(db), GetParam().options());
   ASSERT_TRUE(brute) << brute.message();
   ASSERT_TRUE(method) << method.message();
   const std::vector<Query> queries = real_queries(db, 2000, 17);
@@ -181,7 +194,7 @@ TEST_P(RealExactness, SameCostAsBruteOnTwoThousandConstrainedQueries) {
 
 TEST_P(RealExactness, ExactDuplicateFramesTieAtZeroDistance) {
   const Database& db = subset_database();
-  auto method = make_searcher(GetParam().method, search_input(db), GetParam().options());
+  auto method = make_bench_searcher(GetParam().method, views(db), GetParam().options());
   ASSERT_TRUE(method) << method.message();
   // Takes 027 and 031 of walk-turn-left are the same capture shifted by 23 frames: away from
   // the clip ends their feature rows are bitwise equal. Query such a row of 027 exactly, with
@@ -226,11 +239,11 @@ INSTANTIATE_TEST_SUITE_P(ExactMethods, RealExactness, ::testing::ValuesIn(kExact
 // answer is valid, never better than exact, never worse than `worst_factor` times exact (when
 // finite), and
 // found whenever a candidate exists; returns how many match brute's cost.
-int approximate_exact_count(const char* method, const SearchOptions& options, uint64_t seed,
+int approximate_exact_count(const char* method, const BaselineSearchOptions& options, uint64_t seed,
                             float worst_factor) {
   const Database& db = subset_database();
-  auto brute = make_searcher("brute", search_input(db));
-  auto approx = make_searcher(method, search_input(db), options);
+  auto brute = make_bench_searcher("brute", views(db));
+  auto approx = make_bench_searcher(method, views(db), options);
   EXPECT_TRUE(approx) << approx.message();
   if (!approx) return 0;
   const std::vector<Query> queries = real_queries(db, 1000, seed);
@@ -258,7 +271,7 @@ TEST(RealApprox, WithinItsBoundsOnConstrainedQueries) {
 // them at 0.5): within its (1 + eps) bound, and mostly exact (the benchmark measures the real
 // rate and speed per noise level).
 TEST(RealApprox, KdtreeEpsWithinItsBoundOnConstrainedQueries) {
-  const SearchOptions options;
+  const BaselineSearchOptions options;
   EXPECT_GT(approximate_exact_count("kdtree-eps", options, 29, 1.0f + options.kdtree_eps), 700);
 }
 
@@ -267,11 +280,11 @@ TEST(RealApprox, KdtreeEpsWithinItsBoundOnConstrainedQueries) {
 TEST(RealNormalSet, TreesMatchBruteOnTheFullDatabase) {
   const Database& db = normal_database();
   ASSERT_GT(db.frame_count, 50000);
-  const SearchInput input = search_input(db);
-  auto brute = make_searcher("brute", input);
+  const SearchInput input = views(db);
+  auto brute = make_bench_searcher("brute", input);
   ASSERT_TRUE(brute) << brute.message();
   for (const char* name : {"kdtree", "boxtree"}) {
-    auto method = make_searcher(name, input);
+    auto method = make_bench_searcher(name, input);
     ASSERT_TRUE(method) << method.message();
     int mismatches = 0;
     for (float noise : {0.1f, 0.5f}) {

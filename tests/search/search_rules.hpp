@@ -1,14 +1,13 @@
 #pragma once
-// The search rules (mm/database/search.hpp) checked on one answer, independently of any searcher:
-// shared by the synthetic and the real-data search tests. Header-only, because only the search
-// tests link the database library.
+// The search rules (mm/search/search.hpp) checked on one answer, independently of any searcher:
+// shared by the synthetic and the real-data search tests (header-only: nothing else uses it).
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <span>
 
-#include "mm/database/search.hpp"
+#include "mm/search/search.hpp"
 
 namespace mm::test {
 

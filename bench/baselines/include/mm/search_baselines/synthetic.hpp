@@ -1,14 +1,14 @@
 #pragma once
-// Synthetic search data for tests and benchmarks that must run without the motion-capture
-// files: clips of smooth, curve-like feature rows (locomotion-like cycles with drift) and a
-// dense cluster of low-variance "standing" clips, the hard case for search trees.
+// Synthetic search data for the search tests and benchmarks that must run without the
+// motion-capture files (not part of the library's API): clips of smooth, curve-like feature rows
+// (locomotion-like cycles with drift) and a dense cluster of low-variance "standing" clips, the
+// hard case for search trees.
 
 #include <cstdint>
 #include <span>
 #include <vector>
 
-#include "mm/database/database.hpp"
-#include "mm/database/search.hpp"
+#include "mm/search/search.hpp"
 
 namespace mm {
 
@@ -24,13 +24,13 @@ struct SyntheticSearchSpec {
   uint64_t seed = 1;               // the generator is deterministic for a given seed
 };
 
-// Generated arrays, laid out like a Database's search arrays.
+// Generated arrays, laid out like a database's search arrays.
 struct SyntheticSearchData {
   int dims = 0;
   std::vector<float> features;      // frame_count * dims
   std::vector<uint8_t> searchable;  // per frame
   std::vector<int> frame_clip;      // per frame
-  std::vector<ClipRange> clips;     // ranges and tag masks
+  std::vector<SearchClip> clips;    // ranges and tag masks
 
   int frame_count() const { return static_cast<int>(searchable.size()); }
   // Views for make_searcher() (valid while this object lives).

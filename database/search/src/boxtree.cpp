@@ -32,7 +32,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm::search_detail {
 
@@ -67,7 +67,7 @@ constexpr int kRotatedBoxDims = 16;
 // Depth-first, nearer child first; a subtree is entered only while its box is closer than the
 // best so far. `best` carries the threshold in and the answer out. A subtree pushed for later
 // has its children's boxes (or its first rows, for a leaf) prefetched: a traversal is a chain of
-// dependent reads, and on a busy machine each one that misses the caches costs ~150 ns.
+// dependent reads, and each one that misses the caches stalls the traversal (docs/search.md).
 __attribute__((always_inline)) inline void traverse(const TreeView& tree, const float* query,
                                                     const search_kernels::RowFilter& filter,
                                                     bool tag_filter,
@@ -173,13 +173,7 @@ class BoxTree {
     }
     if (rotate && count > 0) {
       rotation_ = principal_axes(work.data(), count, dims, 4096);
-      float rotated[kMaxSearchDims];
-      for (int i = 0; i < count; ++i) {
-        float* row = work.data() + static_cast<size_t>(i) * row_size;
-        rotation_.apply(row, rotated);
-        std::copy_n(rotated, dims, row);
-        max_row_norm_ = std::max(max_row_norm_, row_norm(rotated, dims));
-      }
+      max_row_norm_ = rotate_rows(rotation_, work.data(), count, dims, row_size);
     }
     // The packed blocks are written last; until then their storage is the second row buffer.
     blocks_.resize(std::max(search_kernels::blocked_float_count(count, dims), work.size()));

@@ -8,7 +8,7 @@
 #include <numeric>
 #include <random>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm::search_detail {
 

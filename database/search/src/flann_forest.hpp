@@ -1,6 +1,7 @@
-// The FLANN-based methods: `kdtree` (flann::KDTreeSingleIndex, exact), `kdtree-eps` (the same
-// tree searched with FLANN's eps: within (1 + eps) of the best) and `approx` (flann::KDTreeIndex,
-// randomized trees with a leaf-check budget).
+#pragma once
+// Internal to the search library (not installed): FLANN indices over k-means groups of the
+// candidate rows, searched under the rules. `kdtree` and `kdtree-eps` (flann.cpp) and the
+// randomized-trees baseline `approx` (bench/baselines/) are instances of FlannSearcher.
 //
 // All three index the searchable rows only (the mask is fixed when the database is built),
 // split into k-means groups (RowGroups) with one FLANN index per group, each over the group's
@@ -27,18 +28,17 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
-#include "search_detail.hpp"
-#include "workers.hpp"
+#include "detail.hpp"
+#include "mm/runtime/workers.hpp"
 
 namespace mm::search_detail {
 
-namespace {
-
 // FLANN's L2, with the row distance from our kernel (8 columns at a time, AVX2 when the CPU has
-// it) instead of FLANN's column-at-a-time loop: a third less time per query on the real data. The
-// single tree passes its threshold, and the kernel stops after 8 or 16 columns once the partial
-// sum exceeds it: in principal axes 92 % of the rows a leaf visits on all styles stop after 8.
+// it) instead of FLANN's column-at-a-time loop, which is markedly slower per query. The single
+// tree passes its threshold, and the kernel stops after 8 or 16 columns once the partial sum
+// exceeds it: in principal axes most rows a leaf visits stop after 8 (figures in docs/search.md).
 struct FlannDistance {
   typedef bool is_kdtree_distance;
   typedef float ElementType;
@@ -61,8 +61,7 @@ struct FlannDistance {
   search_kernels::BoundedRowDistanceFn bounded_kernel = search_kernels::row_distance_bounded();
   // Whether rows may stop early. Not in a dense group in its own axes: there the query's noise
   // outweighs the rows' spread in every axis, about half the rows stop, unpredictably, and the
-  // mispredicted branches cost more than the stops save (normal style, noise 0.1: kdtree median
-  // ~43 -> ~56 us with every group bounded).
+  // mispredicted branches cost more than the stops save (docs/search.md).
   bool bounded = true;
 };
 
@@ -99,27 +98,9 @@ class ConstrainedBestResultSet final : public flann::ResultSet<float> {
   search_kernels::ScanBest best_;
 };
 
-// What differs between the exact and the randomized FLANN index.
-struct ExactTraits {
-  using Index = flann::KDTreeSingleIndex<FlannDistance>;
-  static constexpr std::string_view kName = "kdtree";
-  static constexpr bool kExact = true;
-  // KDTreeSingleIndex with reorder copies the rows into tree order.
-  static constexpr bool kCopiesRows = true;
-};
-struct EpsTraits {
-  using Index = flann::KDTreeSingleIndex<FlannDistance>;
-  static constexpr std::string_view kName = "kdtree-eps";
-  static constexpr bool kExact = false;
-  static constexpr bool kCopiesRows = true;
-};
-struct ApproxTraits {
-  using Index = flann::KDTreeIndex<FlannDistance>;
-  static constexpr std::string_view kName = "approx";
-  static constexpr bool kExact = false;
-  static constexpr bool kCopiesRows = false;
-};
-
+// The traits of a FlannSearcher: `Index` (the FLANN index type), `kName` (the method's name),
+// `kExact` (whether the search is exact) and `kCopiesRows` (whether the index keeps its own copy
+// of the rows, so ours can be released once built).
 // One group: its rows (rotated or not), their candidate rows, frames and tags, and the index.
 template <class Index>
 struct FlannGroup {
@@ -173,13 +154,8 @@ struct FlannForest {
       }
       if (rotate) {
         group.rotation = principal_axes(group.points.data(), count, dims, 4096);
-        float rotated[kMaxSearchDims];
-        for (int i = 0; i < count; ++i) {
-          float* point = group.points.data() + static_cast<size_t>(i) * dims;
-          group.rotation.apply(point, rotated);
-          std::copy_n(rotated, dims, point);
-          group.max_row_norm = std::max(group.max_row_norm, row_norm(rotated, dims));
-        }
+        group.max_row_norm = rotate_rows(group.rotation, group.points.data(), count, dims,
+                                         static_cast<size_t>(dims));
       }
       // Rows stop early only in principal axes (the leading columns carry the spread), and not
       // in a dense group.
@@ -355,70 +331,5 @@ class FlannSearcher final : public Searcher {
   Forest main_;     // all rows: one index, or one per k-means group
   Forest classes_;  // one index per tag class (empty with a single class)
 };
-
-}  // namespace
-
-namespace {
-
-// The options `kdtree` and `kdtree-eps` share.
-Status check_single_tree_options(std::string_view method, const SearchOptions& options) {
-  if (options.kdtree_leaf_size < 1) {
-    return Error{std::string(method) + ": leaf size must be >= 1, got " +
-                 std::to_string(options.kdtree_leaf_size)};
-  }
-  if (options.kdtree_group_rows < 0) {
-    return Error{std::string(method) + ": rows per group must be >= 0 (0: one group), got " +
-                 std::to_string(options.kdtree_group_rows)};
-  }
-  return Status::success();
-}
-
-}  // namespace
-
-Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
-                                              const SearchOptions& options) {
-  if (Status valid = check_single_tree_options("kdtree", options); !valid)
-    return Error{valid.message()};
-  // KDTreeSingleIndex ignores the check count, and eps 0 keeps it exact.
-  return FlannSearcher<ExactTraits>::make(
-      input, options, options.kdtree_group_rows,
-      flann::KDTreeSingleIndexParams(options.kdtree_leaf_size, /*reorder=*/true),
-      flann::SearchParams());
-}
-
-Result<std::unique_ptr<Searcher>> make_kdtree_eps(const SearchInput& input,
-                                                  const SearchOptions& options) {
-  if (Status valid = check_single_tree_options("kdtree-eps", options); !valid) {
-    return Error{valid.message()};
-  }
-  if (!(options.kdtree_eps >= 0.0f) || !std::isfinite(options.kdtree_eps)) {
-    return Error{"kdtree-eps: eps must be finite and >= 0, got " +
-                 std::to_string(options.kdtree_eps)};
-  }
-  // FLANN skips a branch when its lower bound times (1 + eps) reaches the best distance so far.
-  flann::SearchParams search_params;
-  search_params.eps = options.kdtree_eps;
-  return FlannSearcher<EpsTraits>::make(
-      input, options, options.kdtree_group_rows,
-      flann::KDTreeSingleIndexParams(options.kdtree_leaf_size, /*reorder=*/true), search_params);
-}
-
-Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
-                                              const SearchOptions& options) {
-  if (options.approx_trees < 1) {
-    return Error{"approx: tree count must be >= 1, got " + std::to_string(options.approx_trees)};
-  }
-  if (options.approx_checks < 1) {
-    return Error{"approx: the check budget must be >= 1 (unlimited checks are not allowed), got " +
-                 std::to_string(options.approx_checks)};
-  }
-  if (options.approx_group_rows < 0) {
-    return Error{"approx: rows per group must be >= 0 (0: one group), got " +
-                 std::to_string(options.approx_group_rows)};
-  }
-  return FlannSearcher<ApproxTraits>::make(input, options, options.approx_group_rows,
-                                           flann::KDTreeIndexParams(options.approx_trees),
-                                           flann::SearchParams(options.approx_checks));
-}
 
 }  // namespace mm::search_detail

@@ -16,9 +16,10 @@
 #include <utility>
 #include <vector>
 
-#include "mm/database/search.hpp"
-#include "mm/database/search_kernels.hpp"
-#include "mm/database/search_synthetic.hpp"
+#include "mm/search/kernels.hpp"
+#include "mm/search/search.hpp"
+#include "mm/search_baselines/baselines.hpp"
+#include "mm/search_baselines/synthetic.hpp"
 #include "search_rules.hpp"
 
 // Every allocation of this test program is counted, so that a test can check that a searcher's
@@ -105,9 +106,10 @@ bool same_cost(float a, float b) {
   return std::fabs(a - b) <= 1e-5f * std::max(std::fabs(a), std::fabs(b));
 }
 
+// A library method or a baseline (bench/baselines/).
 std::unique_ptr<Searcher> make(std::string_view method, const SearchInput& input,
-                               const SearchOptions& options = {}) {
-  auto searcher = make_searcher(method, input, options);
+                               const BaselineSearchOptions& options = {}) {
+  auto searcher = make_bench_searcher(method, input, options);
   EXPECT_TRUE(searcher.ok()) << method << ": " << (searcher.ok() ? "" : searcher.message());
   return searcher.ok() ? std::move(searcher.value()) : nullptr;
 }
@@ -120,8 +122,7 @@ struct TinyDatabase {
   std::vector<float> features{0, 1, 2, 3, 4, 5, 10, 11, 12, 13, 14, 15, 2.5f, 2.5f, 2.5f};
   std::vector<uint8_t> searchable{1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1};
   std::vector<int> frame_clip{0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 2};
-  std::vector<ClipRange> clips{
-      {"walk", 0, 6, 0b001, false}, {"run", 6, 12, 0b010, false}, {"idle", 12, 15, 0b101, false}};
+  std::vector<SearchClip> clips{{0, 6, 0b001}, {6, 12, 0b010}, {12, 15, 0b101}};
 
   SearchInput input() const {
     SearchInput view;
@@ -137,7 +138,7 @@ struct TinyDatabase {
 class TinyRules : public ::testing::TestWithParam<std::string_view> {
  protected:
   void SetUp() override {
-    SearchOptions options;
+    BaselineSearchOptions options;
     options.kdtree_leaf_size = 2;
     options.approx_checks = 1000;  // more checks than rows: exhaustive on this size
     searcher_ = make(GetParam(), db_.input(), options);
@@ -252,7 +253,7 @@ std::string method_test_name(const ::testing::TestParamInfo<std::string_view>& p
   return name;
 }
 
-INSTANTIATE_TEST_SUITE_P(AllMethods, TinyRules, ::testing::ValuesIn(search_method_names()),
+INSTANTIATE_TEST_SUITE_P(AllMethods, TinyRules, ::testing::ValuesIn(bench_method_names()),
                          method_test_name);
 
 TEST(SearchInputValidation, RejectsEveryInconsistency) {
@@ -281,14 +282,15 @@ TEST(SearchInputValidation, RejectsEveryInconsistency) {
     TinyDatabase bad;
     bad.frame_clip[4] = 7;  // no such clip
     EXPECT_FALSE(bad.input().validate().ok());
-    EXPECT_FALSE(make_searcher("brute", bad.input()).ok());
+    EXPECT_FALSE(make_searcher("brute-simd", bad.input()).ok());
+    EXPECT_FALSE(make_bench_searcher("brute", bad.input()).ok());
   }
   {
     TinyDatabase bad;
     bad.frame_clip[4] = 1;  // clip 1 is frames 6..11
     const Status s = bad.input().validate();
     ASSERT_FALSE(s.ok());
-    EXPECT_NE(s.message().find("run"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("clip 1"), std::string::npos) << s.message();
   }
   {
     TinyDatabase bad;
@@ -305,9 +307,13 @@ TEST(SearchFactory, RejectsUnknownMethodsAndBadOptions) {
   SearchOptions options;
   options.kdtree_leaf_size = 0;
   EXPECT_FALSE(make_searcher("kdtree", db.input(), options).ok());
-  options = {};
-  options.approx_checks = 0;
-  EXPECT_FALSE(make_searcher("approx", db.input(), options).ok());
+  BaselineSearchOptions baseline_options;
+  baseline_options.approx_checks = 0;
+  EXPECT_FALSE(make_bench_searcher("approx", db.input(), baseline_options).ok());
+  auto unknown_baseline = make_bench_searcher("octree", db.input());
+  ASSERT_FALSE(unknown_baseline.ok());
+  EXPECT_NE(unknown_baseline.message().find("brute-staged"), std::string::npos)
+      << unknown_baseline.message();
   for (float eps : {-0.5f, std::numeric_limits<float>::quiet_NaN(), kInf}) {
     options = {};
     options.kdtree_eps = eps;
@@ -315,8 +321,8 @@ TEST(SearchFactory, RejectsUnknownMethodsAndBadOptions) {
     ASSERT_FALSE(refused.ok()) << eps;
     EXPECT_NE(refused.message().find("eps"), std::string::npos) << refused.message();
   }
-  for (std::string_view name : search_method_names()) {
-    auto s = make_searcher(name, db.input());
+  for (std::string_view name : bench_method_names()) {
+    auto s = make_bench_searcher(name, db.input());
     ASSERT_TRUE(s.ok()) << name;
     EXPECT_EQ(s.value()->method(), name);
     EXPECT_EQ(s.value()->dims(), 1);
@@ -325,10 +331,26 @@ TEST(SearchFactory, RejectsUnknownMethodsAndBadOptions) {
   }
 }
 
+// The library offers what a user would choose; the comparison baselines are not among them.
+TEST(SearchFactory, LibraryMethodsExcludeTheBaselines) {
+  TinyDatabase db;
+  const auto library = search_method_names();
+  EXPECT_EQ(std::vector<std::string_view>(library.begin(), library.end()),
+            (std::vector<std::string_view>{"brute-simd", "kdtree", "boxtree", "kdtree-eps"}));
+  for (std::string_view name : baseline_method_names()) {
+    EXPECT_FALSE(make_searcher(name, db.input()).ok()) << name;
+    EXPECT_TRUE(make_bench_searcher(name, db.input()).ok()) << name;
+  }
+  auto plain = make_flann_plain_searcher(db.input());
+  ASSERT_TRUE(plain.ok()) << plain.message();
+  const float q = 2.1f;  // nearest: frame 2 (value 2)
+  EXPECT_EQ(plain.value()->search(std::span<const float>(&q, 1), {}).frame, 2);
+}
+
 TEST(SearchFactory, EmptyCandidateSetFindsNothing) {
   TinyDatabase db;
   std::fill(db.searchable.begin(), db.searchable.end(), uint8_t{0});
-  for (std::string_view name : search_method_names()) {
+  for (std::string_view name : bench_method_names()) {
     auto s = make(name, db.input());
     ASSERT_NE(s, nullptr);
     const float q = 1.0f;
@@ -612,7 +634,8 @@ TEST_P(SyntheticExactness, SameCostAsBruteUnderEveryConstraintCombination) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ExactMethods, SyntheticExactness,
-                         ::testing::Values("brute-simd", "aabb", "kdtree", "boxtree"),
+                         ::testing::Values("brute-simd", "brute-staged", "aabb", "kdtree",
+                                           "boxtree"),
                          method_test_name);
 
 TEST(SyntheticApprox, NeverBelowExactAlwaysValidMostlyExact) {
@@ -644,7 +667,7 @@ TEST(SyntheticApprox, KdtreeEpsStaysWithinItsBound) {
   auto brute = make("brute", data.input());
   const std::vector<Query> queries = constrained_queries(data, 6, 12);
   for (float eps : {0.0f, 0.5f, 2.0f, 8.0f}) {
-    SearchOptions options;
+    BaselineSearchOptions options;
     options.kdtree_eps = eps;
     auto approx = make("kdtree-eps", data.input(), options);
     ASSERT_NE(approx, nullptr);
@@ -693,11 +716,11 @@ TEST(SearchBatch, BatchedResultsEqualSingleSearches) {
 }
 
 // The hot paths of the methods not built on FLANN allocate nothing (FLANN allocates inside its
-// findNeighbors(), as search_flann.cpp documents), and neither does a batched run.
+// findNeighbors(), as flann_forest.hpp documents), and neither does a batched run.
 TEST(SearchAllocations, HotPathsDoNotAllocate) {
   const SyntheticSearchData data = small_synthetic();
   const std::vector<Query> queries = constrained_queries(data, 1, 9);
-  for (const char* name : {"brute", "brute-simd", "aabb", "boxtree"}) {
+  for (const char* name : {"brute", "brute-simd", "brute-staged", "aabb", "boxtree"}) {
     auto searcher = make(name, data.input());
     ASSERT_NE(searcher, nullptr);
     const long before = g_allocations.load();
@@ -721,9 +744,9 @@ TEST(SyntheticData, HasClipsTailsAndAStandingCluster) {
   ASSERT_TRUE(data.input().validate().ok());
   EXPECT_EQ(data.clips.size(), 50u);
   int standing = 0;
-  for (const ClipRange& clip : data.clips) {
-    EXPECT_GE(clip.frame_count(), 60);
-    EXPECT_LE(clip.frame_count(), 180);
+  for (const SearchClip& clip : data.clips) {
+    EXPECT_GE(clip.end - clip.start, 60);
+    EXPECT_LE(clip.end - clip.start, 180);
     // The last 30 frames of each clip are not searchable, the others are.
     EXPECT_TRUE(data.searchable[clip.end - 30 - 1]);
     EXPECT_FALSE(data.searchable[clip.end - 30]);

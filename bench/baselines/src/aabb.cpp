@@ -1,65 +1,22 @@
-// The scan baselines: `brute-simd` (every candidate row, blocks of 8 rows with vector code) and
-// `aabb` (two levels of bounding boxes over consecutive rows with early exits per dimension,
-// the structure of Daniel Holden's Motion-Matching demo).
+// `aabb`: two levels of bounding boxes over consecutive rows with early exits per dimension, the
+// structure of Daniel Holden's Motion-Matching demo.
 
 #include <algorithm>
+#include <cassert>
+#include <limits>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
+#include "factories.hpp"
 
-namespace mm::search_detail {
+namespace mm::search_baselines {
 
 namespace {
 
-using search_kernels::kBlockRows;
-
-class BlockedScanSearcher final : public Searcher {
- public:
-  explicit BlockedScanSearcher(const SearchInput& input)
-      : set_(make_candidate_set(input)), scan_(search_kernels::scan_blocks()) {
-    const int rows = set_.row_count();
-    block_count_ = (rows + kBlockRows - 1) / kBlockRows;
-    blocks_.resize(search_kernels::blocked_float_count(rows, set_.dims));
-    search_kernels::pack_blocks(set_.rows.data(), rows, set_.dims, blocks_.data());
-    block_tags_or_.assign(static_cast<size_t>(block_count_), 0);
-    block_tags_and_.assign(static_cast<size_t>(block_count_), ~uint64_t{0});
-    for (int r = 0; r < rows; ++r) {
-      block_tags_or_[static_cast<size_t>(r / kBlockRows)] |= set_.row_tags[static_cast<size_t>(r)];
-      block_tags_and_[static_cast<size_t>(r / kBlockRows)] &= set_.row_tags[static_cast<size_t>(r)];
-    }
-  }
-
-  std::string_view method() const override { return "brute-simd"; }
-  int dims() const override { return set_.dims; }
-  bool exact() const override { return true; }
-  size_t memory_bytes() const override {
-    return set_.memory_bytes() + blocks_.capacity() * sizeof(float) +
-           (block_tags_or_.capacity() + block_tags_and_.capacity()) * sizeof(uint64_t);
-  }
-
-  SearchResult search(std::span<const float> query,
-                      const SearchConstraints& constraints) const override {
-    assert(static_cast<int>(query.size()) == set_.dims);
-    QueryPlan plan = plan_query(set_, query.data(), constraints);
-    // Distances are never negative: with a bound <= 0 nothing can beat the continuation.
-    if (!(plan.bound > 0.0f)) return finish_query(set_, plan, query.data(), -1, constraints);
-    if (constraints.include_tags != 0 || constraints.exclude_tags != 0) {
-      plan.filter.block_tags_or = block_tags_or_.data();
-      plan.filter.block_tags_and = block_tags_and_.data();
-    }
-    search_kernels::ScanBest best;
-    best.distance = plan.bound;
-    scan_(blocks_.data(), 0, block_count_, set_.dims, query.data(), plan.filter, best);
-    return finish_query(set_, plan, query.data(), best.row, constraints);
-  }
-
- private:
-  CandidateSet set_;
-  search_kernels::ScanBlocksFn scan_;
-  int block_count_ = 0;
-  std::vector<float> blocks_;
-  std::vector<uint64_t> block_tags_or_;
-  std::vector<uint64_t> block_tags_and_;
-};
+using search_detail::CandidateSet;
+using search_detail::finish_query;
+using search_detail::make_candidate_set;
+using search_detail::plan_query;
+using search_detail::QueryPlan;
 
 // Bounding boxes (lo, hi per dimension) over consecutive groups of `size` rows.
 struct BoxLevel {
@@ -151,12 +108,8 @@ class AabbSearcher final : public Searcher {
 
 }  // namespace
 
-Result<std::unique_ptr<Searcher>> make_brute_simd(const SearchInput& input) {
-  return std::unique_ptr<Searcher>(std::make_unique<BlockedScanSearcher>(input));
-}
-
 Result<std::unique_ptr<Searcher>> make_aabb(const SearchInput& input) {
   return std::unique_ptr<Searcher>(std::make_unique<AabbSearcher>(input));
 }
 
-}  // namespace mm::search_detail
+}  // namespace mm::search_baselines

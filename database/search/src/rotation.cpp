@@ -6,7 +6,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm::search_detail {
 
@@ -73,6 +73,19 @@ float row_norm(const float* x, int dims) {
   float sum = 0.0f;
   for (int d = 0; d < dims; ++d) sum += x[d] * x[d];
   return std::sqrt(sum);
+}
+
+float rotate_rows(const FeatureRotation& rotation, float* rows, int count, int dims,
+                  size_t stride) {
+  float max_norm = 0.0f;
+  float rotated[kMaxSearchDims];
+  for (int i = 0; i < count; ++i) {
+    float* row = rows + static_cast<size_t>(i) * stride;
+    rotation.apply(row, rotated);
+    std::copy_n(rotated, dims, row);
+    max_norm = std::max(max_norm, row_norm(rotated, dims));
+  }
+  return max_norm;
 }
 
 namespace {

@@ -1,4 +1,4 @@
-#include "mm/database/search.hpp"
+#include "mm/search/search.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -7,7 +7,7 @@
 #include <mutex>
 #include <thread>
 
-#include "search_detail.hpp"
+#include "detail.hpp"
 
 namespace mm {
 
@@ -32,11 +32,11 @@ Status SearchInput::validate() const {
       return Error{"search input: frame " + std::to_string(f) + " names clip " +
                    std::to_string(clip) + ", but there are " + std::to_string(clips.size())};
     }
-    const ClipRange& range = clips[static_cast<size_t>(clip)];
+    const SearchClip& range = clips[static_cast<size_t>(clip)];
     if (static_cast<int>(f) < range.start || static_cast<int>(f) >= range.end) {
       return Error{"search input: frame " + std::to_string(f) + " is outside the range [" +
                    std::to_string(range.start) + ", " + std::to_string(range.end) +
-                   ") of its clip '" + range.name + "'"};
+                   ") of its clip " + std::to_string(clip)};
     }
   }
   for (size_t i = 0; i < features.size(); ++i) {
@@ -48,31 +48,17 @@ Status SearchInput::validate() const {
   return Status::success();
 }
 
-SearchInput search_input(const Database& database) {
-  SearchInput input;
-  input.features = database.features;
-  input.dims = database.feature_dims();
-  input.searchable = database.searchable;
-  input.frame_clip = database.frame_clip;
-  input.clips = database.clips;
-  return input;
-}
-
 std::span<const std::string_view> search_method_names() {
-  static constexpr std::string_view names[] = {"brute",   "brute-simd", "aabb",      "kdtree",
-                                               "boxtree", "approx",     "kdtree-eps"};
+  static constexpr std::string_view names[] = {"brute-simd", "kdtree", "boxtree", "kdtree-eps"};
   return names;
 }
 
 Result<std::unique_ptr<Searcher>> make_searcher(std::string_view method, const SearchInput& input,
                                                 const SearchOptions& options) {
   if (Status valid = input.validate(); !valid) return Error{valid.message()};
-  if (method == "brute") return search_detail::make_brute(input);
   if (method == "brute-simd") return search_detail::make_brute_simd(input);
-  if (method == "aabb") return search_detail::make_aabb(input);
   if (method == "kdtree") return search_detail::make_kdtree(input, options);
   if (method == "boxtree") return search_detail::make_boxtree(input, options);
-  if (method == "approx") return search_detail::make_approx(input, options);
   if (method == "kdtree-eps") return search_detail::make_kdtree_eps(input, options);
   std::string known;
   for (std::string_view name : search_method_names()) {
@@ -161,90 +147,6 @@ SearchResult finish_query(const CandidateSet& set, const QueryPlan& plan, const 
     }
   }
   return result;
-}
-
-namespace {
-
-// The reference: every frame is checked against the rules exactly as they are written, with
-// only an early exit per row once its partial distance cannot win (which never changes the
-// answer, since partial sums only grow).
-class BruteSearcher final : public Searcher {
- public:
-  explicit BruteSearcher(const SearchInput& input)
-      : dims_(input.dims),
-        features_(input.features.begin(), input.features.end()),
-        searchable_(input.searchable.begin(), input.searchable.end()),
-        frame_clip_(input.frame_clip.begin(), input.frame_clip.end()) {
-    clip_tags_.reserve(input.clips.size());
-    for (const ClipRange& clip : input.clips) clip_tags_.push_back(clip.tags);
-  }
-
-  std::string_view method() const override { return "brute"; }
-  int dims() const override { return dims_; }
-  bool exact() const override { return true; }
-  size_t memory_bytes() const override {
-    return features_.capacity() * sizeof(float) + searchable_.capacity() +
-           frame_clip_.capacity() * sizeof(int) + clip_tags_.capacity() * sizeof(uint64_t);
-  }
-
-  const float* row(int frame) const {
-    return features_.data() + static_cast<size_t>(frame) * dims_;
-  }
-
-  SearchResult search(std::span<const float> query,
-                      const SearchConstraints& constraints) const override {
-    assert(static_cast<int>(query.size()) == dims_);
-    const int frame_count = static_cast<int>(searchable_.size());
-    const int current = constraints.current_frame;
-    const bool playing = current >= 0 && current < frame_count;
-    SearchResult best;
-    // The continuation first: every other candidate then has to be strictly cheaper, which is
-    // how the continuation wins ties.
-    const int next = current + 1;
-    if (playing && next < frame_count && searchable_[static_cast<size_t>(next)] &&
-        frame_clip_[static_cast<size_t>(next)] == frame_clip_[static_cast<size_t>(current)] &&
-        tags_pass(clip_tags_[static_cast<size_t>(frame_clip_[static_cast<size_t>(next)])],
-                  constraints.include_tags, constraints.exclude_tags)) {
-      best.frame = next;
-      best.cost = search_kernels::squared_distance(query.data(), row(next), dims_);
-      best.continuation = true;
-    }
-    for (int f = 0; f < frame_count; ++f) {
-      if (!searchable_[static_cast<size_t>(f)]) continue;
-      if (best.continuation && f == best.frame) continue;
-      if (!tags_pass(clip_tags_[static_cast<size_t>(frame_clip_[static_cast<size_t>(f)])],
-                     constraints.include_tags, constraints.exclude_tags)) {
-        continue;
-      }
-      if (playing && f >= current - constraints.window_frames &&
-          f <= current + constraints.window_frames) {
-        continue;
-      }
-      // Early exit per row: once the partial sum reaches the bound the row cannot win.
-      const float bound = best.cost - constraints.transition_cost;
-      const float distance =
-          search_kernels::squared_distance_bounded(query.data(), row(f), dims_, bound);
-      if (distance < bound && distance + constraints.transition_cost < best.cost) {
-        best.frame = f;
-        best.cost = distance + constraints.transition_cost;
-        best.continuation = false;
-      }
-    }
-    return best;
-  }
-
- private:
-  int dims_;
-  std::vector<float> features_;
-  std::vector<uint8_t> searchable_;
-  std::vector<int> frame_clip_;
-  std::vector<uint64_t> clip_tags_;
-};
-
-}  // namespace
-
-Result<std::unique_ptr<Searcher>> make_brute(const SearchInput& input) {
-  return std::unique_ptr<Searcher>(std::make_unique<BruteSearcher>(input));
 }
 
 }  // namespace search_detail

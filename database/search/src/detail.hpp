@@ -1,6 +1,7 @@
 #pragma once
-// Internal to the search: the candidate rows every method starts from, the per-query rules
-// (continuation, window, tags) shared by the fast methods, and each method's factory.
+// Internal to the search library (not installed): the candidate rows every method starts from,
+// the per-query rules (continuation, window, tags) shared by the fast methods, and each method's
+// factory. The comparison baselines (bench/baselines/) build on these too.
 
 #include <cmath>
 #include <cstdint>
@@ -10,8 +11,8 @@
 #include <span>
 #include <vector>
 
-#include "mm/database/search.hpp"
-#include "mm/database/search_kernels.hpp"
+#include "mm/search/kernels.hpp"
+#include "mm/search/search.hpp"
 
 namespace mm::search_detail {
 
@@ -32,6 +33,26 @@ struct CandidateSet {
 
 // Copies the searchable rows of a validated input.
 CandidateSet make_candidate_set(const SearchInput& input);
+
+// Candidate rows packed in blocks of 8 for the scan kernels, with the OR and AND of the tags of
+// each block's rows (so a scan skips blocks that cannot pass a tag filter).
+struct PackedBlocks {
+  int block_count = 0;
+  std::vector<float> blocks;  // search_kernels::pack_blocks() layout
+  std::vector<uint64_t> block_tags_or;
+  std::vector<uint64_t> block_tags_and;
+
+  // Packs `rows` (set.row_count() rows of set.dims floats, in the set's row order; the set's
+  // own rows or a transform of them).
+  void pack(const CandidateSet& set, const float* rows);
+  // Points `filter` at the block tags when the query has a tag filter.
+  void use_block_tags(const SearchConstraints& constraints,
+                      search_kernels::RowFilter& filter) const;
+  size_t memory_bytes() const {
+    return blocks.capacity() * sizeof(float) +
+           (block_tags_or.capacity() + block_tags_and.capacity()) * sizeof(uint64_t);
+  }
+};
 
 // Eight floats as a GCC vector: 256-bit AVX code in the AVX2 build of the traversal, two SSE
 // registers in the portable one.
@@ -122,12 +143,16 @@ FeatureRotation principal_axes(const float* rows, int row_count, int dims, int m
 // Euclidean norm of a row.
 float row_norm(const float* x, int dims);
 
+// Rotates `count` rows in place (each `dims` floats, `stride` floats apart) into `rotation`'s
+// axes and returns the largest norm of a rotated row (ExactRanker's max_row_norm).
+float rotate_rows(const FeatureRotation& rotation, float* rows, int count, int dims, size_t stride);
+
 // Decides rows found in a rotated space by their canonical (unrotated) distance, so a rotated
 // structure returns exactly what brute force returns. Rotation and float rounding move a
 // distance by at most `slack(d)`. Offered rows wait in a small buffer and get their canonical
 // distance only when it is full or the search ends (resolve()), and then only those still under
 // the threshold: most rows offered early are beaten later, and each canonical distance costs
-// reads far from the structure's own rows (about a quarter of a kdtree query on all styles).
+// reads far from the structure's own rows (a sizeable share of a kdtree query otherwise).
 // Meanwhile the scan threshold follows `upper`, an upper bound on the best canonical distance:
 // the canonical best row lies at most slack above it in the scanned space, so it is never pruned.
 struct ExactRanker {
@@ -226,15 +251,11 @@ RowGroups row_groups_of(const CandidateSet& set, const std::vector<std::vector<i
 std::vector<std::vector<int>> tag_classes(const CandidateSet& set);
 
 // Factories of the methods (input already validated, options checked by each).
-Result<std::unique_ptr<Searcher>> make_brute(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_brute_simd(const SearchInput& input);
-Result<std::unique_ptr<Searcher>> make_aabb(const SearchInput& input);
 Result<std::unique_ptr<Searcher>> make_kdtree(const SearchInput& input,
                                               const SearchOptions& options);
 Result<std::unique_ptr<Searcher>> make_kdtree_eps(const SearchInput& input,
                                                   const SearchOptions& options);
-Result<std::unique_ptr<Searcher>> make_approx(const SearchInput& input,
-                                              const SearchOptions& options);
 Result<std::unique_ptr<Searcher>> make_boxtree(const SearchInput& input,
                                                const SearchOptions& options);
 
