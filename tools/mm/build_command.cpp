@@ -1,6 +1,7 @@
 // `mm build`: makes a database file from BVH / glTF files and folders, with a progress bar and
 // a summary.
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -104,17 +105,15 @@ void add_skeleton_options(CLI::App& app, Arguments& out) {
          },
          "the joint playing a role (" + CLI::detail::join(roles, ", ") +
              "), instead of the name-based default; repeatable")
-      ->check(assignment("ROLE=JOINT") &
-              CLI::Validator(
-                  [roles](std::string& value) -> std::string {
-                    const std::string role = value.substr(0, value.find('='));
-                    for (const std::string& r : roles) {
-                      if (r == role) return {};
-                    }
-                    return "unknown role '" + role + "' (roles: " + CLI::detail::join(roles, ", ") +
-                           ")";
-                  },
-                  ""))
+      ->check(CLI::Validator(
+          [roles](std::string& value) -> std::string {
+            const auto assignment = split_assignment(value);
+            if (!assignment) return "'" + value + "' is not ROLE=JOINT";
+            if (std::find(roles.begin(), roles.end(), assignment->first) != roles.end()) return {};
+            return "unknown role '" + assignment->first +
+                   "' (roles: " + CLI::detail::join(roles, ", ") + ")";
+          },
+          ""))
       ->type_name("ROLE=JOINT")
       ->allow_extra_args(false);
   app.add_option_function<std::vector<std::string>>(
