@@ -18,6 +18,7 @@
 #include "mm/database/files.hpp"
 #include "number_parsing.hpp"
 #include "progress_bar.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {
@@ -84,10 +85,7 @@ void add_input_options(CLI::App& app, Arguments& out) {
                  "worker threads (default 0: all hardware threads)")
       ->check(integer_in(0, 256))
       ->type_name("N");
-  app.add_option("--scale", out.options.bvh.scale,
-                 "BVH units to metres (default 0.01: centimetres)")
-      ->check(number_over(0.0, 1000.0))
-      ->type_name("S");
+  add_bvh_scale_option(app, out.options.bvh.scale);
 }
 
 void add_skeleton_options(CLI::App& app, Arguments& out) {

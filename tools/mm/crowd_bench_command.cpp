@@ -14,8 +14,8 @@
 
 #include "command.hpp"
 #include "command_line.hpp"
-#include "controller_options.hpp"
 #include "mm/controller/crowd.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "command.hpp"
 #include "command_line.hpp"
-#include "controller_options.hpp"
 #include "mm/controller/evaluation.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {

@@ -8,13 +8,13 @@
 
 #include "command.hpp"
 #include "command_line.hpp"
-#include "controller_options.hpp"
 #include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
 #include "number_parsing.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {
@@ -54,9 +54,7 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       ->check(CLI::Validator(
           [](std::string& text) { return text.empty() ? "needs a clip name or index" : ""; }, ""))
       ->type_name("NAME|INDEX");
-  app.add_option("--scale", out.bvh.scale, "BVH units to metres (default 0.01: centimetres)")
-      ->check(number_over(0.0, 1000.0))
-      ->type_name("S");
+  add_bvh_scale_option(app, out.bvh.scale);
   app.add_flag("--body", out.with_body,
                "write the generated, skinned body with the clip (database input)");
   add_weights_option(app, out.body.weights.method, "the body's skinning weights (default heat)");
@@ -141,28 +139,33 @@ Status export_database_body(const Database& db, size_t clip, const CharacterBody
                            range.name, out);
 }
 
+// The clip the arguments' --clip selects among `clips` (a database's or a glTF file's).
+template <typename Clips>
+Result<size_t> select_clip_in(const Clips& clips, const Arguments& arguments) {
+  std::vector<std::string> names;
+  for (const auto& c : clips) names.push_back(c.name);
+  return select_clip(arguments.clip_selector, names, arguments.input);
+}
+
 // Each exporter writes the selected clip of its kind of file and says what it wrote.
 Result<std::string> export_from_database(const Arguments& arguments) {
   Result<Database> db = load_database(arguments.input);
   if (!db) return Error{db.message()};
-  std::vector<std::string> names;
-  for (const ClipRange& c : db->clips) names.push_back(c.name);
-  Result<size_t> clip = select_clip(arguments.clip_selector, names, arguments.input);
+  Result<size_t> clip = select_clip_in(db->clips, arguments);
   if (!clip) return Error{clip.message()};
   const Status written = arguments.with_body
                              ? export_database_body(*db, *clip, arguments.body, arguments.output)
                              : export_database_clip(*db, *clip, arguments.output);
   if (!written) return Error{written.message()};
-  return clip_description(names[*clip], db->clips[*clip].frame_count(), db->joint_count()) +
+  const ClipRange& range = db->clips[*clip];
+  return clip_description(range.name, range.frame_count(), db->joint_count()) +
          (arguments.with_body ? ", with the body" : "");
 }
 
 Result<std::string> export_from_gltf(const Arguments& arguments) {
   Result<GltfAsset> asset = load_gltf(arguments.input);
   if (!asset) return Error{asset.message()};
-  std::vector<std::string> names;
-  for (const Clip& c : asset->clips) names.push_back(c.name);
-  Result<size_t> clip = select_clip(arguments.clip_selector, names, arguments.input);
+  Result<size_t> clip = select_clip_in(asset->clips, arguments);
   if (!clip) return Error{clip.message()};
   const Clip& c = asset->clips[*clip];
   if (Status written = save_gltf(c, arguments.output); !written) return Error{written.message()};

@@ -4,8 +4,8 @@
 #include <sstream>
 
 #include "command_line.hpp"
-#include "controller_options.hpp"
 #include "number_parsing.hpp"
+#include "shared_options.hpp"
 
 namespace mm::viewer {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
-// What the controller-running commands share (`mm eval`, `mm crowd-bench`, `mm export --body`,
-// `mm-viewer`): the options about the controller and the character, declared once, and loading
-// a database for controllers.
+// The options several commands share, declared once: the controller's (`mm eval`,
+// `mm crowd-bench`, `mm-viewer`), the generated body's weights (`mm export`, `mm-viewer`) and
+// the BVH scale (`mm build`, `mm export`); and loading a database for controllers.
 
 #include <CLI/CLI.hpp>
 #include <memory>
@@ -25,6 +25,9 @@ void add_dt_option(CLI::App& app, float& dt, const std::string& default_text);
 
 // `--weights METHOD`: the generated body's skinning weights, one of the method names.
 void add_weights_option(CLI::App& app, WeightMethod& method, const std::string& description);
+
+// `--scale S` in (0, 1000]: BVH units to metres.
+void add_bvh_scale_option(CLI::App& app, float& scale);
 
 // After parsing: the settings as a whole (ranges, a known search method); -1 when they are
 // good, else the usage error's exit code (2) after printing the message.

@@ -1,4 +1,4 @@
-#include "controller_options.hpp"
+#include "shared_options.hpp"
 
 #include <vector>
 
@@ -50,6 +50,12 @@ void add_weights_option(CLI::App& app, WeightMethod& method, const std::string& 
          description)
       ->check(CLI::IsMember(names))
       ->type_name("METHOD");
+}
+
+void add_bvh_scale_option(CLI::App& app, float& scale) {
+  app.add_option("--scale", scale, "BVH units to metres (default 0.01: centimetres)")
+      ->check(number_over(0.0, 1000.0))
+      ->type_name("S");
 }
 
 int check_settings(const CLI::App& app, const ControllerSettings& settings) {
