@@ -424,5 +424,15 @@ TEST(Cli, MissingRequiredOptionsAndBadChoicesAreUsageErrors) {
   EXPECT_NE(two_scripts.output.find("none.mmdb"), std::string::npos) << two_scripts.output;
 }
 
+// An option given twice keeps its last value (scripts append overrides), as before CLI11.
+TEST(Cli, AnOptionGivenTwiceKeepsItsLastValue) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  const CommandRun run =
+      run_mm("build " + quoted(in) + " -o " + quoted(dir / "db.mmdb") + " --idle 2 --idle 0");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("idle:        none"), std::string::npos) << run.output;
+}
+
 }  // namespace
 }  // namespace mm

@@ -100,6 +100,9 @@ void set_up_app(CLI::App& app) {
   formatter->label("Usage", "usage");
   formatter->column_width(kOptionColumn);
   app.formatter(formatter);
+  // An option given twice keeps its last value, as scripts that append overrides expect;
+  // repeatable options keep every value.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
 }
 
 int usage_error(const CLI::App& app, const std::string& message) {

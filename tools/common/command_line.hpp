@@ -13,7 +13,8 @@ namespace mm::cli {
 
 // A CLI::App named after the command as typed ("mm build", "mm-viewer"), whose help starts
 // with "usage: <name> ...". An option's value shows as its type and its validators' ranges or
-// choices, e.g. "--idle SECONDS in [0, 60]" or "--ik {on,off}".
+// choices, e.g. "--idle SECONDS in [0, 60]" or "--ik {on,off}". Call it before declaring the
+// options: an option given twice then keeps its last value (repeatable ones keep every value).
 void set_up_app(CLI::App& app);
 
 // Parses `args` (the words after the command name, in order). Returns -1 when the command
