@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -143,8 +145,11 @@ TEST(Cli, IdleLengthIsAnOptionAndInfoShowsTheIdleClip) {
     const CommandRun run =
         run_mm("build " + quoted(in) + " -o " + quoted(dir / "bad.mmdb") + " --idle " + bad);
     EXPECT_EQ(run.exit_code, 2) << bad << "\n" << run.output;
-    EXPECT_NE(run.output.find("--idle needs a number of seconds from 0 to 60"), std::string::npos)
-        << run.output;
+    const std::string number = bad;
+    const std::string message = number == "-1" || number == "61"
+                                    ? "--idle: " + number + " is outside [0, 60]"
+                                    : "--idle: '" + number + "' is not a finite number";
+    EXPECT_NE(run.output.find(message), std::string::npos) << run.output;
   }
   // In range but too short for a searchable frame: the builder's message.
   const CommandRun short_idle =
@@ -238,7 +243,7 @@ TEST(Cli, ExportBodyWritesASkinnedCharacterWithTheClip) {
   const CommandRun bad_method =
       run_mm("export " + quoted(db) + " --body --weights magic -o " + quoted(out));
   EXPECT_EQ(bad_method.exit_code, 2);
-  EXPECT_NE(bad_method.output.find("--weights needs distance, envelope, heat or geodesic"),
+  EXPECT_NE(bad_method.output.find("--weights: magic not in {distance,envelope,heat,geodesic}"),
             std::string::npos)
       << bad_method.output;
   const CommandRun bvh = run_mm("export " + quoted(test::clip_path("dataset-2_walk_normal_001")) +
@@ -322,6 +327,120 @@ TEST(Cli, SearchBenchRefusesAFractionalQueryCount) {
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find("--queries"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("'1.5' is not an integer"), std::string::npos) << run.output;
+}
+
+// Every command's --help exits 0, starts with its usage line and lists the options it declares
+// (search-bench's own list is its converter's to check; here only its main options).
+TEST(Cli, EveryCommandsHelpListsItsOptions) {
+  const std::pair<const char*, std::vector<const char*>> commands[] = {
+      {"build",
+       {"-o,--output", "--rate", "--mirror", "--idle", "--tags", "--skip-bad", "--threads",
+        "--scale", "--role", "--mirror-pair", "--forward-axis", "--contact-height",
+        "--contact-toe-height", "--contact-speed", "--quiet"}},
+      {"info", {"--clips"}},
+      {"export", {"-o,--output", "--clip", "--scale", "--body", "--weights", "--voxel"}},
+      {"eval", {"--db", "--script", "--dt", "--ik", "--set", "--json", "--dump"}},
+      {"crowd-bench", {"--db", "--characters", "--seconds", "--threads", "--set", "--json"}},
+      {"search-bench", {"--db", "--queries"}},
+  };
+  for (const auto& [command, options] : commands) {
+    const CommandRun help = run_mm(std::string(command) + " --help");
+    EXPECT_EQ(help.exit_code, 0) << command;
+    EXPECT_EQ(help.output.rfind(std::string("usage: mm ") + command, 0), 0u) << help.output;
+    for (const char* option : options) {
+      EXPECT_NE(help.output.find(std::string("  ") + option + " "), std::string::npos)
+          << command << " " << option << "\n"
+          << help.output;
+    }
+  }
+  // The choices and ranges show in the help.
+  EXPECT_NE(run_mm("eval --help").output.find("--ik {on,off}"), std::string::npos);
+  EXPECT_NE(run_mm("build --help").output.find("--threads N in [0, 256]"), std::string::npos);
+  // `mm` alone and an unknown command are usage errors; `mm --help` lists every command with
+  // its summary.
+  EXPECT_EQ(run_mm("").exit_code, 2);
+  EXPECT_EQ(run_mm("no-such-command").exit_code, 2);
+  const CommandRun help = run_mm("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("crowd-bench    many controllers at 60 Hz"), std::string::npos)
+      << help.output;
+}
+
+// An integer option given a fraction is a usage error naming the option, before any file is
+// read (the database path does not exist).
+TEST(Cli, IntegerOptionsRefuseFractions) {
+  for (const std::string& arguments :
+       {std::string("build in -o out.mmdb --threads 1.5"),
+        std::string("crowd-bench --db none.mmdb --seconds 1 --characters 1.5"),
+        std::string("crowd-bench --db none.mmdb --seconds 1 --characters 4 --threads 1.5")}) {
+    const CommandRun run = run_mm(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+    const std::string option =
+        arguments.find("--threads") != std::string::npos ? "--threads" : "--characters";
+    EXPECT_NE(run.output.find(option + ": '1.5' is not an integer"), std::string::npos)
+        << run.output;
+  }
+  const CommandRun range = run_mm("crowd-bench --db none.mmdb --seconds 1 --characters 0");
+  EXPECT_EQ(range.exit_code, 2);
+  EXPECT_NE(range.output.find("--characters: 0 is outside [1, 100000]"), std::string::npos)
+      << range.output;
+}
+
+// A real-valued option given NaN, infinity or a value outside its range is a usage error
+// naming the option.
+TEST(Cli, NumberOptionsRefuseNanInfinityAndOutOfRange) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"build in -o out.mmdb --rate nan", "--rate: 'nan' is not a finite number"},
+      {"build in -o out.mmdb --scale 0", "--scale: 0 is outside (0, 1000]"},
+      {"export in.bvh -o out.glb --voxel inf", "--voxel: 'inf' is not a finite number"},
+      {"eval --db none.mmdb --script none.txt --dt nan", "--dt: 'nan' is not a finite number"},
+      {"crowd-bench --db none.mmdb --characters 2 --seconds nan",
+       "--seconds: 'nan' is not a finite number"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CommandRun run = run_mm(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+  }
+}
+
+// A missing required option or argument is a usage error naming it; so are a bad choice and a
+// second positional argument.
+TEST(Cli, MissingRequiredOptionsAndBadChoicesAreUsageErrors) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"build in", "--output is required"},
+      {"build -o out.mmdb", "inputs is required"},
+      {"info", "file is required"},
+      {"info a.mmdb b.mmdb", "not expected: b.mmdb"},
+      {"export in.bvh", "--output is required"},
+      {"eval --script none.txt", "--db is required"},
+      {"eval --db none.mmdb", "--script is required"},
+      {"eval --db none.mmdb --script none.txt --ik maybe", "--ik: maybe not in {on,off}"},
+      {"eval --db none.mmdb --script none.txt --set halflife", "--set: 'halflife' is not "},
+      {"crowd-bench --db none.mmdb --characters 2", "--seconds is required"},
+      {"build in -o out.mmdb --role knee=Knee", "unknown role 'knee'"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    const CommandRun run = run_mm(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << arguments << "\n" << run.output;
+  }
+  // Repeatable options take one value each time: two scripts, then a run-time failure (the
+  // database does not exist), not a usage error.
+  const CommandRun two_scripts =
+      run_mm("eval --db none.mmdb --script a.txt --script b.txt --set sync_mode=none");
+  EXPECT_EQ(two_scripts.exit_code, 1) << two_scripts.output;
+  EXPECT_NE(two_scripts.output.find("none.mmdb"), std::string::npos) << two_scripts.output;
+}
+
+// An option given twice keeps its last value (scripts append overrides), as before CLI11.
+TEST(Cli, AnOptionGivenTwiceKeepsItsLastValue) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path in = folder_with_real_clips(dir);
+  const CommandRun run =
+      run_mm("build " + quoted(in) + " -o " + quoted(dir / "db.mmdb") + " --idle 2 --idle 0");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("idle:        none"), std::string::npos) << run.output;
 }
 
 }  // namespace

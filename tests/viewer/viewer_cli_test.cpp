@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include <sys/wait.h>
 
@@ -217,11 +218,12 @@ TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
   EXPECT_NE(r.output.find("give --db or --data, not both"), std::string::npos) << r.output;
   r = run(viewer() + " --frames 1.5 --headless --script x");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("--frames needs a whole number"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--frames: '1.5' is not an integer"), std::string::npos) << r.output;
   r = run(viewer() + " --weights blobs");
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("--weights needs distance, envelope, heat or geodesic"),
-            std::string::npos);
+  EXPECT_NE(r.output.find("--weights: blobs not in {distance,envelope,heat,geodesic}"),
+            std::string::npos)
+      << r.output;
 
   const fs::path dir = test::scratch_dir();
   r = run(viewer() + " --db '" + (dir / "missing.mmdb").string() + "' --headless --script '" +
@@ -236,6 +238,41 @@ TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
           "'");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("no display"), std::string::npos) << r.output;
+}
+
+// The generated help lists every option; typed options refuse bad values naming the option,
+// and the options that go together stay usage errors.
+TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
+  ProgramRun r = run(viewer() + " --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.output.rfind("usage: mm-viewer", 0), 0u) << r.output;
+  for (const char* option : {"--db", "--data", "--body", "--weights", "--skinning", "--script",
+                             "--record", "--set", "--debug", "--no-panel", "--headless", "--frames",
+                             "--screenshot", "--every", "--plot", "--size", "--dt"}) {
+    EXPECT_NE(r.output.find(std::string("  ") + option + " "), std::string::npos) << option << "\n"
+                                                                                  << r.output;
+  }
+  EXPECT_NE(r.output.find("--skinning {lbs,dqs}"), std::string::npos) << r.output;
+
+  const std::pair<std::string, std::string> cases[] = {
+      {" --frames 1.5", "--frames: '1.5' is not an integer"},
+      {" --every 2.5 --screenshot s.png", "--every: '2.5' is not an integer"},
+      {" --frames 0", "--frames: 0 is outside [1, 10000000]"},
+      {" --dt nan", "--dt: 'nan' is not a finite number"},
+      {" --dt 0", "--dt: 0 is outside (0, 1]"},
+      {" --size 640x10", "--size: '640x10' is not WxH"},
+      {" --skinning fancy", "--skinning: fancy not in {lbs,dqs}"},
+      {" --debug roots,sparkles", "--debug: 'roots,sparkles' is not a list of"},
+      {" --set nonsense=1", "--set: unknown setting 'nonsense'"},
+      {" --every 10", "--every needs --screenshot"},
+      {" --script a.txt --record b.txt", "--record records live input"},
+      {" stray", "not expected: stray"},
+  };
+  for (const auto& [arguments, message] : cases) {
+    r = run(viewer() + arguments);
+    EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << arguments << "\n" << r.output;
+  }
 }
 
 }  // namespace

@@ -28,4 +28,10 @@ std::optional<long long> parse_count(const std::string& text) {
   return value;
 }
 
+std::optional<std::pair<std::string, std::string>> split_assignment(const std::string& text) {
+  const size_t equals = text.find('=');
+  if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) return std::nullopt;
+  return std::pair{text.substr(0, equals), text.substr(equals + 1)};
+}
+
 }  // namespace mm::cli

@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace mm::cli {
 
@@ -11,5 +12,8 @@ std::optional<double> parse_number(const std::string& text);
 
 // The whole text parsed as a non-negative integer, or nothing ("1.5" and "-2" are refused).
 std::optional<long long> parse_count(const std::string& text);
+
+// "NAME=VALUE" split at its first '=', both sides non-empty, or nothing.
+std::optional<std::pair<std::string, std::string>> split_assignment(const std::string& text);
 
 }  // namespace mm::cli

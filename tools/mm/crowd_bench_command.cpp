@@ -1,9 +1,11 @@
 // `mm crowd-bench`: many controllers over one database at 60 Hz; cost per character and the
 // largest crowd one frame holds, on 1 and 2 threads.
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -11,115 +13,87 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "controller_options.hpp"
-#include "database_summary.hpp"
+#include "command_line.hpp"
 #include "mm/controller/crowd.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {
 
-const char* const kUsage =
-    R"(usage: mm crowd-bench --db FILE.mmdb --characters N --seconds S [options]
+struct Arguments {
+  std::string db_path;
+  std::string json_path;
+  CrowdOptions options;
+  int extra_threads = 0;
+};
 
-Updates N character controllers over one shared database at 60 Hz for S seconds of game
-time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera
-turns), and prints the update cost per character per frame (mean, p99, the share spent in
-search) and the largest crowd a 1/60 s frame holds at that cost, on 1 and on 2 threads (and
-on --threads T when it is another count). Every run ends with the same character positions
-whatever the thread count; the tool checks that.
-
-options:
-  --db FILE          the database (required)
-  --characters N     characters (required, 1 to 100000)
-  --seconds S        seconds of game time (required, > 0)
-  --threads T        also run on T threads (default: only 1 and 2)
-  --set NAME=VALUE   a controller setting by name (see mm eval --help); repeatable
-  --json FILE        also write the results as JSON
-  -h, --help         this text
-
-exit status: 0 fine, 1 bad database or a run that differs between thread counts, 2 bad usage
-)";
-
-int usage_error(const std::string& message) {
-  std::fprintf(stderr, "mm crowd-bench: %s\n\n%s", message.c_str(), kUsage);
-  return 2;
+// Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
+int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
+  CLI::App app(
+      "Updates N character controllers over one shared database at 60 Hz for S seconds of game "
+      "time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera "
+      "turns), and prints the update cost per character per frame (mean, p99, the share spent in "
+      "search) and the largest crowd a 1/60 s frame holds at that cost, on 1 and on 2 threads "
+      "(and on --threads T when it is another count). Every run ends with the same character "
+      "positions whatever the thread count; the tool checks that.",
+      "mm crowd-bench");
+  set_up_app(app);
+  app.footer(
+      "exit status: 0 fine, 1 bad database or a run that differs between thread counts, 2 bad "
+      "usage");
+  app.add_option("--db", out.db_path, "the database")->required()->type_name("FILE");
+  app.add_option("--characters", out.options.characters, "characters")
+      ->required()
+      ->check(integer_in(1, 100000))
+      ->type_name("N");
+  app.add_option("--seconds", out.options.seconds, "seconds of game time")
+      ->required()
+      ->check(number_over(0.0, 3600.0))
+      ->type_name("S");
+  app.add_option("--threads", out.extra_threads, "also run on T threads (default: only 1 and 2)")
+      ->check(integer_in(1, 1024))
+      ->type_name("T");
+  add_set_option(app, out.options.settings);
+  app.add_option("--json", out.json_path, "also write the results as JSON")->type_name("FILE");
+  if (const int code = parse_command_line(app, args); code >= 0) return code;
+  return check_settings(app, out.options.settings);
 }
 
-int run_crowd_bench(const std::vector<std::string>& args) {
-  std::string db_path, json_path;
-  CrowdOptions options;
-  options.characters = 0;
-  options.seconds = 0.0f;
-  int extra_threads = 0;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--db" || a == "--json") {
-      const std::string* v = value();
-      if (!v) return usage_error(a + " needs a file name");
-      (a == "--db" ? db_path : json_path) = *v;
-    } else if (a == "--characters" || a == "--threads") {
-      const std::string* v = value();
-      const std::optional<long long> count = v ? parse_count(*v) : std::nullopt;
-      if (!count || *count < 1 || *count > 100000) {
-        return usage_error(a + " needs a whole number from 1 to 100000");
-      }
-      (a == "--characters" ? options.characters : extra_threads) = static_cast<int>(*count);
-    } else if (a == "--seconds") {
-      const std::string* v = value();
-      const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
-      if (!s || *s <= 0.0 || *s > 3600.0)
-        return usage_error("--seconds needs a number in (0, 3600]");
-      options.seconds = static_cast<float>(*s);
-    } else if (a == "--set") {
-      if (Status s = apply_set_option(value(), options.settings); !s) {
-        return usage_error(s.message());
-      }
-    } else {
-      return usage_error("unknown argument '" + a + "'");
-    }
-  }
-  if (db_path.empty()) return usage_error("--db is required");
-  if (options.characters == 0) return usage_error("--characters is required");
-  if (options.seconds == 0.0f) return usage_error("--seconds is required");
-  if (Status s = options.settings.validate(); !s) return usage_error(s.message());
+// The JSON of one run, and its figures printed as a table row.
+nlohmann::json report_run(const CrowdResult& run) {
+  std::printf("%8d %14.2f %14.2f %12.1f%% %14.3f %16d\n", run.threads, run.update_us_mean,
+              run.update_us_p99, 100.0 * run.search_share, run.frame_ms_mean,
+              run.max_characters_60hz);
+  std::fflush(stdout);
+  return {{"threads", run.threads},
+          {"update_us_mean", run.update_us_mean},
+          {"update_us_p99", run.update_us_p99},
+          {"search_share", run.search_share},
+          {"frame_ms_mean", run.frame_ms_mean},
+          {"max_characters_60hz", run.max_characters_60hz}};
+}
 
-  Result<std::shared_ptr<const ControllerDatabase>> shared = load_controller_database(db_path);
-  if (!shared) {
-    std::fprintf(stderr, "mm crowd-bench: %s\n", shared.message().c_str());
-    return 1;
-  }
-  // Build the searcher before timing anything.
-  if (Result<const Searcher*> s = (*shared)->searcher(options.settings.search_method); !s) {
-    std::fprintf(stderr, "mm crowd-bench: %s\n", s.message().c_str());
-    return 1;
-  }
-
+// Runs the crowd on every thread count into `json`; returns whether every run ended with the
+// same positions, or nothing (with the message printed) when a run failed.
+std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerDatabase>& shared,
+                                      Arguments& arguments, nlohmann::json& json) {
+  CrowdOptions& options = arguments.options;
   std::set<int> thread_counts = {1, 2};
-  if (extra_threads > 0) thread_counts.insert(extra_threads);
+  if (arguments.extra_threads > 0) thread_counts.insert(arguments.extra_threads);
   std::printf("%d characters, %.1f s at 60 Hz (%d frames each)\n", options.characters,
               options.seconds, static_cast<int>(std::ceil(options.seconds * 60.0f)));
   std::printf("%8s %14s %14s %13s %14s %16s\n", "threads", "update us mean", "update us p99",
               "search share", "frame ms mean", "max chars 60 Hz");
-  nlohmann::json json;
-  json["characters"] = options.characters;
-  json["seconds"] = options.seconds;
   std::vector<glm::vec3> reference;
   bool same = true;
   for (int threads : thread_counts) {
     options.threads = threads;
-    Result<CrowdResult> run = run_crowd(*shared, options);
+    Result<CrowdResult> run = run_crowd(shared, options);
     if (!run) {
       std::fprintf(stderr, "mm crowd-bench: %s\n", run.message().c_str());
-      return 1;
+      return std::nullopt;
     }
-    std::printf("%8d %14.2f %14.2f %12.1f%% %14.3f %16d\n", run->threads, run->update_us_mean,
-                run->update_us_p99, 100.0 * run->search_share, run->frame_ms_mean,
-                run->max_characters_60hz);
-    std::fflush(stdout);
+    json["runs"].push_back(report_run(*run));
     if (reference.empty()) {
       reference = run->final_positions;
     } else {
@@ -129,29 +103,48 @@ int run_crowd_bench(const std::vector<std::string>& args) {
     std::string key = "max_characters_60hz_";
     key.append(std::to_string(threads)).append(threads == 1 ? "_thread" : "_threads");
     json[key] = run->max_characters_60hz;
-    json["runs"].push_back({{"threads", run->threads},
-                            {"update_us_mean", run->update_us_mean},
-                            {"update_us_p99", run->update_us_p99},
-                            {"search_share", run->search_share},
-                            {"frame_ms_mean", run->frame_ms_mean},
-                            {"max_characters_60hz", run->max_characters_60hz}});
     if (threads == 1) {
       json["update_us_mean"] = run->update_us_mean;
       json["update_us_p99"] = run->update_us_p99;
       json["search_share"] = run->search_share;
     }
   }
-  json["same_result_every_thread_count"] = same;
-  std::printf("final positions %s across thread counts\n", same ? "identical" : "DIFFER");
-  if (!json_path.empty()) {
-    std::ofstream file(json_path);
+  return same;
+}
+
+int run_crowd_bench(const std::vector<std::string>& args) {
+  Arguments arguments;
+  if (const int code = parse_arguments(args, arguments); code >= 0) return code;
+
+  Result<std::shared_ptr<const ControllerDatabase>> shared =
+      load_controller_database(arguments.db_path);
+  if (!shared) {
+    std::fprintf(stderr, "mm crowd-bench: %s\n", shared.message().c_str());
+    return 1;
+  }
+  // Build the searcher before timing anything.
+  if (Result<const Searcher*> s = (*shared)->searcher(arguments.options.settings.search_method);
+      !s) {
+    std::fprintf(stderr, "mm crowd-bench: %s\n", s.message().c_str());
+    return 1;
+  }
+
+  nlohmann::json json;
+  json["characters"] = arguments.options.characters;
+  json["seconds"] = arguments.options.seconds;
+  const std::optional<bool> same = run_thread_counts(*shared, arguments, json);
+  if (!same) return 1;
+  json["same_result_every_thread_count"] = *same;
+  std::printf("final positions %s across thread counts\n", *same ? "identical" : "DIFFER");
+  if (!arguments.json_path.empty()) {
+    std::ofstream file(arguments.json_path);
     file << json.dump(2) << "\n";
     if (!file) {
-      std::fprintf(stderr, "mm crowd-bench: could not write %s\n", json_path.c_str());
+      std::fprintf(stderr, "mm crowd-bench: could not write %s\n", arguments.json_path.c_str());
       return 1;
     }
   }
-  return same ? 0 : 1;
+  return *same ? 0 : 1;
 }
 
 const bool registered = register_command(

@@ -1,6 +1,5 @@
 #pragma once
-// What `mm build` and `mm info` print about a database, and the small argument helpers the
-// build, info and export commands share.
+// What `mm build` and `mm info` print about a database.
 
 #include <cstdint>
 #include <cstdio>
@@ -8,7 +7,6 @@
 #include <string>
 
 #include "mm/database/database.hpp"
-#include "number_parsing.hpp"
 
 namespace mm::cli {
 

@@ -10,39 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "controller_options.hpp"
-#include "database_summary.hpp"
+#include "command_line.hpp"
 #include "mm/controller/evaluation.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {
-
-const char* const kUsage = R"(usage: mm eval --db FILE.mmdb --script FILE [options]
-
-Runs one character controller on a script of timed stick and button states (see
-controller/include/mm/controller/script.hpp; examples in scripts/input/), headless, at a fixed
-dt, and prints its quality metrics. Several --script options print one row per script.
-
-options:
-  --db FILE          the database (required)
-  --script FILE      the input script (required; repeatable)
-  --dt SECONDS       seconds per update (default 1/60)
-  --ik on|off        foot locking with IK (default on)
-  --set NAME=VALUE   any controller setting by its name (e.g. inertialization_halflife=0.1,
-                     sync_mode=none, search_method=kdtree); repeatable
-  --json FILE        also write the metrics as JSON (one script: the keys at the top level;
-                     several: a list under "runs")
-  --dump FILE        one CSV row per frame (one script only): t, simulation, root, desired
-                     motion, transition, contacts, then every joint's global position
-  -h, --help         this text
-
-exit status: 0 fine, 1 bad database or script, 2 bad usage
-)";
-
-int usage_error(const std::string& message) {
-  std::fprintf(stderr, "mm eval: %s\n\n%s", message.c_str(), kUsage);
-  return 2;
-}
 
 struct Arguments {
   std::string db;
@@ -54,44 +27,35 @@ struct Arguments {
 
 // Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
 int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (a == "--db" || a == "--script" || a == "--json" || a == "--dump") {
-      const std::string* v = value();
-      if (!v) return usage_error(a + " needs a file name");
-      if (a == "--db") out.db = *v;
-      if (a == "--script") out.scripts.push_back(*v);
-      if (a == "--json") out.json_path = *v;
-      if (a == "--dump") out.dump_path = *v;
-    } else if (a == "--dt") {
-      const std::string* v = value();
-      const std::optional<double> dt = v ? parse_number(*v) : std::nullopt;
-      if (!dt || *dt <= 0.0 || *dt > 1.0) return usage_error("--dt needs seconds in (0, 1]");
-      out.options.dt = static_cast<float>(*dt);
-    } else if (a == "--ik") {
-      const std::string* v = value();
-      if (!v || (*v != "on" && *v != "off")) return usage_error("--ik needs on or off");
-      out.options.settings.ik_enabled = *v == "on";
-    } else if (a == "--set") {
-      if (Status s = apply_set_option(value(), out.options.settings); !s) {
-        return usage_error(s.message());
-      }
-    } else {
-      return usage_error("unknown argument '" + a + "'");
-    }
-  }
-  if (out.db.empty()) return usage_error("--db is required");
-  if (out.scripts.empty()) return usage_error("--script is required");
+  CLI::App app(
+      "Runs one character controller on a script of timed stick and button states (see "
+      "controller/include/mm/controller/script.hpp; examples in scripts/input/), headless, at a "
+      "fixed dt, and prints its quality metrics. Several --script options print one row per "
+      "script.",
+      "mm eval");
+  set_up_app(app);
+  app.footer("exit status: 0 fine, 1 bad database or script, 2 bad usage");
+  app.add_option("--db", out.db, "the database")->required()->type_name("FILE");
+  app.add_option("--script", out.scripts, "the input script; repeatable")
+      ->required()
+      ->type_name("FILE")
+      ->allow_extra_args(false);
+  add_dt_option(app, out.options.dt, "default 1/60");
+  add_ik_option(app, out.options.settings);
+  add_set_option(app, out.options.settings);
+  app.add_option("--json", out.json_path,
+                 "also write the metrics as JSON (one script: the keys at the top level; "
+                 "several: a list under \"runs\")")
+      ->type_name("FILE");
+  app.add_option("--dump", out.dump_path,
+                 "one CSV row per frame (one script only): t, simulation, root, desired motion, "
+                 "transition, contacts, then every joint's global position")
+      ->type_name("FILE");
+  if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (!out.dump_path.empty() && out.scripts.size() != 1) {
-    return usage_error("--dump takes one script");
+    return usage_error(app, "--dump takes one script");
   }
-  if (Status s = out.options.settings.validate(); !s) return usage_error(s.message());
-  return -1;
+  return check_settings(app, out.options.settings);
 }
 
 nlohmann::json to_json(const EvaluationMetrics& m) {

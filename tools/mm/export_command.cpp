@@ -1,53 +1,83 @@
 // `mm export`: writes one clip of a BVH, glTF or database file as glTF, for Blender and other
 // viewers.
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "command.hpp"
-#include "database_summary.hpp"
+#include "command_line.hpp"
 #include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
+#include "number_parsing.hpp"
+#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kUsage =
-    R"(usage: mm export <file.bvh|file.gltf|file.glb|file.mmdb> -o <out.glb|out.gltf> [options]
+struct Arguments {
+  std::string input;
+  std::string output;
+  std::string clip_selector;
+  BvhOptions bvh;
+  bool with_body = false;
+  CharacterBodyOptions body;
+};
 
-Writes one clip with its skeleton as glTF (metres, Y up): ".glb" binary or ".gltf" JSON with
-the buffer embedded. From a database the clip is rebuilt from its stored per-frame local
-positions and rotations at the database rate, joint 0 (the simulation root) included as an
-ordinary root joint.
+// Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
+int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
+  CLI::App app(
+      "Writes one clip with its skeleton as glTF (metres, Y up): \".glb\" binary or \".gltf\" "
+      "JSON with the buffer embedded. From a database the clip is rebuilt from its stored "
+      "per-frame local positions and rotations at the database rate, joint 0 (the simulation "
+      "root) included as an ordinary root joint.\n\n"
+      "With --body (database input only) the file also holds the character's generated body: a "
+      "surface around the bones in an A-pose bind pose, skinned with the chosen weights, so the "
+      "clip plays on a character in Blender or any glTF viewer (and mm-viewer --body loads it).",
+      "mm export");
+  set_up_app(app);
+  app.footer("exit status: 0 written, 1 bad input or clip not found, 2 bad usage");
+  app.add_option("input", out.input, "the clip's file: .bvh, .gltf, .glb or .mmdb")
+      ->required()
+      ->type_name("FILE");
+  app.add_option("-o,--output", out.output, "the .glb or .gltf file to write")
+      ->required()
+      ->type_name("FILE");
+  app.add_option("--clip", out.clip_selector,
+                 "which clip (default 0): an index, or a clip / animation name")
+      ->check(CLI::Validator(
+          [](std::string& text) { return text.empty() ? "needs a clip name or index" : ""; }, ""))
+      ->type_name("NAME|INDEX");
+  add_bvh_scale_option(app, out.bvh.scale);
+  app.add_flag("--body", out.with_body,
+               "write the generated, skinned body with the clip (database input)");
+  add_weights_option(app, out.body.weights.method, "the body's skinning weights (default heat)");
+  app.add_option("--voxel", out.body.mesh.voxel_size,
+                 "the body surface's grid spacing (default 0.012; smaller: more vertices)")
+      ->check(number_over(0.0, 1.0))
+      ->type_name("METRES");
+  if (const int code = parse_command_line(app, args); code >= 0) return code;
+  const std::string out_ext = lower_extension(out.output);
+  if (out_ext != ".glb" && out_ext != ".gltf") {
+    return usage_error(app, "the output must end in .glb or .gltf, not '" + out.output + "'");
+  }
+  if (out.with_body && lower_extension(out.input) != ".mmdb") {
+    return usage_error(app,
+                       "--body needs a database (.mmdb): the body is posed from its idle pose");
+  }
+  return -1;
+}
 
-With --body (database input only) the file also holds the character's generated body: a
-surface around the bones in an A-pose bind pose, skinned with the chosen weights, so the
-clip plays on a character in Blender or any glTF viewer (and mm-viewer --body loads it).
-
-options:
-  -o, --output FILE   the .glb or .gltf file to write (required)
-  --clip NAME|INDEX   which clip (default 0): an index, or a clip / animation name
-  --scale S           BVH units to metres (default 0.01: centimetres)
-  --body              write the generated, skinned body with the clip (database input)
-  --weights METHOD    the body's skinning weights: distance, envelope, heat (default) or
-                      geodesic
-  --voxel METRES      the body surface's grid spacing (default 0.012; smaller: more vertices)
-  -h, --help          this text
-
-exit status: 0 written, 1 bad input or clip not found, 2 bad usage
-)";
-
-int usage_error(const std::string& message) {
-  std::fprintf(stderr, "mm export: %s\n\n%s", message.c_str(), kUsage);
-  return 2;
+// What was written, for the last line: "'<name>', N frames, J joints".
+std::string clip_description(const std::string& name, int frames, int joints) {
+  return "'" + name + "', " + std::to_string(frames) + " frames, " + std::to_string(joints) +
+         " joints";
 }
 
 // The index of the clip `selector` names among `names` (an index or an exact name), or an error
@@ -109,118 +139,65 @@ Status export_database_body(const Database& db, size_t clip, const CharacterBody
                            range.name, out);
 }
 
-int run_export(const std::vector<std::string>& args) {
-  std::string input, output, clip_selector;
-  BvhOptions bvh;
-  bool with_body = false;
-  CharacterBodyOptions body;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string* { return i + 1 < args.size() ? &args[++i] : nullptr; };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "-o" || a == "--output") {
-      const std::string* v = value();
-      if (!v) return usage_error(a + " needs a file name");
-      output = *v;
-    } else if (a == "--clip") {
-      const std::string* v = value();
-      if (!v || v->empty()) return usage_error("--clip needs a clip name or index");
-      clip_selector = *v;
-    } else if (a == "--scale") {
-      const std::string* v = value();
-      const std::optional<double> s = v ? parse_number(*v) : std::nullopt;
-      if (!s || *s <= 0.0) return usage_error("--scale needs a positive number");
-      bvh.scale = static_cast<float>(*s);
-    } else if (a == "--body") {
-      with_body = true;
-    } else if (a == "--weights") {
-      const std::string* v = value();
-      const std::optional<WeightMethod> method = v ? parse_weight_method(*v) : std::nullopt;
-      if (!method) return usage_error("--weights needs distance, envelope, heat or geodesic");
-      body.weights.method = *method;
-    } else if (a == "--voxel") {
-      const std::string* v = value();
-      const std::optional<double> size = v ? parse_number(*v) : std::nullopt;
-      if (!size || !(*size > 0.0)) return usage_error("--voxel needs a positive number of metres");
-      body.mesh.voxel_size = static_cast<float>(*size);
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
-    } else if (input.empty()) {
-      input = a;
-    } else {
-      return usage_error("one input file at a time (got '" + input + "' and '" + a + "')");
-    }
-  }
-  if (input.empty()) return usage_error("no input file");
-  if (output.empty()) return usage_error("no output file (-o <out.glb|out.gltf>)");
-  const std::string out_ext = lower_extension(output);
-  if (out_ext != ".glb" && out_ext != ".gltf") {
-    return usage_error("the output must end in .glb or .gltf, not '" + output + "'");
-  }
+// The clip the arguments' --clip selects among `clips` (a database's or a glTF file's).
+template <typename Clips>
+Result<size_t> select_clip_in(const Clips& clips, const Arguments& arguments) {
+  std::vector<std::string> names;
+  for (const auto& c : clips) names.push_back(c.name);
+  return select_clip(arguments.clip_selector, names, arguments.input);
+}
 
-  const std::string in_ext = lower_extension(input);
-  if (with_body && in_ext != ".mmdb") {
-    return usage_error("--body needs a database (.mmdb): the body is posed from its idle pose");
+// Each exporter writes the selected clip of its kind of file and says what it wrote.
+Result<std::string> export_from_database(const Arguments& arguments) {
+  Result<Database> db = load_database(arguments.input);
+  if (!db) return Error{db.message()};
+  Result<size_t> clip = select_clip_in(db->clips, arguments);
+  if (!clip) return Error{clip.message()};
+  const Status written = arguments.with_body
+                             ? export_database_body(*db, *clip, arguments.body, arguments.output)
+                             : export_database_clip(*db, *clip, arguments.output);
+  if (!written) return Error{written.message()};
+  const ClipRange& range = db->clips[*clip];
+  return clip_description(range.name, range.frame_count(), db->joint_count()) +
+         (arguments.with_body ? ", with the body" : "");
+}
+
+Result<std::string> export_from_gltf(const Arguments& arguments) {
+  Result<GltfAsset> asset = load_gltf(arguments.input);
+  if (!asset) return Error{asset.message()};
+  Result<size_t> clip = select_clip_in(asset->clips, arguments);
+  if (!clip) return Error{clip.message()};
+  const Clip& c = asset->clips[*clip];
+  if (Status written = save_gltf(c, arguments.output); !written) return Error{written.message()};
+  return clip_description(c.name, c.frame_count, c.joint_count());
+}
+
+Result<std::string> export_from_bvh(const Arguments& arguments) {
+  Result<Clip> clip = load_bvh(arguments.input, arguments.bvh);
+  if (!clip) return Error{clip.message()};
+  const std::string& selector = arguments.clip_selector;
+  if (!selector.empty() && selector != "0" && selector != clip->name) {
+    return Error{arguments.input + ": a BVH file holds one clip, '" + clip->name + "' (index 0)"};
   }
-  Status written;
-  std::string what;
-  if (in_ext == ".mmdb") {
-    Result<Database> db = load_database(input);
-    if (!db) {
-      std::fprintf(stderr, "mm export: %s\n", db.message().c_str());
-      return 1;
-    }
-    std::vector<std::string> names;
-    for (const ClipRange& c : db->clips) names.push_back(c.name);
-    Result<size_t> clip = select_clip(clip_selector, names, input);
-    if (!clip) {
-      std::fprintf(stderr, "mm export: %s\n", clip.message().c_str());
-      return 1;
-    }
-    written = with_body ? export_database_body(*db, *clip, body, output)
-                        : export_database_clip(*db, *clip, output);
-    what = "'" + names[*clip] + "', " + std::to_string(db->clips[*clip].frame_count()) +
-           " frames, " + std::to_string(db->joint_count()) + " joints" +
-           (with_body ? ", with the body" : "");
-  } else if (in_ext == ".gltf" || in_ext == ".glb") {
-    Result<GltfAsset> asset = load_gltf(input);
-    if (!asset) {
-      std::fprintf(stderr, "mm export: %s\n", asset.message().c_str());
-      return 1;
-    }
-    std::vector<std::string> names;
-    for (const Clip& c : asset->clips) names.push_back(c.name);
-    Result<size_t> clip = select_clip(clip_selector, names, input);
-    if (!clip) {
-      std::fprintf(stderr, "mm export: %s\n", clip.message().c_str());
-      return 1;
-    }
-    const Clip& c = asset->clips[*clip];
-    written = save_gltf(c, output);
-    what = "'" + c.name + "', " + std::to_string(c.frame_count) + " frames, " +
-           std::to_string(c.joint_count()) + " joints";
-  } else {
-    Result<Clip> clip = load_bvh(input, bvh);
-    if (!clip) {
-      std::fprintf(stderr, "mm export: %s\n", clip.message().c_str());
-      return 1;
-    }
-    if (!clip_selector.empty() && clip_selector != "0" && clip_selector != clip->name) {
-      std::fprintf(stderr, "mm export: %s: a BVH file holds one clip, '%s' (index 0)\n",
-                   input.c_str(), clip->name.c_str());
-      return 1;
-    }
-    written = save_gltf(*clip, output);
-    what = "'" + clip->name + "', " + std::to_string(clip->frame_count) + " frames, " +
-           std::to_string(clip->joint_count()) + " joints";
+  if (Status written = save_gltf(*clip, arguments.output); !written) {
+    return Error{written.message()};
   }
-  if (!written) {
-    std::fprintf(stderr, "mm export: %s\n", written.message().c_str());
+  return clip_description(clip->name, clip->frame_count, clip->joint_count());
+}
+
+int run_export(const std::vector<std::string>& args) {
+  Arguments arguments;
+  if (const int code = parse_arguments(args, arguments); code >= 0) return code;
+  const std::string in_ext = lower_extension(arguments.input);
+  const Result<std::string> what = in_ext == ".mmdb" ? export_from_database(arguments)
+                                   : in_ext == ".gltf" || in_ext == ".glb"
+                                       ? export_from_gltf(arguments)
+                                       : export_from_bvh(arguments);
+  if (!what) {
+    std::fprintf(stderr, "mm export: %s\n", what.message().c_str());
     return 1;
   }
-  std::printf("wrote %s (%s)\n", output.c_str(), what.c_str());
+  std::printf("wrote %s (%s)\n", arguments.output.c_str(), what->c_str());
   return 0;
 }
 

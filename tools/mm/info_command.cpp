@@ -6,30 +6,12 @@
 #include <vector>
 
 #include "command.hpp"
+#include "command_line.hpp"
 #include "database_summary.hpp"
 #include "mm/database/database_file.hpp"
 
 namespace mm::cli {
 namespace {
-
-const char* const kUsage = R"(usage: mm info <file.mmdb> [options]
-
-Loads a database file (checking its checksum and every array) and prints its clips, frames,
-joints, tags with counts, feature dimensions, searchable frames and file size, then the
-feature statistics per channel: name, kind, bone or times, columns, weight, and the mean and
-standard deviation per column.
-
-options:
-  --clips        also list every clip: index, frames, name, tags
-  -h, --help     this text
-
-exit status: 0 fine, 1 unreadable or corrupt file, 2 bad usage
-)";
-
-int usage_error(const std::string& message) {
-  std::fprintf(stderr, "mm info: %s\n\n%s", message.c_str(), kUsage);
-  return 2;
-}
 
 void print_clips(const Database& db) {
   std::printf("clips:\n");
@@ -47,21 +29,17 @@ void print_clips(const Database& db) {
 int run_info(const std::vector<std::string>& args) {
   std::string path;
   bool list_clips = false;
-  for (const std::string& a : args) {
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--clips") {
-      list_clips = true;
-    } else if (!a.empty() && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
-    } else if (path.empty()) {
-      path = a;
-    } else {
-      return usage_error("one database file at a time (got '" + path + "' and '" + a + "')");
-    }
-  }
-  if (path.empty()) return usage_error("no database file");
+  CLI::App app(
+      "Loads a database file (checking its checksum and every array) and prints its clips, "
+      "frames, joints, tags with counts, feature dimensions, searchable frames and file size, "
+      "then the feature statistics per channel: name, kind, bone or times, columns, weight, and "
+      "the mean and standard deviation per column.",
+      "mm info");
+  set_up_app(app);
+  app.footer("exit status: 0 fine, 1 unreadable or corrupt file, 2 bad usage");
+  app.add_option("file", path, "the database file (.mmdb)")->required()->type_name("FILE");
+  app.add_flag("--clips", list_clips, "also list every clip: index, frames, name, tags");
+  if (const int code = parse_command_line(app, args); code >= 0) return code;
 
   Result<Database> db = load_database(path);
   if (!db) {

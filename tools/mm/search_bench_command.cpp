@@ -177,10 +177,7 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
   add_run_options(app, out);
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (out.db_path.empty() == !out.synthetic) {
-    std::fprintf(stderr,
-                 "mm search-bench: give exactly one of --db FILE or --synthetic\n"
-                 "run 'mm search-bench --help' for the options\n");
-    return 2;
+    return usage_error(app, "give exactly one of --db FILE or --synthetic");
   }
   // The brute-force rows are the baselines of the speed-up columns: always run, first.
   std::vector<std::string> methods = kBruteForceRows;

@@ -1,4 +1,4 @@
-// mm-viewer: the motion-matching demo (usage in viewer_options.cpp).
+// mm-viewer: the motion-matching demo (`mm-viewer --help`; options in viewer_options.cpp).
 
 #include <cstdio>
 #include <cstdlib>

@@ -1,5 +1,5 @@
 #pragma once
-// The command line of mm-viewer (see kViewerUsage in viewer_options.cpp).
+// The command line of mm-viewer (`mm-viewer --help`; declared in viewer_options.cpp).
 
 #include <string>
 #include <vector>
