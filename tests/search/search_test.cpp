@@ -147,6 +147,14 @@ class TinyRules : public ::testing::TestWithParam<std::string_view> {
   SearchResult find(float query, const SearchConstraints& constraints) const {
     return searcher_->search(std::span<const float>(&query, 1), constraints);
   }
+  // The constraints while `current_frame` plays.
+  static SearchConstraints playing(int current_frame, int window_frames, float transition_cost) {
+    SearchConstraints c;
+    c.current_frame = current_frame;
+    c.window_frames = window_frames;
+    c.transition_cost = transition_cost;
+    return c;
+  }
   TinyDatabase db_;
   std::unique_ptr<Searcher> searcher_;
 };
@@ -164,10 +172,7 @@ TEST_P(TinyRules, NothingPlayingPicksTheNearestSearchableFramePlusTransitionCost
 }
 
 TEST_P(TinyRules, WindowSkipsNeighboursButNotTheContinuation) {
-  SearchConstraints c;
-  c.current_frame = 2;
-  c.window_frames = 1;  // frames 1..3 skipped, except the continuation 3
-  c.transition_cost = 0.0f;
+  SearchConstraints c = playing(2, 1, 0.0f);  // frames 1..3 skipped, except the continuation 3
   // Query 2.0: frame 2 (d 0) and 1 (d 1) are in the window; continuation 3 costs 1; idle
   // frames 12..14 cost 0.25 and win.
   SearchResult r = find(2.0f, c);
@@ -184,10 +189,7 @@ TEST_P(TinyRules, WindowSkipsNeighboursButNotTheContinuation) {
 }
 
 TEST_P(TinyRules, ContinuationWinsAnExactTie) {
-  SearchConstraints c;
-  c.current_frame = 0;
-  c.window_frames = 0;
-  c.transition_cost = 0.0f;
+  const SearchConstraints c = playing(0, 0, 0.0f);
   // Query 1.5: the continuation (frame 1) and frame 2 are both at 0.25; the continuation wins.
   const SearchResult r = find(1.5f, c);
   EXPECT_EQ(r.frame, 1);
@@ -196,10 +198,7 @@ TEST_P(TinyRules, ContinuationWinsAnExactTie) {
 }
 
 TEST_P(TinyRules, ContinuationMustBeSearchableAndInTheSameClip) {
-  SearchConstraints c;
-  c.window_frames = 0;
-  c.transition_cost = 100.0f;
-  c.current_frame = 4;  // next frame 5 is not searchable: no continuation
+  SearchConstraints c = playing(4, 0, 100.0f);  // next frame 5 is not searchable: no continuation
   SearchResult r = find(5.0f, c);
   EXPECT_FALSE(r.continuation);
   EXPECT_EQ(r.frame, 3);  // frame 4 is the window; frame 3 costs 4 + 100

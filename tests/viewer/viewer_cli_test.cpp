@@ -149,19 +149,26 @@ void expect_scene(const Image& image, const Box& box) {
   EXPECT_GT(body, total / 6) << body << " body pixels of " << total;
 }
 
+// A run that succeeded and wrote a screenshot of the given size showing the scene, with the
+// character inside the box the viewer printed.
+void expect_screenshot_of_the_scene(const ProgramRun& r, const fs::path& png, int width,
+                                    int height) {
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  Box box;
+  ASSERT_TRUE(parse_box(r.output, box)) << r.output;
+  const Image image = load_png(png);
+  EXPECT_EQ(image.width, width);
+  EXPECT_EQ(image.height, height);
+  expect_scene(image, box);
+}
+
 TEST(ViewerCli, HeadlessScreenshotShowsSkyGroundGridAndTheCharacter) {
   const fs::path dir = test::scratch_dir();
   const ProgramRun r =
       run(viewer() + " --db '" + database_file().string() + "' --headless --script '" +
           script("circle.txt") + "' --frames 120 --size 640x360 --no-panel --debug none" +
           " --screenshot '" + (dir / "shot.png").string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  Box box;
-  ASSERT_TRUE(parse_box(r.output, box)) << r.output;
-  const Image image = load_png(dir / "shot.png");
-  EXPECT_EQ(image.width, 640);
-  EXPECT_EQ(image.height, 360);
-  expect_scene(image, box);
+  expect_screenshot_of_the_scene(r, dir / "shot.png", 640, 360);
 }
 
 TEST(ViewerCli, WindowedUnderXvfbShowsTheSameScene) {
@@ -170,13 +177,7 @@ TEST(ViewerCli, WindowedUnderXvfbShowsTheSameScene) {
                            database_file().string() + "' --script '" + script("zigzag.txt") +
                            "' --frames 90 --dt 0.0166667 --size 800x450 --no-panel --debug none" +
                            " --screenshot '" + (dir / "window.png").string() + "'");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  Box box;
-  ASSERT_TRUE(parse_box(r.output, box)) << r.output;
-  const Image image = load_png(dir / "window.png");
-  EXPECT_EQ(image.width, 800);
-  EXPECT_EQ(image.height, 450);
-  expect_scene(image, box);
+  expect_screenshot_of_the_scene(r, dir / "window.png", 800, 450);
 }
 
 TEST(ViewerCli, EveryWritesNumberedScreenshotsAndThePlot) {

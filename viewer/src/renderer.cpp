@@ -108,17 +108,26 @@ out vec4 fragment;
 void main() { fragment = vec4(line_colour, 1.0); }
 )";
 
+// The shader or program if its compile or link status is good; else deleted, and an error with
+// the driver's log after `failure`.
+template <class GetStatus, class GetLog, class Delete>
+Result<GLuint> checked(GLuint object, GLenum status, GetStatus get_status, GetLog get_log,
+                       Delete destroy, const std::string& failure) {
+  GLint ok = 0;
+  get_status(object, status, &ok);
+  if (ok) return object;
+  char log[2048] = {};
+  get_log(object, sizeof log, nullptr, log);
+  destroy(object);
+  return Error{failure + log};
+}
+
 Result<GLuint> compile(GLenum type, const char* source, const char* name) {
   const GLuint shader = glCreateShader(type);
   glShaderSource(shader, 1, &source, nullptr);
   glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok) return shader;
-  char log[2048] = {};
-  glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-  glDeleteShader(shader);
-  return Error{std::string("renderer: the ") + name + " shader does not compile: " + log};
+  return checked(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, glDeleteShader,
+                 std::string("renderer: the ") + name + " shader does not compile: ");
 }
 
 Result<GLuint> link(const char* vertex, const char* fragment, const char* name) {
@@ -135,13 +144,8 @@ Result<GLuint> link(const char* vertex, const char* fragment, const char* name) 
   glLinkProgram(program);
   glDeleteShader(*vs);
   glDeleteShader(*fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (ok) return program;
-  char log[2048] = {};
-  glGetProgramInfoLog(program, sizeof log, nullptr, log);
-  glDeleteProgram(program);
-  return Error{std::string("renderer: the ") + name + " program does not link: " + log};
+  return checked(program, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, glDeleteProgram,
+                 std::string("renderer: the ") + name + " program does not link: ");
 }
 
 GLint uniform(GLuint program, const char* name) {
