@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 
+#include "large_arrays.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/files.hpp"
@@ -34,15 +35,6 @@ bool is_motion_file(const fs::path& path) {
 
 bool is_gltf_file(const fs::path& path) {
   return has_extension(path, {".gltf", ".glb"});
-}
-
-// Grows an empty vector to n value-initialized elements, its block first marked for huge pages:
-// the database arrays are hundreds of MB.
-template <class T>
-void resize_large(std::vector<T>& v, size_t n) {
-  v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
-  v.resize(n);
 }
 
 // What phase 1 made of one input (a file or an in-memory clip): its clips at the database
@@ -397,39 +389,26 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
   return assign_tags(db, state.clip_tag_lists);
 }
 
-// Phase 2d: the database arrays. Fresh memory costs more to fault in than to fill, so they are
-// allocated in parallel, largest first.
+// Phase 2d: the database arrays, allocated in parallel (large_arrays.hpp).
 void allocate_arrays(BuildState& state) {
   Database& db = state.db;
   const size_t frames = state.total_frames;
   const size_t values = frames * static_cast<size_t>(db.joint_count());
   const size_t dims = static_cast<size_t>(state.context.dims);
   db.frame_count = static_cast<int>(frames);
-  detail::run_workers(8, state.threads, [&](int, size_t array) {
+  detail::size_joint_arrays(db, values, state.threads, 4, [&](size_t array) {
     switch (array) {
       case 0:
-        resize_large(db.local_rotations, values);
+        detail::resize_large(db.features, frames * dims);
         break;
       case 1:
-        resize_large(db.local_positions, values);
+        detail::resize_large(db.frame_clip, frames);
         break;
       case 2:
-        resize_large(db.local_velocities, values);
-        break;
-      case 3:
-        resize_large(db.local_angular_velocities, values);
-        break;
-      case 4:
-        resize_large(db.features, frames * dims);
-        break;
-      case 5:
-        resize_large(db.frame_clip, frames);
-        break;
-      case 6:
-        resize_large(db.contacts, frames * 2);
+        detail::resize_large(db.contacts, frames * 2);
         break;
       default:
-        resize_large(db.searchable, frames);
+        detail::resize_large(db.searchable, frames);
         break;
     }
   });

@@ -17,6 +17,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "large_arrays.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/preprocess.hpp"
 #include "workers.hpp"
@@ -200,9 +201,17 @@ glm::quat decode_rotation(const float* components, uint8_t code, const float* ex
     const uint32_t magnitude = predicted + static_cast<uint32_t>((code >> 3) - kUlpBias);
     value = std::bit_cast<float>(magnitude | static_cast<uint32_t>((code >> 2) & 1) << 31);
   }
-  float c[4];
-  for (int k = 0, n = 0; k < 4; ++k) c[k] = k == left_out ? value : components[n++];
-  return glm::quat(c[3], c[0], c[1], c[2]);
+  const float a = components[0], b = components[1], c = components[2];
+  switch (left_out) {  // glm::quat(w, x, y, z)
+    case 0:
+      return glm::quat(c, value, a, b);
+    case 1:
+      return glm::quat(c, a, value, b);
+    case 2:
+      return glm::quat(c, a, b, value);
+    default:
+      return glm::quat(value, a, b, c);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -562,22 +571,13 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
   return file.subspan(static_cast<size_t>(sec.offset), static_cast<size_t>(sec.length));
 }
 
-// Grows an empty vector to n elements, its block first marked for huge pages.
-template <class T>
-void resize_large(std::vector<T>& out, size_t count) {
-  out.clear();
-  out.reserve(count);  // allocates without touching the memory, so the advice applies
-  advise_huge_pages(out.data(), count * sizeof(T));
-  out.resize(count);
-}
-
 // Copies a fixed-size section whose length parse_header() already matched to the counts.
 template <class T>
 void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
                 std::vector<T>& out) {
   static_assert(std::is_trivially_copyable_v<T>);
   const std::span<const std::byte> bytes = section_bytes(file, info, s);
-  resize_large(out, bytes.size() / sizeof(T));
+  detail::resize_large(out, bytes.size() / sizeof(T));
   if (!bytes.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
 }
 
@@ -783,20 +783,16 @@ Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info
   const std::byte* varying_bytes =
       section_bytes(file, info, DatabaseSection::VaryingPositions).data();
   const uint8_t* is_constant = plan.positions.constant.data() + c * joints;
-  size_t next_constant = plan.positions.first_constant[c];
-  size_t next_varying = plan.positions.first_varying[c];
-  glm::vec3* positions = db.local_positions.data() + first;
-  for (size_t j = 0; j < joints; ++j) {
-    if (!is_constant[j]) continue;
-    glm::vec3 value;
-    std::memcpy(glm::value_ptr(value), constant_bytes + 12 * next_constant++, 12);
-    for (size_t f = 0; f < frames; ++f) positions[f * joints + j] = value;
-  }
-  for (size_t f = 0; f < frames; ++f) {
+  const std::byte* constant = constant_bytes + 12 * plan.positions.first_constant[c];
+  const std::byte* varying = varying_bytes + 12 * plan.positions.first_varying[c];
+  // Frame by frame: the constant columns (the same every frame), then the varying ones.
+  float* positions = glm::value_ptr(db.local_positions[first]);
+  for (size_t f = 0; f < frames; ++f, positions += 3 * joints) {
+    const std::byte* next_constant = constant;
     for (size_t j = 0; j < joints; ++j) {
-      if (is_constant[j]) continue;
-      std::memcpy(glm::value_ptr(positions[f * joints + j]), varying_bytes + 12 * next_varying++,
-                  12);
+      const std::byte*& from = is_constant[j] ? next_constant : varying;
+      std::memcpy(positions + 3 * j, from, 12);
+      from += 12;
     }
   }
 
@@ -847,31 +843,16 @@ uint64_t hash_and_allocate(std::span<const std::byte> file, const DatabaseFileIn
   const std::span<const std::byte> covered = file.first(file.size() - kChecksumSize);
   const size_t samples = size_t{info.frame_count} * info.joint_count;
   uint64_t computed = 0;
-  detail::run_workers(6, threads, [&](int, size_t job) {
-    switch (job) {
-      case 0:
-        computed = database_checksum(covered);
-        break;
-      case 1:
-        resize_large(db.local_rotations, samples);
-        break;
-      case 2:
-        resize_large(db.local_positions, samples);
-        break;
-      case 3:
-        resize_large(db.local_velocities, samples);
-        break;
-      case 4:
-        resize_large(db.local_angular_velocities, samples);
-        break;
-      default:
-        copy_array(file, info, DatabaseSection::Features, db.features);
-        copy_array(file, info, DatabaseSection::Contacts, db.contacts);
-        copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
-        copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
-        copy_array(file, info, DatabaseSection::Searchable, db.searchable);
-        break;
+  detail::size_joint_arrays(db, samples, threads, 2, [&](size_t job) {
+    if (job == 0) {
+      computed = database_checksum(covered);
+      return;
     }
+    copy_array(file, info, DatabaseSection::Features, db.features);
+    copy_array(file, info, DatabaseSection::Contacts, db.contacts);
+    copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
+    copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
+    copy_array(file, info, DatabaseSection::Searchable, db.searchable);
   });
   return computed;
 }
@@ -888,7 +869,7 @@ Status decode_clips(std::span<const std::byte> file, const DatabaseFileInfo& inf
     if (!s) return s;
   }
   // frame_clip is derived, not stored (the clips tile the frames: checked before decoding).
-  resize_large(db.frame_clip, info.frame_count);
+  detail::resize_large(db.frame_clip, info.frame_count);
   for (size_t c = 0; c < db.clips.size(); ++c) {
     std::fill(db.frame_clip.begin() + db.clips[c].start, db.frame_clip.begin() + db.clips[c].end,
               static_cast<int>(c));

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -24,20 +24,6 @@ namespace fs = std::filesystem;
 template <class T>
 bool same_bits(const T* a, const T* b, size_t count) {
   return std::memcmp(a, b, count * sizeof(T)) == 0;
-}
-
-// Global joint positions of one database frame by forward kinematics.
-std::vector<glm::vec3> global_positions(const Database& db, int frame) {
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  std::vector<Transform> local(joints), global(joints);
-  for (size_t j = 0; j < joints; ++j) {
-    local[j].translation = db.local_positions[static_cast<size_t>(frame) * joints + j];
-    local[j].rotation = db.local_rotations[static_cast<size_t>(frame) * joints + j];
-  }
-  forward_kinematics(db.skeleton.parents(), local, global);
-  std::vector<glm::vec3> out(joints);
-  for (size_t j = 0; j < joints; ++j) out[j] = global[j].translation;
-  return out;
 }
 
 TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
@@ -83,10 +69,11 @@ TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
                           db.local_angular_velocities.data() + first, count))
         << clip.name;
     for (const int f : {clip.start, (clip.start + clip.end) / 2, clip.end - 1}) {
-      const std::vector<glm::vec3> a = global_positions(db, f);
-      const std::vector<glm::vec3> b = global_positions(back, f);
+      const std::vector<Transform> a = test::frame_globals(db, f);
+      const std::vector<Transform> b = test::frame_globals(back, f);
       for (size_t j = 0; j < joints; ++j) {
-        EXPECT_LE(glm::length(a[j] - b[j]), 1e-6f) << clip.name << " frame " << f << " joint " << j;
+        EXPECT_LE(glm::length(a[j].translation - b[j].translation), 1e-6f)
+            << clip.name << " frame " << f << " joint " << j;
       }
     }
     // No velocity looks across the boundary: the first and last frames of a clip (of more than
