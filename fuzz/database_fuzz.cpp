@@ -6,7 +6,10 @@
 //   2. the same bytes with the trailing checksum recomputed, so the header and section parsers
 //      see the fuzzer's bytes;
 //   3. as a list of patches (2 bytes offset, 1 byte value) applied to a small valid database,
-//      resealed, so the fuzzer can reach every semantic check of Database::validate().
+//      resealed, so the fuzzer can reach the compact sections' decoders (position columns,
+//      rotation codes and their exceptions) and every semantic check of Database::validate().
+// The seed has a constant position column and a rotation stored through an exception, so both
+// paths are in the valid file the patches start from.
 // LLVMFuzzerInitialize builds that valid database in memory and, when the first corpus folder
 // given on the command line exists, writes it there as a seed (seed_valid.mmdb), so nothing
 // binary is committed.
@@ -22,6 +25,7 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/preprocess.hpp"
 
 namespace {
 
@@ -38,11 +42,12 @@ mm::Database make_seed_database() {
   db.frame_count = 6;
   for (int i = 0; i < db.frame_count * 3; ++i) {
     const float t = 0.1f * static_cast<float>(i);
-    db.local_positions.emplace_back(t, 0.5f, -t);
+    // Joint 2 (the foot) keeps its offset: one constant column per clip.
+    db.local_positions.push_back(i % 3 == 2 ? glm::vec3(0.1f, -0.8f, 0.0f)
+                                            : glm::vec3(t, 0.5f, -t));
     db.local_rotations.push_back(glm::angleAxis(t, glm::vec3(0.0f, 1.0f, 0.0f)));
-    db.local_velocities.emplace_back(1.0f, 0.0f, t);
-    db.local_angular_velocities.emplace_back(0.0f, t, 0.0f);
   }
+  db.local_rotations[4] = glm::quat(1.0004f, 0.0f, 0.0f, 0.0f);  // not exactly unit: an exception
   db.contacts = {1, 0, 1, 0, 0, 1, 0, 1, 1, 1, 0, 0};
   db.clips = {{"walk", 0, 4, 1, false}, {"walk_mirror", 4, 6, 3, true}};
   db.tag_names = {"walk", "mirror"};
@@ -61,6 +66,18 @@ mm::Database make_seed_database() {
   db.feature_scale = {1.0f, 2.0f, 0.5f, 1.5f, 3.0f};
   db.searchable = {1, 1, 0, 0, 1, 0};
   db.frame_clip = {0, 0, 0, 0, 1, 1};
+  // The velocities the file does not store, as load recomputes them (clip by clip).
+  db.local_velocities.resize(db.local_positions.size());
+  db.local_angular_velocities.resize(db.local_positions.size());
+  for (const mm::ClipRange& clip : db.clips) {
+    const size_t first = static_cast<size_t>(clip.start) * 3;
+    const size_t count = static_cast<size_t>(clip.frame_count()) * 3;
+    mm::compute_local_velocities(std::span(db.local_positions).subspan(first, count),
+                                 std::span(db.local_rotations).subspan(first, count),
+                                 clip.frame_count(), 3, db.frame_time,
+                                 std::span(db.local_velocities).subspan(first, count),
+                                 std::span(db.local_angular_velocities).subspan(first, count));
+  }
   return db;
 }
 
@@ -70,7 +87,8 @@ void reseal(std::vector<std::byte>& bytes) {
   std::memcpy(bytes.data() + bytes.size() - 8, &checksum, 8);
 }
 
-// Loads the image; whatever loads must validate and survive serialize -> deserialize unchanged.
+// Loads the image; whatever loads must validate and survive serialize -> deserialize unchanged
+// (the velocities it recomputed included).
 void try_load(std::span<const std::byte> bytes) {
   mm::Result<mm::Database> db = mm::deserialize_database(bytes, "fuzz input");
   if (!db) {

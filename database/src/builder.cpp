@@ -10,6 +10,7 @@
 #include <mutex>
 #include <set>
 
+#include "large_arrays.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/files.hpp"
@@ -34,15 +35,6 @@ bool is_motion_file(const fs::path& path) {
 
 bool is_gltf_file(const fs::path& path) {
   return has_extension(path, {".gltf", ".glb"});
-}
-
-// Grows an empty vector to n value-initialized elements, its block first marked for huge pages:
-// the database arrays are hundreds of MB.
-template <class T>
-void resize_large(std::vector<T>& v, size_t n) {
-  v.reserve(n);
-  advise_huge_pages(v.data(), n * sizeof(T));
-  v.resize(n);
 }
 
 // What phase 1 made of one input (a file or an in-memory clip): its clips at the database
@@ -186,6 +178,376 @@ std::string topology_difference(const Skeleton& a, const Skeleton& b) {
   return "the same joints";
 }
 
+// Checks the options before any input is read; returns the idle clip's frame count.
+Result<int> check_build_options(const BuildOptions& options, size_t input_count) {
+  if (!(options.rate > 0.0f) || !(options.rate <= 1000.0f)) {
+    return Error{"build: the rate must be a number of frames per second in (0, 1000], found " +
+                 std::to_string(options.rate)};
+  }
+  if (Status s = options.schema.validate(); !s) return Error{"build: " + s.message()};
+  const Result<int> idle_frames = idle_frame_count(options);
+  if (!idle_frames) return Error{idle_frames.message()};
+  if (input_count == 0) return Error{"build: no inputs"};
+  return *idle_frames;
+}
+
+// The tag rules (manifest first, then the options' own) and the preprocessing options.
+Status make_context(const BuildOptions& options, BuildContext& context) {
+  if (!options.tags_file.empty()) {
+    Result<std::vector<TagRule>> rules = load_tag_manifest(options.tags_file);
+    if (!rules) return Error{rules.message()};
+    context.tag_rules = std::move(rules).value();
+  }
+  context.tag_rules.insert(context.tag_rules.end(), options.tag_rules.begin(),
+                           options.tag_rules.end());
+  context.preprocess.root = options.root;
+  context.preprocess.contacts = options.contacts;
+  return Status::success();
+}
+
+// Everything the phases of one build share.
+struct BuildState {
+  BuildState(const std::vector<std::string>& names, const BuildOptions& build_options,
+             BuildReport& report, size_t input_count)
+      : input_names(names),
+        options(build_options),
+        rep(report),
+        context{build_options, {}, {}, build_options.schema.dims()},
+        threads(detail::worker_threads(build_options.threads)),
+        scratch(static_cast<size_t>(threads)),
+        results(input_count),
+        progress_total(2 * input_count) {}
+
+  // Progress counts every input twice: once imported (phase 1), once processed (phase 3).
+  void step() {
+    if (!options.progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    options.progress(++progress_done, progress_total);
+  }
+
+  const std::vector<std::string>& input_names;
+  const BuildOptions& options;
+  BuildReport& rep;
+  BuildContext context;
+  int threads;
+  std::vector<WorkerScratch> scratch;
+  std::vector<InputResult> results;
+  size_t progress_total;
+  std::mutex progress_mutex;
+  size_t progress_done = 0;
+
+  // Phase 2 on.
+  Database db;
+  std::vector<int> bones;       // the joint of every feature channel
+  std::vector<int> mirror_map;  // per source joint (only with options.mirror)
+  std::vector<ClipJob> jobs;
+  std::vector<std::vector<std::string>> clip_tag_lists;  // per database clip
+  size_t total_frames = 0;
+};
+
+// Phase 1, parallel over inputs: import, validate, resample, find roles.
+template <class Load>
+void import_inputs(BuildState& state, const Load& load) {
+  const size_t input_count = state.results.size();
+  // Without skip_bad the first failing input (in input order) is the answer: inputs after a
+  // known failure are skipped, inputs before it still run so the reported one is always the same.
+  std::atomic<size_t> first_failure{input_count};
+  state.rep.threads = detail::run_workers(input_count, state.threads, [&](int, size_t i) {
+    InputResult& result = state.results[i];
+    if (!state.options.skip_bad && i > first_failure.load()) return;
+    try {
+      result.status = load(i, result);
+      for (size_t c = 0; c < result.clips.size() && result.status; ++c) {
+        result.status = prepare_clip(result.clips[c], state.input_names[i], state.options, result);
+        if (result.status && c > 0 &&
+            !result.clips[c].skeleton.same_topology(result.clips[0].skeleton)) {
+          result.status = Error{state.input_names[i] + ": its clips do not share one skeleton"};
+        }
+      }
+    } catch (const std::exception& e) {
+      result.status = Error{state.input_names[i] + ": " + e.what()};
+    }
+    result.processed = true;
+    if (!result.status) {
+      result.clips.clear();
+      size_t expected = first_failure.load();
+      while (i < expected && !first_failure.compare_exchange_weak(expected, i)) {
+      }
+    }
+    state.step();
+  });
+}
+
+// Phase 2a, in input order: refuses what failed or does not match the first skeleton; returns
+// the index of the first usable input, whose skeleton the database takes.
+Result<size_t> choose_reference_input(BuildState& state) {
+  const InputResult* reference = nullptr;
+  size_t reference_index = 0;
+  for (size_t i = 0; i < state.results.size(); ++i) {
+    InputResult& result = state.results[i];
+    if (!result.processed) continue;
+    state.rep.bytes_read += result.bytes;
+    Status status = result.status;
+    if (status && reference &&
+        !reference->clips[0].skeleton.same_topology(result.clips[0].skeleton)) {
+      status = Error{state.input_names[i] + ": its skeleton differs from that of " +
+                     state.input_names[reference_index] + ": " +
+                     topology_difference(reference->clips[0].skeleton, result.clips[0].skeleton) +
+                     "; every clip of a database needs the same joints and parents"};
+    }
+    if (!status) {
+      if (!state.options.skip_bad) return Error{status.message()};
+      state.rep.refused.push_back({state.input_names[i], status.message()});
+      result.clips.clear();
+      result.processed = false;
+      continue;
+    }
+    if (!reference) {
+      reference = &result;
+      reference_index = i;
+    }
+  }
+  if (!reference) {
+    return Error{"build: no usable input: all " + std::to_string(state.results.size()) +
+                 " were refused (the first: " + state.rep.refused.front().message + ")"};
+  }
+  return reference_index;
+}
+
+// Phase 2b: the database skeleton (simulation root + the reference's joints), its roles, the
+// feature channels' joints and the mirror map.
+Status start_database(BuildState& state, size_t reference_index) {
+  const InputResult& reference = state.results[reference_index];
+  const Skeleton& source_skeleton = reference.clips[0].skeleton;
+  Database& db = state.db;
+  db.frame_time = 1.0f / state.options.rate;
+  db.schema = state.options.schema;
+  Result<Skeleton> skeleton = add_simulation_root(source_skeleton);
+  if (!skeleton) return Error{state.input_names[reference_index] + ": " + skeleton.message()};
+  db.skeleton = std::move(skeleton).value();
+  for (const JointRoleInfo& role : kJointRoles) {
+    const int j = reference.roles.*role.index;
+    db.roles.*role.index = j < 0 ? -1 : j + 1;  // behind the inserted simulation root
+  }
+  Result<std::vector<int>> bones = resolve_feature_bones(db.schema, db.skeleton, db.roles);
+  if (!bones) return Error{"build: " + bones.message()};
+  state.bones = std::move(bones).value();
+  if (state.options.mirror) {
+    Result<std::vector<int>> map = mirror_joint_map(source_skeleton, state.options.mirror_pairs);
+    if (!map) return Error{"build: " + map.message()};
+    state.mirror_map = std::move(map).value();
+  }
+  return Status::success();
+}
+
+// Phase 2c: clip ranges (a mirrored copy right after its original, the idle clip last) and
+// their tags.
+Status lay_out_clips(BuildState& state, int idle_frames) {
+  Database& db = state.db;
+  for (size_t i = 0; i < state.results.size(); ++i) {
+    if (!state.results[i].processed) continue;
+    for (size_t c = 0; c < state.results[i].clips.size(); ++c) {
+      const Clip& clip = state.results[i].clips[c];
+      for (const bool mirrored : {false, true}) {
+        if (mirrored && !state.options.mirror) continue;
+        ClipRange range;
+        range.name = mirrored ? clip.name + "_mirror" : clip.name;
+        range.start = static_cast<int>(state.total_frames);
+        range.end = range.start + clip.frame_count;
+        range.mirrored = mirrored;
+        state.total_frames += static_cast<size_t>(clip.frame_count);
+        if (state.total_frames > kMaxDatabaseFrames) {
+          return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
+                       " frames, the most a database holds"};
+        }
+        state.jobs.push_back({i, c, mirrored, db.clips.size()});
+        db.clips.push_back(std::move(range));
+        state.clip_tag_lists.push_back(clip_tags(clip.name, mirrored, state.context.tag_rules));
+      }
+    }
+  }
+  // The idle clip's frames are reserved now so that the arrays are allocated once; which pose
+  // they hold is known only after phase 3 (it needs the contacts and velocities).
+  if (idle_frames > 0) {
+    ClipRange range;
+    range.name = kIdleClipName;
+    range.start = static_cast<int>(state.total_frames);
+    range.end = range.start + idle_frames;
+    state.total_frames += static_cast<size_t>(idle_frames);
+    if (state.total_frames > kMaxDatabaseFrames) {
+      return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
+                   " frames with the idle clip, the most a database holds"};
+    }
+    db.clips.push_back(std::move(range));
+    // Manifest rules match the name "idle" like any clip name.
+    std::vector<std::string> tags = clip_tags(kIdleClipName, false, state.context.tag_rules);
+    tags.emplace_back(kIdleTag);
+    std::sort(tags.begin(), tags.end());
+    tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+    state.clip_tag_lists.push_back(std::move(tags));
+  }
+  return assign_tags(db, state.clip_tag_lists);
+}
+
+// Phase 2d: the database arrays, allocated in parallel (large_arrays.hpp).
+void allocate_arrays(BuildState& state) {
+  Database& db = state.db;
+  const size_t frames = state.total_frames;
+  const size_t values = frames * static_cast<size_t>(db.joint_count());
+  const size_t dims = static_cast<size_t>(state.context.dims);
+  db.frame_count = static_cast<int>(frames);
+  detail::size_joint_arrays(db, values, state.threads, 4, [&](size_t array) {
+    switch (array) {
+      case 0:
+        detail::resize_large(db.features, frames * dims);
+        break;
+      case 1:
+        detail::resize_large(db.frame_clip, frames);
+        break;
+      case 2:
+        detail::resize_large(db.contacts, frames * 2);
+        break;
+      default:
+        detail::resize_large(db.searchable, frames);
+        break;
+    }
+  });
+  for (size_t r = 0; r < db.clips.size(); ++r) {
+    std::fill(db.frame_clip.begin() + db.clips[r].start, db.frame_clip.begin() + db.clips[r].end,
+              static_cast<int>(r));
+  }
+}
+
+// Phase 3a, parallel over clips: preprocess and extract raw features straight into the
+// database's arrays at each clip's frames.
+Status process_clips(BuildState& state) {
+  Database& db = state.db;
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  std::vector<Status> job_status(state.jobs.size());
+  std::vector<std::atomic<int>> jobs_left(state.results.size());
+  for (const ClipJob& job : state.jobs) jobs_left[job.input].fetch_add(1);
+  detail::run_workers(state.jobs.size(), state.threads, [&](int worker, size_t k) {
+    const ClipJob& job = state.jobs[k];
+    const ClipRange& range = db.clips[job.range];
+    try {
+      const Clip& source = state.results[job.input].clips[job.clip];
+      Clip mirrored;
+      if (job.mirrored) mirrored = mirror_clip(source, state.mirror_map);
+      const Clip& clip = job.mirrored ? mirrored : source;
+      const size_t first = static_cast<size_t>(range.start) * joints;
+      const size_t count = static_cast<size_t>(range.frame_count()) * joints;
+      const std::span<glm::vec3> positions = std::span(db.local_positions).subspan(first, count);
+      const std::span<glm::quat> rotations = std::span(db.local_rotations).subspan(first, count);
+      const std::span<glm::vec3> velocities = std::span(db.local_velocities).subspan(first, count);
+      const std::span<glm::vec3> angular =
+          std::span(db.local_angular_velocities).subspan(first, count);
+      const ClipMotionOutput out{positions, rotations, velocities, angular,
+                                 std::span(db.contacts)
+                                     .subspan(static_cast<size_t>(range.start) * 2,
+                                              static_cast<size_t>(range.frame_count()) * 2)};
+      Status status =
+          preprocess_clip(clip, state.results[job.input].roles, state.context.preprocess, out,
+                          state.scratch[static_cast<size_t>(worker)].preprocess);
+      if (status) {
+        extract_range_features(db, range, state.bones,
+                               state.scratch[static_cast<size_t>(worker)].features);
+      } else {
+        status = Error{state.input_names[job.input] + ": " + status.message()};
+      }
+      job_status[k] = std::move(status);
+    } catch (const std::exception& e) {
+      job_status[k] =
+          Error{state.input_names[job.input] + ": clip '" + range.name + "': " + e.what()};
+    }
+    if (jobs_left[job.input].fetch_sub(1) == 1) state.step();
+  });
+  for (const Status& s : job_status) {
+    if (!s) return Error{s.message()};
+  }
+  state.results.clear();  // the imported clips are no longer needed
+  return Status::success();
+}
+
+// Phase 3b: the idle clip, one pass in frame order over the finished clips, then a copy; or,
+// when no frame qualifies, the reserved frames given back.
+Status add_idle_clip(BuildState& state) {
+  Database& db = state.db;
+  BuildReport& rep = state.rep;
+  const ClipRange& idle = db.clips.back();
+  const IdleSourceSearch found = search_idle_source(db);
+  if (found.frame >= 0) {
+    fill_idle_clip(db, idle, found.frame);
+    extract_range_features(db, idle, state.bones, state.scratch[0].features);
+    const ClipRange& source = db.clips[static_cast<size_t>(db.frame_clip[found.frame])];
+    rep.idle_frames = idle.frame_count();
+    rep.idle_source_clip = source.name;
+    rep.idle_source_frame = found.frame - source.start;
+    return Status::success();
+  }
+  rep.warnings.push_back("no idle clip: " + idle_search_failure(found));
+  // The reserved frames are the last ones: give them back and drop the clip's tags.
+  state.total_frames -= static_cast<size_t>(idle.frame_count());
+  db.clips.pop_back();
+  state.clip_tag_lists.pop_back();
+  if (Status s = assign_tags(db, state.clip_tag_lists); !s) return Error{s.message()};
+  const size_t frames = state.total_frames;
+  db.frame_count = static_cast<int>(frames);
+  const size_t kept = frames * static_cast<size_t>(db.joint_count());
+  db.local_positions.resize(kept);
+  db.local_rotations.resize(kept);
+  db.local_velocities.resize(kept);
+  db.local_angular_velocities.resize(kept);
+  db.features.resize(frames * static_cast<size_t>(state.context.dims));
+  db.frame_clip.resize(frames);
+  db.contacts.resize(frames * 2);
+  db.searchable.resize(frames);
+  return Status::success();
+}
+
+// Phase 4: normalization over the whole database, then a final check.
+Status normalize_and_check(BuildState& state) {
+  Database& db = state.db;
+  BuildReport& rep = state.rep;
+  for (const ClipRange& range : db.clips) {
+    if (std::find(db.searchable.begin() + range.start, db.searchable.begin() + range.end,
+                  uint8_t{1}) == db.searchable.begin() + range.end) {
+      rep.warnings.push_back("clip '" + range.name + "' (" + std::to_string(range.frame_count()) +
+                             " frames) is shorter than the feature times need: none of its "
+                             "frames can be matched (it can still be played into)");
+    }
+  }
+  FeatureNormalization normalization =
+      compute_feature_normalization(db.schema, db.features, db.searchable);
+  // Normalizing is element-wise, so splitting the rows between threads changes nothing.
+  const size_t dims = static_cast<size_t>(state.context.dims);
+  const size_t frames = state.total_frames;
+  const size_t chunk_rows = 4096;
+  const size_t chunks = (frames + chunk_rows - 1) / chunk_rows;
+  detail::run_workers(chunks, state.threads, [&](int, size_t chunk) {
+    const size_t first = chunk * chunk_rows;
+    const size_t rows = std::min(chunk_rows, frames - first);
+    normalize_features(std::span(db.features).subspan(first * dims, rows * dims),
+                       normalization.offset, normalization.scale);
+  });
+  db.feature_offset = std::move(normalization.offset);
+  db.feature_scale = std::move(normalization.scale);
+  rep.warnings.insert(rep.warnings.end(), normalization.warnings.begin(),
+                      normalization.warnings.end());
+
+  if (Status s = db.validate(); !s) {
+    return Error{
+        "build: the assembled database is inconsistent (a bug or a non-finite input "
+        "value): " +
+        s.message()};
+  }
+  rep.clips = static_cast<int>(db.clips.size());
+  rep.frames = db.frame_count;
+  rep.duration_s = static_cast<double>(db.frame_count) / static_cast<double>(state.options.rate);
+  rep.searchable_frames =
+      static_cast<int>(std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1}));
+  return Status::success();
+}
+
 // The shared part of both entry points: `load(i, result)` imports input i into result.clips.
 //
 // Phase 1 (parallel over inputs): import, validate, resample, find roles.
@@ -202,328 +564,34 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   BuildReport& rep = report ? *report : local_report;
   rep = BuildReport{};
   rep.inputs = static_cast<int>(input_count);
-
-  if (!(options.rate > 0.0f) || !(options.rate <= 1000.0f)) {
-    return Error{"build: the rate must be a number of frames per second in (0, 1000], found " +
-                 std::to_string(options.rate)};
-  }
-  if (Status s = options.schema.validate(); !s) return Error{"build: " + s.message()};
-  const Result<int> idle_frames = idle_frame_count(options);
+  const Result<int> idle_frames = check_build_options(options, input_count);
   if (!idle_frames) return Error{idle_frames.message()};
-  if (input_count == 0) return Error{"build: no inputs"};
+  BuildState state(input_names, options, rep, input_count);
+  if (Status s = make_context(options, state.context); !s) return Error{s.message()};
 
-  BuildContext context{options, {}, {}, options.schema.dims()};
-  if (!options.tags_file.empty()) {
-    Result<std::vector<TagRule>> rules = load_tag_manifest(options.tags_file);
-    if (!rules) return Error{rules.message()};
-    context.tag_rules = std::move(rules).value();
-  }
-  context.tag_rules.insert(context.tag_rules.end(), options.tag_rules.begin(),
-                           options.tag_rules.end());
-  context.preprocess.root = options.root;
-  context.preprocess.contacts = options.contacts;
-
-  int threads = detail::worker_threads(options.threads);
-  std::vector<WorkerScratch> scratch(static_cast<size_t>(threads));
-  // Progress counts every input twice: once imported (phase 1), once processed (phase 3).
-  const size_t progress_total = 2 * input_count;
-  std::mutex progress_mutex;
-  size_t progress_done = 0;
-  auto step = [&] {
-    if (!options.progress) return;
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    options.progress(++progress_done, progress_total);
-  };
-
-  // ---- Phase 1, parallel over inputs.
-  std::vector<InputResult> results(input_count);
-  // Without skip_bad the first failing input (in input order) is the answer: inputs after a
-  // known failure are skipped, inputs before it still run so the reported one is always the same.
-  std::atomic<size_t> first_failure{input_count};
-  rep.threads = detail::run_workers(input_count, threads, [&](int, size_t i) {
-    InputResult& result = results[i];
-    if (!options.skip_bad && i > first_failure.load()) return;
-    try {
-      result.status = load(i, result);
-      for (size_t c = 0; c < result.clips.size() && result.status; ++c) {
-        result.status = prepare_clip(result.clips[c], input_names[i], options, result);
-        if (result.status && c > 0 &&
-            !result.clips[c].skeleton.same_topology(result.clips[0].skeleton)) {
-          result.status = Error{input_names[i] + ": its clips do not share one skeleton"};
-        }
-      }
-    } catch (const std::exception& e) {
-      result.status = Error{input_names[i] + ": " + e.what()};
-    }
-    result.processed = true;
-    if (!result.status) {
-      result.clips.clear();
-      size_t expected = first_failure.load();
-      while (i < expected && !first_failure.compare_exchange_weak(expected, i)) {
-      }
-    }
-    step();
-  });
+  import_inputs(state, load);
   rep.load_seconds = seconds_since(start);
   Clock::time_point phase_start = Clock::now();
 
-  // ---- Phase 2, in input order: refuse what failed or does not match the first skeleton.
-  const InputResult* reference = nullptr;
-  size_t reference_index = 0;
-  for (size_t i = 0; i < input_count; ++i) {
-    InputResult& result = results[i];
-    if (!result.processed) continue;
-    rep.bytes_read += result.bytes;
-    Status status = result.status;
-    if (status && reference &&
-        !reference->clips[0].skeleton.same_topology(result.clips[0].skeleton)) {
-      status = Error{input_names[i] + ": its skeleton differs from that of " +
-                     input_names[reference_index] + ": " +
-                     topology_difference(reference->clips[0].skeleton, result.clips[0].skeleton) +
-                     "; every clip of a database needs the same joints and parents"};
-    }
-    if (!status) {
-      if (!options.skip_bad) return Error{status.message()};
-      rep.refused.push_back({input_names[i], status.message()});
-      result.clips.clear();
-      result.processed = false;
-      continue;
-    }
-    if (!reference) {
-      reference = &result;
-      reference_index = i;
-    }
-  }
-  if (!reference) {
-    return Error{"build: no usable input: all " + std::to_string(input_count) +
-                 " were refused (the first: " + rep.refused.front().message + ")"};
-  }
-
-  const Skeleton& source_skeleton = reference->clips[0].skeleton;
-  const JointRoleIndices roles = reference->roles;
-  Database db;
-  db.frame_time = 1.0f / options.rate;
-  db.schema = options.schema;
-  Result<Skeleton> skeleton = add_simulation_root(source_skeleton);
-  if (!skeleton) return Error{input_names[reference_index] + ": " + skeleton.message()};
-  db.skeleton = std::move(skeleton).value();
-  auto shifted = [](int j) { return j < 0 ? -1 : j + 1; };
-  db.roles = {shifted(roles.hips),     shifted(roles.left_foot), shifted(roles.right_foot),
-              shifted(roles.left_toe), shifted(roles.right_toe), shifted(roles.head)};
-  Result<std::vector<int>> bones = resolve_feature_bones(db.schema, db.skeleton, db.roles);
-  if (!bones) return Error{"build: " + bones.message()};
-  std::vector<int> mirror_map;
-  if (options.mirror) {
-    Result<std::vector<int>> map = mirror_joint_map(source_skeleton, options.mirror_pairs);
-    if (!map) return Error{"build: " + map.message()};
-    mirror_map = std::move(map).value();
-  }
-
-  // Clip ranges (a mirrored copy right after its original, the idle clip last) and their tags.
-  std::vector<ClipJob> jobs;
-  std::vector<std::vector<std::string>> clip_tag_lists;
-  size_t total_frames = 0;
-  for (size_t i = 0; i < input_count; ++i) {
-    if (!results[i].processed) continue;
-    for (size_t c = 0; c < results[i].clips.size(); ++c) {
-      const Clip& clip = results[i].clips[c];
-      for (const bool mirrored : {false, true}) {
-        if (mirrored && !options.mirror) continue;
-        ClipRange range;
-        range.name = mirrored ? clip.name + "_mirror" : clip.name;
-        range.start = static_cast<int>(total_frames);
-        range.end = range.start + clip.frame_count;
-        range.mirrored = mirrored;
-        total_frames += static_cast<size_t>(clip.frame_count);
-        if (total_frames > kMaxDatabaseFrames) {
-          return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
-                       " frames, the most a database holds"};
-        }
-        jobs.push_back({i, c, mirrored, db.clips.size()});
-        db.clips.push_back(std::move(range));
-        clip_tag_lists.push_back(clip_tags(clip.name, mirrored, context.tag_rules));
-      }
-    }
-  }
-  // The idle clip's frames are reserved now so that the arrays are allocated once; which pose
-  // they hold is known only after phase 3 (it needs the contacts and velocities).
-  if (*idle_frames > 0) {
-    ClipRange range;
-    range.name = kIdleClipName;
-    range.start = static_cast<int>(total_frames);
-    range.end = range.start + *idle_frames;
-    total_frames += static_cast<size_t>(*idle_frames);
-    if (total_frames > kMaxDatabaseFrames) {
-      return Error{"build: more than " + std::to_string(kMaxDatabaseFrames) +
-                   " frames with the idle clip, the most a database holds"};
-    }
-    db.clips.push_back(std::move(range));
-    // Manifest rules match the name "idle" like any clip name.
-    std::vector<std::string> tags = clip_tags(kIdleClipName, false, context.tag_rules);
-    tags.emplace_back(kIdleTag);
-    std::sort(tags.begin(), tags.end());
-    tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
-    clip_tag_lists.push_back(std::move(tags));
-  }
-  if (Status s = assign_tags(db, clip_tag_lists); !s) return Error{s.message()};
-
-  const int joints = db.joint_count();
-  const size_t dims = static_cast<size_t>(context.dims);
-  const size_t values = total_frames * static_cast<size_t>(joints);
-  db.frame_count = static_cast<int>(total_frames);
-  // Fresh memory costs more to fault in than to fill, so the arrays are allocated in parallel,
-  // largest first.
-  detail::run_workers(8, threads, [&](int, size_t array) {
-    switch (array) {
-      case 0:
-        resize_large(db.local_rotations, values);
-        break;
-      case 1:
-        resize_large(db.local_positions, values);
-        break;
-      case 2:
-        resize_large(db.local_velocities, values);
-        break;
-      case 3:
-        resize_large(db.local_angular_velocities, values);
-        break;
-      case 4:
-        resize_large(db.features, total_frames * dims);
-        break;
-      case 5:
-        resize_large(db.frame_clip, total_frames);
-        break;
-      case 6:
-        resize_large(db.contacts, total_frames * 2);
-        break;
-      default:
-        resize_large(db.searchable, total_frames);
-        break;
-    }
-  });
-  for (size_t r = 0; r < db.clips.size(); ++r) {
-    std::fill(db.frame_clip.begin() + db.clips[r].start, db.frame_clip.begin() + db.clips[r].end,
-              static_cast<int>(r));
-  }
-
+  const Result<size_t> reference = choose_reference_input(state);
+  if (!reference) return Error{reference.message()};
+  if (Status s = start_database(state, *reference); !s) return Error{s.message()};
+  if (Status s = lay_out_clips(state, *idle_frames); !s) return Error{s.message()};
+  allocate_arrays(state);
   rep.layout_seconds = seconds_since(phase_start);
   phase_start = Clock::now();
 
-  // ---- Phase 3, parallel over clips: straight into the database's arrays.
-  std::vector<Status> job_status(jobs.size());
-  std::vector<std::atomic<int>> jobs_left(input_count);
-  for (const ClipJob& job : jobs) jobs_left[job.input].fetch_add(1);
-  detail::run_workers(jobs.size(), threads, [&](int worker, size_t k) {
-    const ClipJob& job = jobs[k];
-    const ClipRange& range = db.clips[job.range];
-    try {
-      const Clip& source = results[job.input].clips[job.clip];
-      Clip mirrored;
-      if (job.mirrored) mirrored = mirror_clip(source, mirror_map);
-      const Clip& clip = job.mirrored ? mirrored : source;
-      const size_t first = static_cast<size_t>(range.start) * joints;
-      const size_t count = static_cast<size_t>(range.frame_count()) * joints;
-      const std::span<glm::vec3> positions = std::span(db.local_positions).subspan(first, count);
-      const std::span<glm::quat> rotations = std::span(db.local_rotations).subspan(first, count);
-      const std::span<glm::vec3> velocities = std::span(db.local_velocities).subspan(first, count);
-      const std::span<glm::vec3> angular =
-          std::span(db.local_angular_velocities).subspan(first, count);
-      const ClipMotionOutput out{positions, rotations, velocities, angular,
-                                 std::span(db.contacts)
-                                     .subspan(static_cast<size_t>(range.start) * 2,
-                                              static_cast<size_t>(range.frame_count()) * 2)};
-      Status status = preprocess_clip(clip, results[job.input].roles, context.preprocess, out,
-                                      scratch[worker].preprocess);
-      if (status) {
-        extract_range_features(db, range, *bones, scratch[worker].features);
-      } else {
-        status = Error{input_names[job.input] + ": " + status.message()};
-      }
-      job_status[k] = std::move(status);
-    } catch (const std::exception& e) {
-      job_status[k] = Error{input_names[job.input] + ": clip '" + range.name + "': " + e.what()};
-    }
-    if (jobs_left[job.input].fetch_sub(1) == 1) step();
-  });
-  for (const Status& s : job_status) {
-    if (!s) return Error{s.message()};
-  }
-  results.clear();  // the imported clips are no longer needed
-
-  // The idle clip: one pass in frame order over the finished clips, then a copy.
+  if (Status s = process_clips(state); !s) return Error{s.message()};
   if (*idle_frames > 0) {
-    const ClipRange& idle = db.clips.back();
-    const IdleSourceSearch found = search_idle_source(db);
-    if (found.frame >= 0) {
-      fill_idle_clip(db, idle, found.frame);
-      extract_range_features(db, idle, *bones, scratch[0].features);
-      const ClipRange& source = db.clips[static_cast<size_t>(db.frame_clip[found.frame])];
-      rep.idle_frames = idle.frame_count();
-      rep.idle_source_clip = source.name;
-      rep.idle_source_frame = found.frame - source.start;
-    } else {
-      rep.warnings.push_back("no idle clip: " + idle_search_failure(found));
-      // The reserved frames are the last ones: give them back and drop the clip's tags.
-      total_frames -= static_cast<size_t>(idle.frame_count());
-      db.clips.pop_back();
-      clip_tag_lists.pop_back();
-      if (Status s = assign_tags(db, clip_tag_lists); !s) return Error{s.message()};
-      db.frame_count = static_cast<int>(total_frames);
-      const size_t kept = total_frames * static_cast<size_t>(joints);
-      db.local_positions.resize(kept);
-      db.local_rotations.resize(kept);
-      db.local_velocities.resize(kept);
-      db.local_angular_velocities.resize(kept);
-      db.features.resize(total_frames * dims);
-      db.frame_clip.resize(total_frames);
-      db.contacts.resize(total_frames * 2);
-      db.searchable.resize(total_frames);
-    }
+    if (Status s = add_idle_clip(state); !s) return Error{s.message()};
   }
-
   rep.process_seconds = seconds_since(phase_start);
   phase_start = Clock::now();
 
-  // ---- Phase 4: normalization over the whole database, then a final check.
-  for (const ClipRange& range : db.clips) {
-    if (std::find(db.searchable.begin() + range.start, db.searchable.begin() + range.end,
-                  uint8_t{1}) == db.searchable.begin() + range.end) {
-      rep.warnings.push_back("clip '" + range.name + "' (" + std::to_string(range.frame_count()) +
-                             " frames) is shorter than the feature times need: none of its "
-                             "frames can be matched (it can still be played into)");
-    }
-  }
-  FeatureNormalization normalization =
-      compute_feature_normalization(db.schema, db.features, db.searchable);
-  // Normalizing is element-wise, so splitting the rows between threads changes nothing.
-  const size_t chunk_rows = 4096;
-  const size_t chunks = (total_frames + chunk_rows - 1) / chunk_rows;
-  detail::run_workers(chunks, threads, [&](int, size_t chunk) {
-    const size_t first = chunk * chunk_rows;
-    const size_t rows = std::min(chunk_rows, total_frames - first);
-    normalize_features(std::span(db.features).subspan(first * dims, rows * dims),
-                       normalization.offset, normalization.scale);
-  });
-  db.feature_offset = std::move(normalization.offset);
-  db.feature_scale = std::move(normalization.scale);
-  rep.warnings.insert(rep.warnings.end(), normalization.warnings.begin(),
-                      normalization.warnings.end());
-
-  if (Status s = db.validate(); !s) {
-    return Error{
-        "build: the assembled database is inconsistent (a bug or a non-finite input "
-        "value): " +
-        s.message()};
-  }
-
-  rep.clips = static_cast<int>(db.clips.size());
-  rep.frames = db.frame_count;
-  rep.duration_s = static_cast<double>(db.frame_count) / static_cast<double>(options.rate);
-  rep.searchable_frames =
-      static_cast<int>(std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1}));
+  if (Status s = normalize_and_check(state); !s) return Error{s.message()};
   rep.finish_seconds = seconds_since(phase_start);
   rep.total_seconds = seconds_since(start);
-  return db;
+  return std::move(state.db);
 }
 
 }  // namespace

@@ -473,15 +473,10 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 Status validate_roles(const Skeleton& skeleton, const JointRoleIndices& roles) {
-  const std::pair<int, const char*> all[] = {{roles.hips, "hips"},
-                                             {roles.left_foot, "left foot"},
-                                             {roles.right_foot, "right foot"},
-                                             {roles.left_toe, "left toe"},
-                                             {roles.right_toe, "right toe"},
-                                             {roles.head, "head"}};
-  for (const auto& [joint, name] : all) {
+  for (const JointRoleInfo& role : kJointRoles) {
+    const int joint = roles.*role.index;
     if (joint < -1 || joint >= skeleton.joint_count()) {
-      return Error{std::string("character body: the ") + name + " role is joint " +
+      return Error{"character body: the " + std::string(role.name) + " role is joint " +
                    std::to_string(joint) + ", out of range (the skeleton has " +
                    std::to_string(skeleton.joint_count()) + " joints)"};
     }

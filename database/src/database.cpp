@@ -125,13 +125,8 @@ bool finite3(const glm::vec3& v) {
 
 // The joint a role name refers to in this database, or -2 when the name is not a role.
 int role_joint(const JointRoleIndices& roles, std::string_view name) {
-  if (name == "hips") return roles.hips;
-  if (name == "left_foot") return roles.left_foot;
-  if (name == "right_foot") return roles.right_foot;
-  if (name == "left_toe") return roles.left_toe;
-  if (name == "right_toe") return roles.right_toe;
-  if (name == "head") return roles.head;
-  return -2;
+  const JointRoleInfo* role = find_joint_role(name);
+  return role ? roles.*role->index : -2;
 }
 
 bool is_bone_kind(FeatureKind kind) {
@@ -165,120 +160,8 @@ uint64_t Database::tag_mask(std::span<const std::string> names) const {
   return mask;
 }
 
-Status Database::validate() const {
-  if (!(frame_time > 0.0f) || !std::isfinite(frame_time)) {
-    return Error{"database: frame_time " + std::to_string(frame_time) +
-                 " s; expected a positive finite number of seconds"};
-  }
-
-  // Skeleton: structure, then rest transforms.
-  const int joints = joint_count();
-  if (joints <= 0) return Error{"database: the skeleton has no joints"};
-  if (Status s = Skeleton::validate(skeleton.names(), skeleton.parents(), skeleton.rest().size());
-      !s) {
-    return Error{"database: " + s.message()};
-  }
-  for (int j = 0; j < joints; ++j) {
-    const Transform& t = skeleton.rest(j);
-    const glm::quat& q = t.rotation;
-    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-    if (!finite3(t.translation) || !finite3(t.scale) ||
-        !(n2 >= kMinUnitNormSquared && n2 <= kMaxUnitNormSquared)) {
-      return Error{"database: skeleton rest transform of joint " + std::to_string(j) + " '" +
-                   skeleton.name(j) + "' is not finite or its rotation is not unit length"};
-    }
-  }
-
-  // Roles name existing joints or nothing.
-  const std::pair<const char*, int> role_list[] = {{"hips", roles.hips},
-                                                   {"left_foot", roles.left_foot},
-                                                   {"right_foot", roles.right_foot},
-                                                   {"left_toe", roles.left_toe},
-                                                   {"right_toe", roles.right_toe},
-                                                   {"head", roles.head}};
-  for (const auto& [role, joint] : role_list) {
-    if (joint < -1 || joint >= joints) {
-      return Error{"database: role " + std::string(role) + " is joint " + std::to_string(joint) +
-                   ", out of range [-1, " + std::to_string(joints) + ")"};
-    }
-  }
-
-  if (frame_count <= 0)
-    return Error{"database: has no frames (frame_count " + std::to_string(frame_count) + ")"};
-  const size_t frames = static_cast<size_t>(frame_count);
-  const size_t samples = frames * static_cast<size_t>(joints);
-  const std::string per_joint =
-      std::to_string(frame_count) + " frames x " + std::to_string(joints) + " joints";
-  if (Status s = check_size("local_positions", local_positions.size(), samples, per_joint); !s)
-    return s;
-  if (Status s = check_size("local_rotations", local_rotations.size(), samples, per_joint); !s)
-    return s;
-  if (Status s = check_size("local_velocities", local_velocities.size(), samples, per_joint); !s)
-    return s;
-  if (Status s = check_size("local_angular_velocities", local_angular_velocities.size(), samples,
-                            per_joint);
-      !s) {
-    return s;
-  }
-  if (Status s = check_size("contacts", contacts.size(), frames * 2,
-                            std::to_string(frame_count) + " frames x 2 feet");
-      !s) {
-    return s;
-  }
-
-  // Schema and feature matrix.
-  if (Status s = schema.validate(); !s) return Error{"database: schema: " + s.message()};
-  for (size_t c = 0; c < schema.channels.size(); ++c) {
-    const FeatureChannel& channel = schema.channels[c];
-    if (!is_bone_kind(channel.kind)) continue;
-    const int role = role_joint(roles, channel.bone);
-    if (role == -1) {
-      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
-                   "' uses role '" + channel.bone + "', which this database's skeleton lacks"};
-    }
-    if (role == -2 && skeleton.find(channel.bone) < 0) {
-      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
-                   "' names bone '" + channel.bone + "', which is neither a role nor a joint"};
-    }
-  }
-  const int dims_int = feature_dims();
-  if (dims_int <= 0) return Error{"database: the feature schema has no columns"};
-  const size_t dims = static_cast<size_t>(dims_int);
-  if (Status s = check_size(
-          "features", features.size(), frames * dims,
-          std::to_string(frame_count) + " frames x " + std::to_string(dims) + " feature columns");
-      !s) {
-    return s;
-  }
-  if (Status s =
-          check_size("feature_offset", feature_offset.size(), dims, "one per feature column");
-      !s) {
-    return s;
-  }
-  if (Status s = check_size("feature_scale", feature_scale.size(), dims, "one per feature column");
-      !s) {
-    return s;
-  }
-  if (Status s = check_size("searchable", searchable.size(), frames, "one per frame"); !s) return s;
-
-  // Tags.
-  if (tag_names.size() > 64) {
-    return Error{"database: " + std::to_string(tag_names.size()) +
-                 " tag names; at most 64 fit the 64-bit clip tag masks"};
-  }
-  for (size_t i = 0; i < tag_names.size(); ++i) {
-    if (tag_names[i].empty()) return Error{"database: tag name " + std::to_string(i) + " is empty"};
-    for (size_t k = 0; k < i; ++k) {
-      if (tag_names[k] == tag_names[i]) {
-        return Error{"database: duplicate tag name '" + tag_names[i] + "' (tags " +
-                     std::to_string(k) + " and " + std::to_string(i) + ")"};
-      }
-    }
-  }
-  const uint64_t known_tags =
-      tag_names.size() >= 64 ? ~uint64_t{0} : (uint64_t{1} << tag_names.size()) - 1;
-
-  // Clips tile [0, frame_count) in order.
+Status validate_clip_ranges(std::span<const ClipRange> clips, int frame_count, size_t tag_count) {
+  const uint64_t known_tags = tag_count >= 64 ? ~uint64_t{0} : (uint64_t{1} << tag_count) - 1;
   if (clips.empty()) return Error{"database: has frames but no clips"};
   int expected_start = 0;
   for (size_t c = 0; c < clips.size(); ++c) {
@@ -299,7 +182,7 @@ Status Database::validate() const {
     if ((clip.tags & ~known_tags) != 0) {
       return Error{where + " has tag bit " +
                    std::to_string(std::countr_zero(clip.tags & ~known_tags)) + " set, but only " +
-                   std::to_string(tag_names.size()) + " tags exist"};
+                   std::to_string(tag_count) + " tags exist"};
     }
     expected_start = clip.end;
   }
@@ -307,55 +190,207 @@ Status Database::validate() const {
     return Error{"database: the clips end at frame " + std::to_string(expected_start) +
                  " but there are " + std::to_string(frame_count) + " frames"};
   }
-  if (Status s = check_size("frame_clip", frame_clip.size(), frames, "one per frame"); !s) return s;
-  for (size_t c = 0; c < clips.size(); ++c) {
-    for (int f = clips[c].start; f < clips[c].end; ++f) {
-      if (frame_clip[static_cast<size_t>(f)] != static_cast<int>(c)) {
+  return Status::success();
+}
+
+namespace {
+
+// The skeleton: structure, then rest transforms.
+Status check_skeleton(const Database& db) {
+  const int joints = db.joint_count();
+  if (joints <= 0) return Error{"database: the skeleton has no joints"};
+  if (Status s =
+          Skeleton::validate(db.skeleton.names(), db.skeleton.parents(), db.skeleton.rest().size());
+      !s) {
+    return Error{"database: " + s.message()};
+  }
+  for (int j = 0; j < joints; ++j) {
+    const Transform& t = db.skeleton.rest(j);
+    const glm::quat& q = t.rotation;
+    const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    if (!finite3(t.translation) || !finite3(t.scale) ||
+        !(n2 >= kMinUnitNormSquared && n2 <= kMaxUnitNormSquared)) {
+      return Error{"database: skeleton rest transform of joint " + std::to_string(j) + " '" +
+                   db.skeleton.name(j) + "' is not finite or its rotation is not unit length"};
+    }
+  }
+  return Status::success();
+}
+
+// Roles name existing joints or nothing.
+Status check_roles(const Database& db) {
+  const int joints = db.joint_count();
+  for (const JointRoleInfo& role : kJointRoles) {
+    const int joint = db.roles.*role.index;
+    if (joint < -1 || joint >= joints) {
+      return Error{"database: role " + std::string(role.name) + " is joint " +
+                   std::to_string(joint) + ", out of range [-1, " + std::to_string(joints) + ")"};
+    }
+  }
+  return Status::success();
+}
+
+// The per-frame, per-joint arrays and the contacts hold one value per frame (and joint).
+Status check_frame_arrays(const Database& db) {
+  const int joints = db.joint_count();
+  if (db.frame_count <= 0)
+    return Error{"database: has no frames (frame_count " + std::to_string(db.frame_count) + ")"};
+  const size_t frames = static_cast<size_t>(db.frame_count);
+  const size_t samples = frames * static_cast<size_t>(joints);
+  const std::string per_joint =
+      std::to_string(db.frame_count) + " frames x " + std::to_string(joints) + " joints";
+  if (Status s = check_size("local_positions", db.local_positions.size(), samples, per_joint); !s)
+    return s;
+  if (Status s = check_size("local_rotations", db.local_rotations.size(), samples, per_joint); !s)
+    return s;
+  if (Status s = check_size("local_velocities", db.local_velocities.size(), samples, per_joint); !s)
+    return s;
+  if (Status s = check_size("local_angular_velocities", db.local_angular_velocities.size(), samples,
+                            per_joint);
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("contacts", db.contacts.size(), frames * 2,
+                            std::to_string(db.frame_count) + " frames x 2 feet");
+      !s) {
+    return s;
+  }
+  return Status::success();
+}
+
+// The schema, the bones its channels name, and the feature arrays' sizes.
+Status check_schema_and_features(const Database& db) {
+  const size_t frames = static_cast<size_t>(db.frame_count);
+  if (Status s = db.schema.validate(); !s) return Error{"database: schema: " + s.message()};
+  for (size_t c = 0; c < db.schema.channels.size(); ++c) {
+    const FeatureChannel& channel = db.schema.channels[c];
+    if (!is_bone_kind(channel.kind)) continue;
+    const int role = role_joint(db.roles, channel.bone);
+    if (role == -1) {
+      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
+                   "' uses role '" + channel.bone + "', which this database's skeleton lacks"};
+    }
+    if (role == -2 && db.skeleton.find(channel.bone) < 0) {
+      return Error{"database: schema channel " + std::to_string(c) + " '" + channel.name +
+                   "' names bone '" + channel.bone + "', which is neither a role nor a joint"};
+    }
+  }
+  const int dims_int = db.feature_dims();
+  if (dims_int <= 0) return Error{"database: the feature schema has no columns"};
+  const size_t dims = static_cast<size_t>(dims_int);
+  if (Status s = check_size("features", db.features.size(), frames * dims,
+                            std::to_string(db.frame_count) + " frames x " + std::to_string(dims) +
+                                " feature columns");
+      !s) {
+    return s;
+  }
+  if (Status s =
+          check_size("feature_offset", db.feature_offset.size(), dims, "one per feature column");
+      !s) {
+    return s;
+  }
+  if (Status s =
+          check_size("feature_scale", db.feature_scale.size(), dims, "one per feature column");
+      !s) {
+    return s;
+  }
+  if (Status s = check_size("searchable", db.searchable.size(), frames, "one per frame"); !s)
+    return s;
+  return Status::success();
+}
+
+// Tag names: at most 64, non-empty, distinct.
+Status check_tags(const Database& db) {
+  if (db.tag_names.size() > 64) {
+    return Error{"database: " + std::to_string(db.tag_names.size()) +
+                 " tag names; at most 64 fit the 64-bit clip tag masks"};
+  }
+  for (size_t i = 0; i < db.tag_names.size(); ++i) {
+    if (db.tag_names[i].empty())
+      return Error{"database: tag name " + std::to_string(i) + " is empty"};
+    for (size_t k = 0; k < i; ++k) {
+      if (db.tag_names[k] == db.tag_names[i]) {
+        return Error{"database: duplicate tag name '" + db.tag_names[i] + "' (tags " +
+                     std::to_string(k) + " and " + std::to_string(i) + ")"};
+      }
+    }
+  }
+  return Status::success();
+}
+
+// Clips tile [0, frame_count) in order; frame_clip agrees with them.
+Status check_clips(const Database& db) {
+  const size_t frames = static_cast<size_t>(db.frame_count);
+  if (Status s = validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size()); !s) return s;
+  if (Status s = check_size("frame_clip", db.frame_clip.size(), frames, "one per frame"); !s)
+    return s;
+  for (size_t c = 0; c < db.clips.size(); ++c) {
+    for (int f = db.clips[c].start; f < db.clips[c].end; ++f) {
+      if (db.frame_clip[static_cast<size_t>(f)] != static_cast<int>(c)) {
         return Error{"database: frame_clip[" + std::to_string(f) + "] is " +
-                     std::to_string(frame_clip[static_cast<size_t>(f)]) +
-                     ", but the frame is in clip " + std::to_string(c) + " '" + clips[c].name +
+                     std::to_string(db.frame_clip[static_cast<size_t>(f)]) +
+                     ", but the frame is in clip " + std::to_string(c) + " '" + db.clips[c].name +
                      "'"};
       }
     }
   }
+  return Status::success();
+}
 
-  // Values: the large arrays last, with the vectorized scans.
-  if (size_t i = first_non_unit(local_rotations); i != kNotFound) {
-    const glm::quat& q = local_rotations[i];
-    return Error{"database: local_rotations" + frame_joint(*this, i) +
+// Values: the large arrays last, with the vectorized scans.
+Status check_values(const Database& db) {
+  const size_t dims = static_cast<size_t>(db.feature_dims());
+  if (size_t i = first_non_unit(db.local_rotations); i != kNotFound) {
+    const glm::quat& q = db.local_rotations[i];
+    return Error{"database: local_rotations" + frame_joint(db, i) +
                  " is not a finite unit quaternion (squared length " +
                  std::to_string(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) + ")"};
   }
   const std::pair<const char*, const std::vector<glm::vec3>*> vector_arrays[] = {
-      {"local_positions", &local_positions},
-      {"local_velocities", &local_velocities},
-      {"local_angular_velocities", &local_angular_velocities}};
+      {"local_positions", &db.local_positions},
+      {"local_velocities", &db.local_velocities},
+      {"local_angular_velocities", &db.local_angular_velocities}};
   for (const auto& [name, array] : vector_arrays) {
     if (size_t i = first_non_finite(floats_of(*array)); i != kNotFound) {
-      return Error{"database: " + std::string(name) + frame_joint(*this, i / 3) + " is not finite"};
+      return Error{"database: " + std::string(name) + frame_joint(db, i / 3) + " is not finite"};
     }
   }
-  if (size_t i = first_non_boolean(contacts); i != kNotFound) {
+  if (size_t i = first_non_boolean(db.contacts); i != kNotFound) {
     return Error{"database: contacts[frame " + std::to_string(i / 2) + ", " +
-                 (i % 2 == 0 ? "left" : "right") + "] is " + std::to_string(contacts[i]) +
+                 (i % 2 == 0 ? "left" : "right") + "] is " + std::to_string(db.contacts[i]) +
                  "; expected 0 or 1"};
   }
-  if (size_t i = first_non_finite(features); i != kNotFound) {
+  if (size_t i = first_non_finite(db.features); i != kNotFound) {
     return Error{"database: features[frame " + std::to_string(i / dims) + ", column " +
                  std::to_string(i % dims) + "] is not finite"};
   }
   for (size_t c = 0; c < dims; ++c) {
-    if (!std::isfinite(feature_offset[c])) {
+    if (!std::isfinite(db.feature_offset[c])) {
       return Error{"database: feature_offset[" + std::to_string(c) + "] is not finite"};
     }
-    if (!std::isfinite(feature_scale[c]) || feature_scale[c] == 0.0f) {
+    if (!std::isfinite(db.feature_scale[c]) || db.feature_scale[c] == 0.0f) {
       return Error{"database: feature_scale[" + std::to_string(c) + "] is " +
-                   std::to_string(feature_scale[c]) + "; expected a finite non-zero scale"};
+                   std::to_string(db.feature_scale[c]) + "; expected a finite non-zero scale"};
     }
   }
-  if (size_t i = first_non_boolean(searchable); i != kNotFound) {
+  if (size_t i = first_non_boolean(db.searchable); i != kNotFound) {
     return Error{"database: searchable[" + std::to_string(i) + "] is " +
-                 std::to_string(searchable[i]) + "; expected 0 or 1"};
+                 std::to_string(db.searchable[i]) + "; expected 0 or 1"};
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+Status Database::validate() const {
+  if (!(frame_time > 0.0f) || !std::isfinite(frame_time)) {
+    return Error{"database: frame_time " + std::to_string(frame_time) +
+                 " s; expected a positive finite number of seconds"};
+  }
+  for (Status (*check)(const Database&) :
+       {check_skeleton, check_roles, check_frame_arrays, check_schema_and_features, check_tags,
+        check_clips, check_values}) {
+    if (Status s = check(*this); !s) return s;
   }
   return Status::success();
 }

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
@@ -12,12 +13,14 @@
 #include <cstring>
 #include <limits>
 #include <system_error>
-#include <thread>
 #include <type_traits>
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "large_arrays.hpp"
 #include "mm/database/files.hpp"
+#include "mm/database/preprocess.hpp"
+#include "workers.hpp"
 
 namespace mm {
 
@@ -62,7 +65,10 @@ inline uint64_t avalanche(uint64_t h) {
 
 class ByteWriter {
  public:
-  explicit ByteWriter(size_t expected_size) { bytes_.reserve(expected_size); }
+  explicit ByteWriter(size_t expected_size) {
+    bytes_.reserve(expected_size);
+    advise_huge_pages(bytes_.data(), expected_size);
+  }
 
   void raw(const void* data, size_t size) {
     const auto* p = static_cast<const std::byte*>(data);
@@ -111,9 +117,10 @@ constexpr size_t kOffSectionCount = 28;
 constexpr size_t kOffCounts = 32;
 constexpr size_t kOffFrameTime = 56;
 constexpr size_t kOffRoles = 60;
-constexpr size_t kOffReserved = 84;
+constexpr size_t kOffReserved = kOffRoles + 4 * kJointRoleCount;
 constexpr size_t kOffSectionTable = 88;
 constexpr size_t kChecksumSize = 8;
+static_assert(kOffReserved + 4 == kOffSectionTable, "the roles fill the header up to the table");
 static_assert(kOffSectionTable + kDatabaseSectionCount * 16 <= kDatabaseHeaderSize);
 static_assert(kDatabaseHeaderSize % 16 == 0);
 static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::quat) == 16);
@@ -123,12 +130,141 @@ constexpr uint64_t kMinStringBytes = 4;
 constexpr uint64_t kMinChannelBytes = 4 + 4 + 4 + 4 + 12 + 4;
 constexpr uint64_t kMinClipBytes = 4 + 4 + 8 + 4 + 4;
 constexpr uint64_t kRestTransformBytes = 10 * 4;
+constexpr uint64_t kRotationExceptionBytes = 16;
 
 void write_rest(ByteWriter& w, const Transform& t) {
   const float values[10] = {t.rotation.x,    t.rotation.y,    t.rotation.z,    t.rotation.w,
                             t.translation.x, t.translation.y, t.translation.z, t.scale.x,
                             t.scale.y,       t.scale.z};
   w.raw(values, sizeof values);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rotations: "smallest three" without loss (see database_file.hpp).
+
+constexpr int kUlpBias = 16;        // code bits 3-7 hold 16 + the distance in ulps
+constexpr uint8_t kEscape = 31;     // ... or this: the value is in rotation_exceptions
+constexpr int kMinUlp = -kUlpBias;  // the distances a code can hold
+constexpr int kMaxUlp = kEscape - 1 - kUlpBias;
+
+// The magnitude a unit quaternion's fourth component has given the other three, rounded to
+// float. The squares are exact in double, so the result does not depend on FMA contraction.
+inline float unit_complement(float a, float b, float c) {
+  const double sum =
+      static_cast<double>(a) * a + static_cast<double>(b) * b + static_cast<double>(c) * c;
+  return static_cast<float>(std::sqrt(std::max(0.0, 1.0 - sum)));
+}
+
+struct EncodedRotation {
+  float components[3];
+  uint8_t code;
+  float exact;  // the left-out component, needed when the code is an escape
+};
+
+EncodedRotation encode_rotation(const glm::quat& q) {
+  const float c[4] = {q.x, q.y, q.z, q.w};
+  int largest = 0;
+  for (int k = 1; k < 4; ++k) {
+    if (std::abs(c[k]) > std::abs(c[largest])) largest = k;
+  }
+  EncodedRotation out{};
+  for (int k = 0, n = 0; k < 4; ++k) {
+    if (k != largest) out.components[n++] = c[k];
+  }
+  const uint32_t bits = std::bit_cast<uint32_t>(c[largest]);
+  const uint32_t sign = bits >> 31;
+  const uint32_t magnitude = bits & 0x7FFFFFFFu;
+  const uint32_t predicted = std::bit_cast<uint32_t>(
+      unit_complement(out.components[0], out.components[1], out.components[2]));
+  const int64_t ulps = static_cast<int64_t>(magnitude) - static_cast<int64_t>(predicted);
+  const bool fits = ulps >= kMinUlp && ulps <= kMaxUlp;
+  const uint32_t field = fits ? static_cast<uint32_t>(ulps + kUlpBias) : kEscape;
+  out.code = static_cast<uint8_t>(static_cast<uint32_t>(largest) | sign << 2 | field << 3);
+  out.exact = c[largest];
+  return out;
+}
+
+bool is_escape(uint8_t code) {
+  return (code >> 3) == kEscape;
+}
+
+// The quaternion of a non-escape code. A corrupt code gives a non-unit or NaN quaternion, which
+// validation reports; nothing here is undefined for any input.
+glm::quat decode_rotation(const float* components, uint8_t code, const float* exact) {
+  const int left_out = code & 3;
+  float value;
+  if (exact != nullptr) {
+    value = *exact;
+  } else {
+    const uint32_t predicted =
+        std::bit_cast<uint32_t>(unit_complement(components[0], components[1], components[2]));
+    const uint32_t magnitude = predicted + static_cast<uint32_t>((code >> 3) - kUlpBias);
+    value = std::bit_cast<float>(magnitude | static_cast<uint32_t>((code >> 2) & 1) << 31);
+  }
+  const float a = components[0], b = components[1], c = components[2];
+  switch (left_out) {  // glm::quat(w, x, y, z)
+    case 0:
+      return glm::quat(c, value, a, b);
+    case 1:
+      return glm::quat(c, a, value, b);
+    case 2:
+      return glm::quat(c, a, b, value);
+    default:
+      return glm::quat(value, a, b, c);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Positions: a column (one joint in one clip) whose value never changes is stored once.
+
+bool constant_column(const std::vector<glm::vec3>& positions, size_t joints, const ClipRange& clip,
+                     size_t joint) {
+  const size_t first = static_cast<size_t>(clip.start) * joints + joint;
+  for (int f = clip.start + 1; f < clip.end; ++f) {
+    if (std::memcmp(&positions[static_cast<size_t>(f) * joints + joint], &positions[first],
+                    sizeof(glm::vec3)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Where each clip's positions lie in the two position sections, in values.
+struct PositionLayout {
+  std::vector<uint8_t> constant;       // per clip and joint, clip-major
+  std::vector<size_t> first_constant;  // per clip: its first value in constant_positions
+  std::vector<size_t> first_varying;   // per clip: its first value in varying_positions
+  size_t constant_count = 0;           // values in constant_positions
+  size_t varying_count = 0;            // values in varying_positions
+};
+
+// Fills first_constant, first_varying and the counts from `constant`.
+void lay_out_positions(std::span<const ClipRange> clips, size_t joints, PositionLayout& layout) {
+  layout.first_constant.resize(clips.size());
+  layout.first_varying.resize(clips.size());
+  layout.constant_count = 0;
+  layout.varying_count = 0;
+  for (size_t c = 0; c < clips.size(); ++c) {
+    layout.first_constant[c] = layout.constant_count;
+    layout.first_varying[c] = layout.varying_count;
+    size_t constants = 0;
+    for (size_t j = 0; j < joints; ++j) constants += layout.constant[c * joints + j];
+    layout.constant_count += constants;
+    layout.varying_count += static_cast<size_t>(clips[c].frame_count()) * (joints - constants);
+  }
+}
+
+PositionLayout position_layout_of(const Database& db) {
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  PositionLayout layout;
+  layout.constant.resize(db.clips.size() * joints);
+  for (size_t c = 0; c < db.clips.size(); ++c) {
+    for (size_t j = 0; j < joints; ++j) {
+      layout.constant[c * joints + j] = constant_column(db.local_positions, joints, db.clips[c], j);
+    }
+  }
+  lay_out_positions(db.clips, joints, layout);
+  return layout;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -262,31 +398,11 @@ Status check_identity(std::span<const std::byte> prefix, uint64_t actual_size,
   return Status::success();
 }
 
-// Checks the whole header: check_identity(), then the sizes, counts and section table.
-Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_t actual_size,
-                                      std::string_view name) {
-  if (Status s = check_identity(prefix, actual_size, name); !s) return Error{s.message()};
-  const std::string where(name);
-  const uint32_t version = read_at<uint32_t>(prefix, kOffVersion);
-  const uint64_t declared_size = read_at<uint64_t>(prefix, kOffFileSize);
-  const uint32_t header_size = read_at<uint32_t>(prefix, kOffHeaderSize);
-  const uint32_t section_count = read_at<uint32_t>(prefix, kOffSectionCount);
-  if (header_size != kDatabaseHeaderSize || section_count != kDatabaseSectionCount ||
-      read_at<uint32_t>(prefix, kOffReserved) != 0) {
-    return Error{where + ": corrupt header: header size " + std::to_string(header_size) +
-                 " and section count " + std::to_string(section_count) + ", expected " +
-                 std::to_string(kDatabaseHeaderSize) + " and " +
-                 std::to_string(kDatabaseSectionCount) + " with a zero reserved field"};
-  }
-  if (actual_size < uint64_t{kDatabaseHeaderSize} + kChecksumSize) {
-    return Error{where + ": truncated: expected at least " +
-                 std::to_string(kDatabaseHeaderSize + kChecksumSize) + " bytes, file has " +
-                 std::to_string(actual_size)};
-  }
-
+// Reads the counts, frame time and roles of a header whose identity check passed.
+DatabaseFileInfo read_header_fields(std::span<const std::byte> prefix) {
   DatabaseFileInfo info;
-  info.format_version = version;
-  info.file_size = declared_size;
+  info.format_version = read_at<uint32_t>(prefix, kOffVersion);
+  info.file_size = read_at<uint64_t>(prefix, kOffFileSize);
   uint32_t counts[6];
   std::memcpy(counts, prefix.data() + kOffCounts, sizeof counts);
   info.joint_count = counts[0];
@@ -296,11 +412,14 @@ Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_
   info.feature_dims = counts[4];
   info.channel_count = counts[5];
   info.frame_time = read_at<float>(prefix, kOffFrameTime);
-  int32_t roles[6];
-  std::memcpy(roles, prefix.data() + kOffRoles, sizeof roles);
-  info.roles = {roles[0], roles[1], roles[2], roles[3], roles[4], roles[5]};
+  for (size_t r = 0; r < kJointRoleCount; ++r) {
+    info.roles.*kJointRoles[r].index = read_at<int32_t>(prefix, kOffRoles + 4 * r);
+  }
+  return info;
+}
 
-  // Sane limits, so that nothing later allocates from a corrupt count.
+// Sane limits, so that nothing later allocates from a corrupt count.
+Status check_header_counts(const DatabaseFileInfo& info, const std::string& where) {
   struct Limit {
     const char* what;
     uint32_t value, min, max;
@@ -320,12 +439,73 @@ Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_
                    std::to_string(l.max) + "]"};
     }
   }
+  return Status::success();
+}
 
-  // The section table: ordered, aligned, inside the file, sized as the counts say.
-  const uint64_t data_end = declared_size - kChecksumSize;
+// What the counts say about a section's length: exactly `exact` bytes, or (variable sections)
+// at least `minimum` and at most `maximum` bytes in whole records of `unit` bytes.
+struct SectionSize {
+  uint64_t exact = 0;  // 0: variable
+  uint64_t minimum = 0;
+  uint64_t maximum = std::numeric_limits<uint64_t>::max();
+  uint64_t unit = 1;
+  std::string how;
+};
+
+SectionSize expected_section_size(DatabaseSection section, const DatabaseFileInfo& info) {
   const uint64_t frames = info.frame_count;
   const uint64_t samples = frames * info.joint_count;
   const uint64_t dims = info.feature_dims;
+  const uint64_t columns = uint64_t{info.clip_count} * info.joint_count;
+  auto records = [](uint64_t minimum, uint32_t count, const char* what) {
+    return SectionSize{0, minimum * count, std::numeric_limits<uint64_t>::max(), 1,
+                       std::string(what) + " " + std::to_string(count) + " records"};
+  };
+  switch (section) {
+    case DatabaseSection::Schema:
+      return records(kMinChannelBytes, info.channel_count, "channel_count");
+    case DatabaseSection::SkeletonNames:
+      return records(kMinStringBytes, info.joint_count, "joint_count");
+    case DatabaseSection::SkeletonParents:
+      return {4 * uint64_t{info.joint_count}, 0, 0, 1, "joint_count x 4"};
+    case DatabaseSection::SkeletonRest:
+      return {kRestTransformBytes * info.joint_count, 0, 0, 1, "joint_count x 40"};
+    case DatabaseSection::Clips:
+      return records(kMinClipBytes, info.clip_count, "clip_count");
+    case DatabaseSection::TagNames:
+      return records(kMinStringBytes, info.tag_count, "tag_count");
+    case DatabaseSection::PositionColumns:
+      return {columns, 0, 0, 1, "clip_count x joint_count"};
+    case DatabaseSection::ConstantPositions:
+      return {0, 0, columns * 12, 12, "at most clip_count x joint_count x 12"};
+    case DatabaseSection::VaryingPositions:
+      return {0, 0, samples * 12, 12, "at most frame_count x joint_count x 12"};
+    case DatabaseSection::RotationComponents:
+      return {samples * 12, 0, 0, 1, "frame_count x joint_count x 12"};
+    case DatabaseSection::RotationCodes:
+      return {samples, 0, 0, 1, "frame_count x joint_count"};
+    case DatabaseSection::RotationExceptions:
+      return {0, 0, samples * kRotationExceptionBytes, kRotationExceptionBytes,
+              "at most frame_count x joint_count x 16"};
+    case DatabaseSection::Contacts:
+      return {frames * 2, 0, 0, 1, "frame_count x 2"};
+    case DatabaseSection::Features:
+      return {frames * dims * 4, 0, 0, 1, "frame_count x feature_dims x 4"};
+    case DatabaseSection::FeatureOffset:
+    case DatabaseSection::FeatureScale:
+      return {dims * 4, 0, 0, 1, "feature_dims x 4"};
+    case DatabaseSection::Searchable:
+      return {frames, 0, 0, 1, "frame_count"};
+    case DatabaseSection::Count:
+      break;
+  }
+  return {};
+}
+
+// The section table: ordered, aligned, inside the file, sized as the counts say.
+Status read_section_table(std::span<const std::byte> prefix, const std::string& where,
+                          DatabaseFileInfo& info) {
+  const uint64_t data_end = info.file_size - kChecksumSize;
   uint64_t previous_end = kDatabaseHeaderSize;
   for (size_t i = 0; i < kDatabaseSectionCount; ++i) {
     const auto section = static_cast<DatabaseSection>(i);
@@ -341,75 +521,46 @@ Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_
     }
     previous_end = s.offset + s.length;
 
-    uint64_t exact = 0;    // expected length of a fixed-size section (0: variable)
-    uint64_t minimum = 0;  // smallest possible length of a variable section
-    std::string how;
-    switch (section) {
-      case DatabaseSection::Schema:
-        minimum = kMinChannelBytes * info.channel_count;
-        how = "channel_count " + std::to_string(info.channel_count) + " records";
-        break;
-      case DatabaseSection::SkeletonNames:
-        minimum = kMinStringBytes * info.joint_count;
-        how = "joint_count " + std::to_string(info.joint_count) + " names";
-        break;
-      case DatabaseSection::SkeletonParents:
-        exact = 4 * uint64_t{info.joint_count};
-        how = "joint_count x 4";
-        break;
-      case DatabaseSection::SkeletonRest:
-        exact = kRestTransformBytes * info.joint_count;
-        how = "joint_count x 40";
-        break;
-      case DatabaseSection::LocalPositions:
-      case DatabaseSection::LocalVelocities:
-      case DatabaseSection::LocalAngularVelocities:
-        exact = samples * 12;
-        how = "frame_count x joint_count x 12";
-        break;
-      case DatabaseSection::LocalRotations:
-        exact = samples * 16;
-        how = "frame_count x joint_count x 16";
-        break;
-      case DatabaseSection::Contacts:
-        exact = frames * 2;
-        how = "frame_count x 2";
-        break;
-      case DatabaseSection::Features:
-        exact = frames * dims * 4;
-        how = "frame_count x feature_dims x 4";
-        break;
-      case DatabaseSection::FeatureOffset:
-      case DatabaseSection::FeatureScale:
-        exact = dims * 4;
-        how = "feature_dims x 4";
-        break;
-      case DatabaseSection::Searchable:
-        exact = frames;
-        how = "frame_count";
-        break;
-      case DatabaseSection::Clips:
-        minimum = kMinClipBytes * info.clip_count;
-        how = "clip_count " + std::to_string(info.clip_count) + " records";
-        break;
-      case DatabaseSection::TagNames:
-        minimum = kMinStringBytes * info.tag_count;
-        how = "tag_count " + std::to_string(info.tag_count) + " names";
-        break;
-      case DatabaseSection::Count:
-        break;
-    }
-    if (exact != 0 && s.length != exact) {
+    const SectionSize size = expected_section_size(section, info);
+    if (size.exact != 0 && s.length != size.exact) {
       return Error{sec + ": " + std::to_string(s.length) + " bytes, expected " +
-                   std::to_string(exact) + " (" + how + ")"};
+                   std::to_string(size.exact) + " (" + size.how + ")"};
     }
-    if (exact == 0 && s.length < minimum) {
-      return Error{sec + ": " + std::to_string(s.length) + " bytes cannot hold " + how +
-                   " (at least " + std::to_string(minimum) + " bytes)"};
+    if (size.exact == 0 &&
+        (s.length < size.minimum || s.length > size.maximum || s.length % size.unit != 0)) {
+      return Error{sec + ": " + std::to_string(s.length) + " bytes cannot hold " + size.how +
+                   (size.minimum > 0 ? " (at least " + std::to_string(size.minimum) + " bytes)"
+                                     : std::string(" in whole records of ") +
+                                           std::to_string(size.unit) + " bytes")};
     }
   }
-  if (prefix.size() >= declared_size) {
-    info.stored_checksum = read_at<uint64_t>(prefix, static_cast<size_t>(data_end));
+  return Status::success();
+}
+
+// Checks the whole header: check_identity(), then the sizes, counts and section table.
+Result<DatabaseFileInfo> parse_header(std::span<const std::byte> prefix, uint64_t actual_size,
+                                      std::string_view name) {
+  if (Status s = check_identity(prefix, actual_size, name); !s) return Error{s.message()};
+  const std::string where(name);
+  const uint32_t header_size = read_at<uint32_t>(prefix, kOffHeaderSize);
+  const uint32_t section_count = read_at<uint32_t>(prefix, kOffSectionCount);
+  if (header_size != kDatabaseHeaderSize || section_count != kDatabaseSectionCount ||
+      read_at<uint32_t>(prefix, kOffReserved) != 0) {
+    return Error{where + ": corrupt header: header size " + std::to_string(header_size) +
+                 " and section count " + std::to_string(section_count) + ", expected " +
+                 std::to_string(kDatabaseHeaderSize) + " and " +
+                 std::to_string(kDatabaseSectionCount) + " with a zero reserved field"};
+  }
+  if (actual_size < uint64_t{kDatabaseHeaderSize} + kChecksumSize) {
+    return Error{where + ": truncated: expected at least " +
+                 std::to_string(kDatabaseHeaderSize + kChecksumSize) + " bytes, file has " +
+                 std::to_string(actual_size)};
+  }
+  DatabaseFileInfo info = read_header_fields(prefix);
+  if (Status s = check_header_counts(info, where); !s) return Error{s.message()};
+  if (Status s = read_section_table(prefix, where, info); !s) return Error{s.message()};
+  if (prefix.size() >= info.file_size) {
+    info.stored_checksum = read_at<uint64_t>(prefix, info.file_size - kChecksumSize);
   }
   return info;
 }
@@ -424,21 +575,10 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
 template <class T>
 void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
                 std::vector<T>& out) {
+  static_assert(std::is_trivially_copyable_v<T>);
   const std::span<const std::byte> bytes = section_bytes(file, info, s);
-  const size_t count = bytes.size() / sizeof(T);
-  out.clear();
-  out.reserve(count);  // allocates without touching the memory, so the advice applies
-  advise_huge_pages(out.data(), count * sizeof(T));
-  out.resize(count);
-  if (bytes.empty()) return;
-  if constexpr (std::is_trivially_copyable_v<T>) {
-    std::memcpy(out.data(), bytes.data(), bytes.size());
-  } else {
-    // GLM vectors and quaternions (not trivially copyable under GLM_FORCE_CTOR_INIT) are
-    // standard-layout runs of floats: the bytes are copied into those float members.
-    static_assert(std::is_standard_layout_v<T> && sizeof(T) % sizeof(float) == 0);
-    std::memcpy(glm::value_ptr(out[0]), bytes.data(), bytes.size());
-  }
+  detail::resize_large(out, bytes.size() / sizeof(T));
+  if (!bytes.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
 }
 
 Status read_string_list(std::span<const std::byte> file, const DatabaseFileInfo& info,
@@ -543,24 +683,67 @@ Status read_skeleton(std::span<const std::byte> file, const DatabaseFileInfo& in
   return Status::success();
 }
 
-// The large arrays in two groups for the two threads: the hashing thread takes rotations,
-// velocities and features (115 MB of 219 MB at 167k frames x 23 joints), the parsing thread
-// positions and angular velocities (92 MB), which balances them once the hash is counted.
-void copy_arrays_a(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
-  copy_array(file, info, DatabaseSection::LocalRotations, db.local_rotations);
-  copy_array(file, info, DatabaseSection::LocalVelocities, db.local_velocities);
-  copy_array(file, info, DatabaseSection::Features, db.features);
+Status read_position_layout(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                            const std::vector<ClipRange>& clips, std::string_view name,
+                            PositionLayout& layout) {
+  copy_array(file, info, DatabaseSection::PositionColumns, layout.constant);
+  SectionReader columns(section_bytes(file, info, DatabaseSection::PositionColumns),
+                        DatabaseSection::PositionColumns, name);
+  const size_t joints = info.joint_count;
+  for (size_t i = 0; i < layout.constant.size(); ++i) {
+    if (layout.constant[i] > 1) {
+      return columns.fail("clip " + std::to_string(i / joints) + ", joint " +
+                          std::to_string(i % joints) + ": flag " +
+                          std::to_string(layout.constant[i]) + ", expected 0 or 1");
+    }
+  }
+  lay_out_positions(clips, joints, layout);
+  const std::pair<DatabaseSection, size_t> sizes[] = {
+      {DatabaseSection::ConstantPositions, layout.constant_count},
+      {DatabaseSection::VaryingPositions, layout.varying_count}};
+  for (const auto& [section, count] : sizes) {
+    if (info.section(section).length != count * sizeof(glm::vec3)) {
+      return SectionReader(section_bytes(file, info, section), section, name)
+          .fail(std::to_string(info.section(section).length) + " bytes, but position_columns " +
+                "and the clips call for " + std::to_string(count) + " positions of 12 bytes");
+    }
+  }
+  return Status::success();
 }
 
-void copy_arrays_b(std::span<const std::byte> file, const DatabaseFileInfo& info, Database& db) {
-  copy_array(file, info, DatabaseSection::LocalPositions, db.local_positions);
-  copy_array(file, info, DatabaseSection::LocalAngularVelocities, db.local_angular_velocities);
+struct RotationException {
+  uint64_t sample = 0;
+  float value = 0.0f;
+};
+
+Status read_rotation_exceptions(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                                std::string_view name, std::vector<RotationException>& out) {
+  SectionReader r(section_bytes(file, info, DatabaseSection::RotationExceptions),
+                  DatabaseSection::RotationExceptions, name);
+  const uint64_t samples = uint64_t{info.frame_count} * info.joint_count;
+  out.resize(info.section(DatabaseSection::RotationExceptions).length / kRotationExceptionBytes);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const std::string where = "exception " + std::to_string(i);
+    if (Status s = r.pod(out[i].sample, where + " sample"); !s) return s;
+    if (Status s = r.pod(out[i].value, where + " value"); !s) return s;
+    if (Status s = r.zero_padding(4, where + " padding"); !s) return s;
+    if (out[i].sample >= samples || (i > 0 && out[i].sample <= out[i - 1].sample)) {
+      return r.fail(where + ": sample " + std::to_string(out[i].sample) +
+                    " is not in increasing order within [0, " + std::to_string(samples) + ")");
+    }
+  }
+  return r.finish();
 }
 
-// Everything but the checksum and copy_arrays_a(): the variable sections record by record, the
-// other arrays by memcpy.
-Status read_contents(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                     std::string_view name, Database& db) {
+// Everything but the per-frame arrays: schema, skeleton, clips, tags and the layout of the
+// position and rotation sections, checked record by record.
+struct LoadPlan {
+  PositionLayout positions;
+  std::vector<RotationException> exceptions;
+};
+
+Status read_small_sections(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                           std::string_view name, Database& db, LoadPlan& plan) {
   if (Status s = read_schema(file, info, name, db.schema); !s) return s;
   if (db.schema.dims() != static_cast<int>(info.feature_dims)) {
     return Error{std::string(name) + ": section 'schema': its channels have " +
@@ -571,29 +754,130 @@ Status read_contents(std::span<const std::byte> file, const DatabaseFileInfo& in
   db.roles = info.roles;
   db.frame_time = info.frame_time;
   db.frame_count = static_cast<int>(info.frame_count);
-  copy_arrays_b(file, info, db);
-  copy_array(file, info, DatabaseSection::Contacts, db.contacts);
-  copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
-  copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
-  copy_array(file, info, DatabaseSection::Searchable, db.searchable);
   if (Status s = read_clips(file, info, name, db.clips); !s) return s;
   if (Status s = read_string_list(file, info, DatabaseSection::TagNames, info.tag_count, name,
                                   db.tag_names);
       !s) {
     return s;
   }
-  // frame_clip is derived, not stored; clips that do not tile the frames leave -1 entries,
-  // and validate() reports the clip itself.
-  db.frame_clip.assign(info.frame_count, -1);
+  // The per-clip sections are laid out by the clips, so these must tile the frames first.
+  if (Status s = validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size()); !s) {
+    return Error{std::string(name) + ": " + s.message()};
+  }
+  if (Status s = read_position_layout(file, info, db.clips, name, plan.positions); !s) return s;
+  return read_rotation_exceptions(file, info, name, plan.exceptions);
+}
+
+// Positions, rotations and velocities of one clip, straight into the database's arrays.
+Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                   const LoadPlan& plan, size_t c, std::string_view name, Database& db) {
+  const ClipRange& clip = db.clips[c];
+  const size_t joints = info.joint_count;
+  const size_t frames = static_cast<size_t>(clip.frame_count());
+  const size_t first = static_cast<size_t>(clip.start) * joints;
+  const size_t count = frames * joints;
+
+  // Positions: constant columns broadcast, varying ones in frame order.
+  const std::byte* constant_bytes =
+      section_bytes(file, info, DatabaseSection::ConstantPositions).data();
+  const std::byte* varying_bytes =
+      section_bytes(file, info, DatabaseSection::VaryingPositions).data();
+  const uint8_t* is_constant = plan.positions.constant.data() + c * joints;
+  const std::byte* constant = constant_bytes + 12 * plan.positions.first_constant[c];
+  const std::byte* varying = varying_bytes + 12 * plan.positions.first_varying[c];
+  // Frame by frame: the constant columns (the same every frame), then the varying ones.
+  float* positions = glm::value_ptr(db.local_positions[first]);
+  for (size_t f = 0; f < frames; ++f, positions += 3 * joints) {
+    const std::byte* next_constant = constant;
+    for (size_t j = 0; j < joints; ++j) {
+      const std::byte*& from = is_constant[j] ? next_constant : varying;
+      std::memcpy(positions + 3 * j, from, 12);
+      from += 12;
+    }
+  }
+
+  // Rotations, with this clip's exceptions in sample order.
+  const std::byte* components =
+      section_bytes(file, info, DatabaseSection::RotationComponents).data() + 12 * first;
+  const auto* codes = reinterpret_cast<const uint8_t*>(
+      section_bytes(file, info, DatabaseSection::RotationCodes).data() + first);
+  auto exception = std::lower_bound(
+      plan.exceptions.begin(), plan.exceptions.end(), first,
+      [](const RotationException& e, uint64_t sample) { return e.sample < sample; });
+  glm::quat* rotations = db.local_rotations.data() + first;
+  for (size_t i = 0; i < count; ++i) {
+    float three[3];
+    std::memcpy(three, components + 12 * i, sizeof three);
+    const float* exact = nullptr;
+    if (is_escape(codes[i])) {
+      if (exception == plan.exceptions.end() || exception->sample != first + i) {
+        return SectionReader({}, DatabaseSection::RotationExceptions, name)
+            .fail("no exception for the escape code of sample " + std::to_string(first + i) +
+                  " [frame " + std::to_string((first + i) / joints) + ", joint " +
+                  std::to_string(i % joints) + "]");
+      }
+      exact = &exception->value;
+      ++exception;
+    }
+    rotations[i] = decode_rotation(three, codes[i], exact);
+  }
+  if (exception != plan.exceptions.end() && exception->sample < first + count) {
+    return SectionReader({}, DatabaseSection::RotationExceptions, name)
+        .fail("exception for sample " + std::to_string(exception->sample) +
+              ", whose rotation code is not an escape");
+  }
+
+  compute_local_velocities(std::span(db.local_positions).subspan(first, count),
+                           std::span(db.local_rotations).subspan(first, count), clip.frame_count(),
+                           static_cast<int>(joints), db.frame_time,
+                           std::span(db.local_velocities).subspan(first, count),
+                           std::span(db.local_angular_velocities).subspan(first, count));
+  return Status::success();
+}
+
+// Phase 2 of a load, on two threads: the checksum, the allocation of the per-frame arrays
+// (fresh memory is faulted in by whoever first writes it, so the arrays are spread over the
+// threads) and the plain copies. Returns the computed checksum.
+uint64_t hash_and_allocate(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                           int threads, Database& db) {
+  const std::span<const std::byte> covered = file.first(file.size() - kChecksumSize);
+  const size_t samples = size_t{info.frame_count} * info.joint_count;
+  uint64_t computed = 0;
+  detail::size_joint_arrays(db, samples, threads, 2, [&](size_t job) {
+    if (job == 0) {
+      computed = database_checksum(covered);
+      return;
+    }
+    copy_array(file, info, DatabaseSection::Features, db.features);
+    copy_array(file, info, DatabaseSection::Contacts, db.contacts);
+    copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
+    copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
+    copy_array(file, info, DatabaseSection::Searchable, db.searchable);
+  });
+  return computed;
+}
+
+// Phase 3 of a load, on two threads pulling clips: decode_clip() for every clip. Returns the
+// failure of the first clip that failed.
+Status decode_clips(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                    const LoadPlan& plan, std::string_view name, int threads, Database& db) {
+  std::vector<Status> status(db.clips.size());
+  detail::run_workers(db.clips.size(), threads, [&](int, size_t c) {
+    status[c] = decode_clip(file, info, plan, c, name, db);
+  });
+  for (const Status& s : status) {
+    if (!s) return s;
+  }
+  // frame_clip is derived, not stored (the clips tile the frames: checked before decoding).
+  detail::resize_large(db.frame_clip, info.frame_count);
   for (size_t c = 0; c < db.clips.size(); ++c) {
-    const int start = std::max(db.clips[c].start, 0);
-    const int end = std::min(db.clips[c].end, db.frame_count);
-    for (int f = start; f < end; ++f) db.frame_clip[static_cast<size_t>(f)] = static_cast<int>(c);
+    std::fill(db.frame_clip.begin() + db.clips[c].start, db.frame_clip.begin() + db.clips[c].end,
+              static_cast<int>(c));
   }
   return Status::success();
 }
 
-// Files at least this large hash on a second thread while the first copies the arrays.
+// Files at least this large are loaded on two threads.
 constexpr size_t kParallelHashBytes = size_t{8} << 20;
 
 std::string errno_text(int error) {
@@ -612,14 +896,22 @@ const char* database_section_name(DatabaseSection section) {
       return "skeleton_parents";
     case DatabaseSection::SkeletonRest:
       return "skeleton_rest";
-    case DatabaseSection::LocalPositions:
-      return "local_positions";
-    case DatabaseSection::LocalRotations:
-      return "local_rotations";
-    case DatabaseSection::LocalVelocities:
-      return "local_velocities";
-    case DatabaseSection::LocalAngularVelocities:
-      return "local_angular_velocities";
+    case DatabaseSection::Clips:
+      return "clips";
+    case DatabaseSection::TagNames:
+      return "tag_names";
+    case DatabaseSection::PositionColumns:
+      return "position_columns";
+    case DatabaseSection::ConstantPositions:
+      return "constant_positions";
+    case DatabaseSection::VaryingPositions:
+      return "varying_positions";
+    case DatabaseSection::RotationComponents:
+      return "rotation_components";
+    case DatabaseSection::RotationCodes:
+      return "rotation_codes";
+    case DatabaseSection::RotationExceptions:
+      return "rotation_exceptions";
     case DatabaseSection::Contacts:
       return "contacts";
     case DatabaseSection::Features:
@@ -630,10 +922,6 @@ const char* database_section_name(DatabaseSection section) {
       return "feature_scale";
     case DatabaseSection::Searchable:
       return "searchable";
-    case DatabaseSection::Clips:
-      return "clips";
-    case DatabaseSection::TagNames:
-      return "tag_names";
     case DatabaseSection::Count:
       break;
   }
@@ -669,24 +957,10 @@ uint64_t database_checksum(std::span<const std::byte> bytes) {
   return avalanche(h);
 }
 
-std::vector<std::byte> serialize_database(const Database& db) {
-  auto bytes_of = [](const auto& v) { return v.size() * sizeof(v[0]); };
-  size_t strings = 0;
-  for (const std::string& s : db.skeleton.names()) strings += s.size() + 4;
-  for (const std::string& s : db.tag_names) strings += s.size() + 4;
-  for (const ClipRange& c : db.clips) strings += c.name.size() + kMinClipBytes;
-  for (const FeatureChannel& c : db.schema.channels) {
-    strings += c.name.size() + c.bone.size() + c.times.size() * 4 + kMinChannelBytes;
-  }
-  const size_t expected = kDatabaseHeaderSize + strings + bytes_of(db.local_positions) +
-                          bytes_of(db.local_rotations) + bytes_of(db.local_velocities) +
-                          bytes_of(db.local_angular_velocities) + bytes_of(db.contacts) +
-                          bytes_of(db.features) + bytes_of(db.feature_offset) +
-                          bytes_of(db.feature_scale) + bytes_of(db.searchable) +
-                          db.skeleton.rest().size() * (kRestTransformBytes + 4) +
-                          16 * kDatabaseSectionCount + kChecksumSize;
-  ByteWriter w(expected);
+namespace {
 
+// The header and the small sections of a version-2 file, written in place.
+void write_header(ByteWriter& w, const Database& db) {
   w.raw(kDatabaseMagic.data(), kDatabaseMagic.size());
   w.pod(kDatabaseFormatVersion);
   w.pod(kDatabaseEndianMarker);
@@ -701,9 +975,117 @@ std::vector<std::byte> serialize_database(const Database& db) {
   w.patch(kOffSectionCount, static_cast<uint32_t>(kDatabaseSectionCount));
   w.patch(kOffCounts, counts);
   w.patch(kOffFrameTime, db.frame_time);
-  const int32_t roles[6] = {db.roles.hips,     db.roles.left_foot, db.roles.right_foot,
-                            db.roles.left_toe, db.roles.right_toe, db.roles.head};
-  w.patch(kOffRoles, roles);
+  for (size_t r = 0; r < kJointRoleCount; ++r) {
+    w.patch(kOffRoles + 4 * r, static_cast<int32_t>(db.roles.*kJointRoles[r].index));
+  }
+}
+
+void write_schema(ByteWriter& w, const FeatureSchema& schema) {
+  for (const FeatureChannel& c : schema.channels) {
+    w.pod(static_cast<uint8_t>(c.kind));
+    w.zeros(3);
+    w.string(c.name);
+    w.string(c.bone);
+    w.pod(static_cast<uint32_t>(c.times.size()));
+    w.array(c.times);
+    const float tail[4] = {c.axis.x, c.axis.y, c.axis.z, c.weight};
+    w.raw(tail, sizeof tail);
+  }
+}
+
+void write_clips(ByteWriter& w, const std::vector<ClipRange>& clips) {
+  for (const ClipRange& c : clips) {
+    w.pod(static_cast<int32_t>(c.start));
+    w.pod(static_cast<int32_t>(c.end));
+    w.pod(c.tags);
+    w.pod(static_cast<uint8_t>(c.mirrored ? 1 : 0));
+    w.zeros(3);
+    w.string(c.name);
+  }
+}
+
+void write_positions(ByteWriter& w, const Database& db, const PositionLayout& layout,
+                     bool constant) {
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  for (size_t c = 0; c < db.clips.size(); ++c) {
+    const ClipRange& clip = db.clips[c];
+    const uint8_t* flags = layout.constant.data() + c * joints;
+    const int last = constant ? clip.start + 1 : clip.end;  // a constant column once
+    for (int f = clip.start; f < last; ++f) {
+      for (size_t j = 0; j < joints; ++j) {
+        if (flags[j] == (constant ? 1 : 0)) {
+          w.raw(glm::value_ptr(db.local_positions[static_cast<size_t>(f) * joints + j]), 12);
+        }
+      }
+    }
+  }
+}
+
+// The three rotation sections: components and codes sample by sample, then the exceptions.
+void write_rotations(ByteWriter& w, const Database& db,
+                     std::array<DatabaseFileSection, kDatabaseSectionCount>& table) {
+  const size_t samples = db.local_rotations.size();
+  std::vector<uint8_t> codes(samples);
+  std::vector<RotationException> exceptions;
+  w.align16();
+  const size_t start = w.size();
+  for (size_t i = 0; i < samples; ++i) {
+    const EncodedRotation e = encode_rotation(db.local_rotations[i]);
+    w.raw(e.components, sizeof e.components);
+    codes[i] = e.code;
+    if (is_escape(e.code)) exceptions.push_back({i, e.exact});
+  }
+  table[static_cast<size_t>(DatabaseSection::RotationComponents)] = {start, w.size() - start};
+  w.align16();
+  table[static_cast<size_t>(DatabaseSection::RotationCodes)] = {w.size(), codes.size()};
+  w.array(codes);
+  w.align16();
+  table[static_cast<size_t>(DatabaseSection::RotationExceptions)] = {
+      w.size(), exceptions.size() * kRotationExceptionBytes};
+  for (const RotationException& e : exceptions) {
+    w.pod(e.sample);
+    w.pod(e.value);
+    w.zeros(4);
+  }
+}
+
+// The bytes serialize_database() will write, to allocate them once.
+size_t expected_file_size(const Database& db, const PositionLayout& layout) {
+  size_t bytes = kDatabaseHeaderSize + 16 * kDatabaseSectionCount + kChecksumSize;
+  for (const std::string& s : db.skeleton.names()) bytes += s.size() + 4;
+  for (const std::string& s : db.tag_names) bytes += s.size() + 4;
+  for (const ClipRange& c : db.clips) bytes += c.name.size() + kMinClipBytes;
+  for (const FeatureChannel& c : db.schema.channels) {
+    bytes += c.name.size() + c.bone.size() + c.times.size() * 4 + kMinChannelBytes;
+  }
+  bytes += db.skeleton.rest().size() * (kRestTransformBytes + 4);
+  bytes += layout.constant.size() + 12 * (layout.constant_count + layout.varying_count);
+  bytes += 13 * db.local_rotations.size();
+  bytes += db.contacts.size() +
+           4 * (db.features.size() + db.feature_offset.size() + db.feature_scale.size()) +
+           db.searchable.size();
+  return bytes;
+}
+
+// True when the clips and the position array agree well enough to lay the positions out by
+// clip (Database::validate() checks far more).
+bool positions_fit_clips(const Database& db) {
+  const size_t samples =
+      static_cast<size_t>(std::max(db.frame_count, 0)) * static_cast<size_t>(db.joint_count());
+  return db.local_positions.size() == samples && db.local_rotations.size() == samples &&
+         validate_clip_ranges(db.clips, db.frame_count, 64).ok();
+}
+
+}  // namespace
+
+std::vector<std::byte> serialize_database(const Database& db) {
+  // An inconsistent database keeps its positions and rotations out of the file (load refuses it
+  // then), rather than reading past its arrays.
+  const bool fits = positions_fit_clips(db);
+  PositionLayout layout;
+  if (fits) layout = position_layout_of(db);
+  ByteWriter w(expected_file_size(db, layout));
+  write_header(w, db);
 
   std::array<DatabaseFileSection, kDatabaseSectionCount> table{};
   auto section = [&](DatabaseSection s, auto&& write) {
@@ -712,18 +1094,7 @@ std::vector<std::byte> serialize_database(const Database& db) {
     write();
     table[static_cast<size_t>(s)] = {start, w.size() - start};
   };
-  section(DatabaseSection::Schema, [&] {
-    for (const FeatureChannel& c : db.schema.channels) {
-      w.pod(static_cast<uint8_t>(c.kind));
-      w.zeros(3);
-      w.string(c.name);
-      w.string(c.bone);
-      w.pod(static_cast<uint32_t>(c.times.size()));
-      w.array(c.times);
-      const float tail[4] = {c.axis.x, c.axis.y, c.axis.z, c.weight};
-      w.raw(tail, sizeof tail);
-    }
-  });
+  section(DatabaseSection::Schema, [&] { write_schema(w, db.schema); });
   section(DatabaseSection::SkeletonNames, [&] {
     for (const std::string& n : db.skeleton.names()) w.string(n);
   });
@@ -733,28 +1104,30 @@ std::vector<std::byte> serialize_database(const Database& db) {
   section(DatabaseSection::SkeletonRest, [&] {
     for (const Transform& t : db.skeleton.rest()) write_rest(w, t);
   });
-  section(DatabaseSection::LocalPositions, [&] { w.array(db.local_positions); });
-  section(DatabaseSection::LocalRotations, [&] { w.array(db.local_rotations); });
-  section(DatabaseSection::LocalVelocities, [&] { w.array(db.local_velocities); });
-  section(DatabaseSection::LocalAngularVelocities, [&] { w.array(db.local_angular_velocities); });
+  section(DatabaseSection::Clips, [&] { write_clips(w, db.clips); });
+  section(DatabaseSection::TagNames, [&] {
+    for (const std::string& n : db.tag_names) w.string(n);
+  });
+  section(DatabaseSection::PositionColumns, [&] { w.array(layout.constant); });
+  section(DatabaseSection::ConstantPositions, [&] {
+    if (fits) write_positions(w, db, layout, true);
+  });
+  section(DatabaseSection::VaryingPositions, [&] {
+    if (fits) write_positions(w, db, layout, false);
+  });
+  if (fits) {
+    write_rotations(w, db, table);
+  } else {
+    for (DatabaseSection s : {DatabaseSection::RotationComponents, DatabaseSection::RotationCodes,
+                              DatabaseSection::RotationExceptions}) {
+      section(s, [] {});
+    }
+  }
   section(DatabaseSection::Contacts, [&] { w.array(db.contacts); });
   section(DatabaseSection::Features, [&] { w.array(db.features); });
   section(DatabaseSection::FeatureOffset, [&] { w.array(db.feature_offset); });
   section(DatabaseSection::FeatureScale, [&] { w.array(db.feature_scale); });
   section(DatabaseSection::Searchable, [&] { w.array(db.searchable); });
-  section(DatabaseSection::Clips, [&] {
-    for (const ClipRange& c : db.clips) {
-      w.pod(static_cast<int32_t>(c.start));
-      w.pod(static_cast<int32_t>(c.end));
-      w.pod(c.tags);
-      w.pod(static_cast<uint8_t>(c.mirrored ? 1 : 0));
-      w.zeros(3);
-      w.string(c.name);
-    }
-  });
-  section(DatabaseSection::TagNames, [&] {
-    for (const std::string& n : db.tag_names) w.string(n);
-  });
 
   for (size_t i = 0; i < kDatabaseSectionCount; ++i) {
     w.patch(kOffSectionTable + 16 * i, table[i].offset);
@@ -772,6 +1145,11 @@ Result<DatabaseFileInfo> parse_database_header(std::span<const std::byte> bytes,
   return parse_header(bytes, bytes.size(), name_for_messages);
 }
 
+// Phases: 1. identity, header and the small sections (schema, skeleton, clips, tags, the layout
+// of the position and rotation sections); 2. checksum, allocation and plain copies; 3. the
+// clips' positions, rotations and velocities; 4. Database::validate(). A checksum mismatch is
+// reported in preference to anything phase 1 found; phases 2 and 3 read only what phase 1
+// checked, and phase 3 runs only on a file whose checksum matched.
 Result<Database> deserialize_database(std::span<const std::byte> bytes,
                                       std::string_view name_for_messages) {
   const std::string name(name_for_messages);
@@ -784,53 +1162,35 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
     return Error{name + ": checksum mismatch (stored " + hex(stored) + ", computed " +
                  hex(computed) + "): the file was changed or damaged after it was written"};
   };
+  const int threads = bytes.size() >= kParallelHashBytes ? 2 : 1;
 
-  // Fresh memory for the arrays costs a page fault per 4 KiB, more than the copying itself, so
-  // on a large file a second thread hashes and fills about half of the arrays while this one
-  // parses and fills the rest. Only a file whose header parsed is split: every offset and
-  // length used below was checked against the file, so reading before the checksum is verified
-  // is safe, and a checksum failure is reported in preference to anything found.
-  Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
-  uint64_t computed = 0;
   Database db;
-  bool worker_failed = false;
-  std::thread worker;
-  if (header && bytes.size() >= kParallelHashBytes) {
-    try {
-      worker =
-          std::thread([&computed, &worker_failed, &db, covered, bytes, &info = header.value()] {
-            computed = database_checksum(covered);
-            try {
-              copy_arrays_a(bytes, info, db);
-            } catch (...) {
-              worker_failed = true;  // out of memory
-            }
-          });
-    } catch (...) {
-      // No thread to be had: everything runs on this one below.
-    }
+  LoadPlan plan;
+  Status phase1;
+  Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
+  try {
+    phase1 = header ? read_small_sections(bytes, *header, name, db, plan) : Error{header.message()};
+  } catch (const std::exception& e) {
+    phase1 = Error{name + ": cannot load: " + e.what()};  // only allocation can throw
   }
-  const bool parallel = worker.joinable();
-  if (!parallel) {
-    computed = database_checksum(covered);
-    if (computed != stored) return checksum_error(computed);
-    if (!header) return header.error();
+  if (!phase1) {
+    if (const uint64_t computed = database_checksum(covered); computed != stored) {
+      return checksum_error(computed);
+    }
+    return Error{phase1.message()};
   }
 
-  Status contents;
   try {
-    contents = read_contents(bytes, header.value(), name, db);
-    if (!parallel) copy_arrays_a(bytes, header.value(), db);
+    if (const uint64_t computed = hash_and_allocate(bytes, *header, threads, db);
+        computed != stored) {
+      return checksum_error(computed);
+    }
+    if (Status s = decode_clips(bytes, *header, plan, name, threads, db); !s) {
+      return Error{s.message()};
+    }
   } catch (const std::exception& e) {
-    // Only allocation can throw here, and every size was checked against the file first.
-    contents = Error{name + ": cannot load: " + e.what()};
+    return Error{name + ": cannot load: " + e.what()};
   }
-  if (parallel) {
-    worker.join();
-    if (computed != stored) return checksum_error(computed);
-    if (worker_failed) return Error{name + ": cannot load: out of memory"};
-  }
-  if (!contents) return Error{contents.message()};
   if (Status s = db.validate(); !s) return Error{name + ": " + s.message()};
   return db;
 }

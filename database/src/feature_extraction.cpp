@@ -11,15 +11,9 @@ namespace mm {
 namespace {
 
 int role_index(const std::string& bone, const JointRoleIndices& roles, bool& is_role) {
-  is_role = true;
-  if (bone == "hips") return roles.hips;
-  if (bone == "left_foot") return roles.left_foot;
-  if (bone == "right_foot") return roles.right_foot;
-  if (bone == "left_toe") return roles.left_toe;
-  if (bone == "right_toe") return roles.right_toe;
-  if (bone == "head") return roles.head;
-  is_role = false;
-  return -1;
+  const JointRoleInfo* role = find_joint_role(bone);
+  is_role = role != nullptr;
+  return role ? roles.*role->index : -1;
 }
 
 bool is_bone_kind(FeatureKind kind) {
@@ -56,9 +50,9 @@ Result<std::vector<int>> resolve_feature_bones(const FeatureSchema& schema,
     const int joint = resolve_feature_bone(c.bone, skeleton, roles);
     if (joint < 0 || joint >= skeleton.joint_count()) {
       return Error{"feature channel '" + c.name + "': bone '" + c.bone + "' " +
-                   (is_role ? "is a joint role that this skeleton does not have"
-                            : "is neither a role name (hips, left_foot, right_foot, left_toe, "
-                              "right_toe, head) nor a joint of the skeleton")};
+                   (is_role ? std::string("is a joint role that this skeleton does not have")
+                            : "is neither a role name (" + joint_role_names() +
+                                  ") nor a joint of the skeleton")};
     }
     bones[i] = joint;
   }

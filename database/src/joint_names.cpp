@@ -104,23 +104,15 @@ std::vector<std::string> mirror_candidates(const std::string& name) {
 
 Result<JointRoleIndices> find_joint_roles(const Skeleton& skeleton, const JointRoles& roles) {
   JointRoleIndices out;
-  out.hips = find_role(skeleton, roles.hips);
-  out.left_foot = find_role(skeleton, roles.left_foot);
-  out.right_foot = find_role(skeleton, roles.right_foot);
-  out.left_toe = find_role(skeleton, roles.left_toe);
-  out.right_toe = find_role(skeleton, roles.right_toe);
-  out.head = find_role(skeleton, roles.head);
-  const std::pair<const char*, std::pair<int, const std::vector<std::string>*>> required[] = {
-      {"hips", {out.hips, &roles.hips}},
-      {"left_foot", {out.left_foot, &roles.left_foot}},
-      {"right_foot", {out.right_foot, &roles.right_foot}}};
-  for (const auto& [role, found] : required) {
-    if (found.first >= 0) continue;
-    return Error{"no joint for the required role '" + std::string(role) +
-                 "': looked for (ignoring case) " +
-                 (found.second->empty() ? std::string("nothing (the list is empty)")
-                                        : joined(*found.second, 16)) +
-                 "; the skeleton's joints are " + joined(skeleton.names(), 40)};
+  for (const JointRoleInfo& role : kJointRoles) {
+    const std::vector<std::string>& candidates = roles.*role.candidates;
+    out.*role.index = find_role(skeleton, candidates);
+    if (!role.required || out.*role.index >= 0) continue;
+    return Error{
+        "no joint for the required role '" + std::string(role.name) +
+        "': looked for (ignoring case) " +
+        (candidates.empty() ? std::string("nothing (the list is empty)") : joined(candidates, 16)) +
+        "; the skeleton's joints are " + joined(skeleton.names(), 40)};
   }
   return out;
 }

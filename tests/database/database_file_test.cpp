@@ -10,6 +10,7 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/preprocess.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -53,7 +54,25 @@ FeatureSchema two_channel_schema() {
   return schema;
 }
 
-// `frames_in_clip1` lets one test make a large database with the same shape.
+// Velocities and angular velocities as the builder makes them and load recomputes them: clip by
+// clip, never across a boundary.
+void derive_velocities(Database& db) {
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  db.local_velocities.resize(db.local_positions.size());
+  db.local_angular_velocities.resize(db.local_positions.size());
+  for (const ClipRange& clip : db.clips) {
+    const size_t first = static_cast<size_t>(clip.start) * joints;
+    const size_t count = static_cast<size_t>(clip.frame_count()) * joints;
+    compute_local_velocities(std::span(db.local_positions).subspan(first, count),
+                             std::span(db.local_rotations).subspan(first, count),
+                             clip.frame_count(), db.joint_count(), db.frame_time,
+                             std::span(db.local_velocities).subspan(first, count),
+                             std::span(db.local_angular_velocities).subspan(first, count));
+  }
+}
+
+// `frames_in_clip1` lets one test make a large database with the same shape. Joint 3 keeps one
+// position through clip 0 (a constant column, stored once); every other column varies.
 Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -75,12 +94,13 @@ Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
   for (size_t i = 0; i < samples; ++i) {
     db.local_positions.push_back(random_vec3(rng, 2.0f));
     db.local_rotations.push_back(random_unit_quat(rng));
-    db.local_velocities.push_back(random_vec3(rng, 5.0f));
-    db.local_angular_velocities.push_back(random_vec3(rng, 10.0f));
   }
+  for (int f = 1; f < kClip0Frames; ++f)
+    db.local_positions[f * kJoints + 3] = db.local_positions[3];
   for (int f = 0; f < db.frame_count * 2; ++f) db.contacts.push_back(unit(rng) < 0.5f ? 1 : 0);
   db.clips.push_back({"walk_take", 0, kClip0Frames, 0b001, false});
   db.clips.push_back({"run_take_mirror", kClip0Frames, db.frame_count, 0b110, true});
+  derive_velocities(db);
   db.tag_names = {"walk", "run", "mirror"};
   db.schema = two_channel_schema();
   for (int i = 0; i < db.frame_count * kDims; ++i) db.features.push_back(unit(rng) * 4.0f - 2.0f);
@@ -205,7 +225,7 @@ TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
   std::memcpy(&version, bytes.data() + 8, 4);
   std::memcpy(&marker, bytes.data() + 12, 4);
   std::memcpy(&size, bytes.data() + 16, 8);
-  EXPECT_EQ(version, 1u);
+  EXPECT_EQ(version, 2u);
   EXPECT_EQ(marker, 0x01020304u);
   EXPECT_EQ(size, bytes.size());
 
@@ -217,16 +237,52 @@ TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
   EXPECT_EQ(info->tag_count, 3u);
   EXPECT_EQ(info->feature_dims, 7u);
   EXPECT_EQ(info->channel_count, 2u);
-  // Fixed sections hold exactly the arrays, by hand: 20 frames x 4 joints x 16 bytes.
-  EXPECT_EQ(info->section(DatabaseSection::LocalRotations).length, 20u * 4 * 16);
+  // Fixed sections hold exactly the arrays, by hand: 20 frames x 4 joints x 12 bytes of
+  // rotation components and one code byte each.
+  EXPECT_EQ(info->section(DatabaseSection::RotationComponents).length, 20u * 4 * 12);
+  EXPECT_EQ(info->section(DatabaseSection::RotationCodes).length, 20u * 4);
   EXPECT_EQ(info->section(DatabaseSection::Features).length, 20u * 7 * 4);
   for (const DatabaseFileSection& s : info->sections) EXPECT_EQ(s.offset % 16, 0u);
-  // The rotations are stored x, y, z, w with one memcpy: check one quaternion by hand.
-  const uint64_t rot = info->section(DatabaseSection::LocalRotations).offset;
-  float q[4];
-  std::memcpy(q, bytes.data() + rot + 16 * 5, 16);
-  EXPECT_EQ(q[0], db.local_rotations[5].x);
-  EXPECT_EQ(q[3], db.local_rotations[5].w);
+  // Positions: one flag per clip and joint; joint 3 of clip 0 is the only constant column, stored
+  // once; the other 7 columns store every frame (12 x 3 + 8 x 4 = 68 values).
+  EXPECT_EQ(info->section(DatabaseSection::PositionColumns).length, 2u * 4);
+  const uint64_t columns = info->section(DatabaseSection::PositionColumns).offset;
+  for (size_t i = 0; i < 8; ++i) {
+    EXPECT_EQ(std::to_integer<int>(bytes[columns + i]), i == 3 ? 1 : 0) << i;
+  }
+  EXPECT_EQ(info->section(DatabaseSection::ConstantPositions).length, 12u);
+  EXPECT_EQ(info->section(DatabaseSection::VaryingPositions).length, 68u * 12);
+  float p[3];
+  std::memcpy(p, bytes.data() + info->section(DatabaseSection::ConstantPositions).offset, 12);
+  EXPECT_EQ(glm::vec3(p[0], p[1], p[2]), db.local_positions[3]);
+  // Rotation 5 by hand: its code names the left-out component, its sign and its distance in ulps
+  // from sqrt(1 - a^2 - b^2 - c^2) of the three stored ones (x, y, z, w order).
+  const uint64_t rot = info->section(DatabaseSection::RotationComponents).offset;
+  const uint64_t codes = info->section(DatabaseSection::RotationCodes).offset;
+  float three[3];
+  std::memcpy(three, bytes.data() + rot + 12 * 5, 12);
+  const int code = std::to_integer<int>(bytes[codes + 5]);
+  ASSERT_NE(code >> 3, 31);  // no escape in a freshly normalized quaternion
+  const float q[4] = {db.local_rotations[5].x, db.local_rotations[5].y, db.local_rotations[5].z,
+                      db.local_rotations[5].w};
+  const int left_out = code & 3;
+  for (int k = 0, n = 0; k < 4; ++k) {
+    if (k != left_out) {
+      EXPECT_EQ(three[n++], q[k]) << k;
+    }
+  }
+  for (int k = 0; k < 4; ++k) EXPECT_LE(std::abs(q[k]), std::abs(q[left_out])) << k;
+  EXPECT_EQ((code >> 2) & 1, std::signbit(q[left_out]) ? 1 : 0);
+  const double sum =
+      double{three[0]} * three[0] + double{three[1]} * three[1] + double{three[2]} * three[2];
+  const float predicted = static_cast<float>(std::sqrt(1.0 - sum));
+  int32_t predicted_bits = 0, actual_bits = 0;
+  const float magnitude = std::abs(q[left_out]);
+  std::memcpy(&predicted_bits, &predicted, 4);
+  std::memcpy(&actual_bits, &magnitude, 4);
+  EXPECT_EQ(actual_bits - predicted_bits, (code >> 3) - 16);
+  // Velocities are not stored at all.
+  EXPECT_EQ(bytes.size(), info->section(DatabaseSection::Searchable).offset + 20 + 8);
   // The last 8 bytes are the checksum of everything before them.
   uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
@@ -247,23 +303,24 @@ TEST(DatabaseFile, HeaderReaderReportsSizes) {
 }
 
 TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
-  // 40k frames make a file over 8 MiB, which takes the two-thread path.
-  const Database db = make_database(40000, 11);
+  // 70k frames make a file over 8 MiB, which takes the two-thread path.
+  const Database db = make_database(70000, 11);
   std::vector<std::byte> bytes = serialize_database(db);
   ASSERT_GT(bytes.size(), size_t{8} << 20);
   Result<Database> loaded = deserialize_database(bytes, "large");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   expect_same_database(db, *loaded);
 
-  // A NaN deep in the velocities without resealing: the checksum reports it, not the NaN.
-  const uint64_t vel = section_offset(bytes, DatabaseSection::LocalVelocities);
+  // A NaN deep in the positions without resealing: the checksum reports it, not the NaN.
+  const uint64_t varying = section_offset(bytes, DatabaseSection::VaryingPositions);
   std::vector<std::byte> corrupt = bytes;
-  std::memcpy(corrupt.data() + vel + 12 * 100000 + 4, &nan, 4);
+  std::memcpy(corrupt.data() + varying + 12 * 100000 + 4, &nan, 4);
   EXPECT_TRUE(contains(load_error(corrupt), "checksum mismatch")) << load_error(corrupt);
-  // Resealed, the value check finds it: sample 100000 is frame 25000, joint 0.
-  const std::string message = load_error(patched(bytes, vel + 12 * 100000 + 4, nan));
-  EXPECT_TRUE(
-      contains(message, "local_velocities[frame 25000, joint 0 'Simulation'] is not finite"))
+  // Resealed, the value check finds it. Varying value 100000: clip 0 stores 12 frames x 3
+  // varying joints, so it is value 99964 of clip 1 (4 joints a frame from frame 12): frame 25003,
+  // joint 0.
+  const std::string message = load_error(patched(bytes, varying + 12 * 100000 + 4, nan));
+  EXPECT_TRUE(contains(message, "local_positions[frame 25003, joint 0 'Simulation'] is not finite"))
       << message;
 }
 
@@ -280,8 +337,8 @@ TEST(DatabaseFile, EveryTruncationIsRefusedWithItsSize) {
     if (length == 0) {
       expected = "empty file";
     } else if (length < kDatabaseHeaderSize) {
-      expected =
-          "truncated: expected at least 336 bytes of header, file has " + std::to_string(length);
+      expected = "truncated: expected at least " + std::to_string(kDatabaseHeaderSize) +
+                 " bytes of header, file has " + std::to_string(length);
     } else {
       expected = "truncated: expected " + std::to_string(bytes.size()) + " bytes, file has " +
                  std::to_string(length);
@@ -354,11 +411,11 @@ TEST(DatabaseFile, WrongMagicVersionAndEndiannessHaveSpecificMessages) {
   }
   EXPECT_TRUE(contains(load_error(mangled), "text-mode")) << load_error(mangled);
 
-  const std::string newer = load_error(patched(bytes, 8, uint32_t{2}));
-  EXPECT_TRUE(contains(newer, "format version 2 is newer than the version this program reads (1)"))
+  const std::string newer = load_error(patched(bytes, 8, uint32_t{3}));
+  EXPECT_TRUE(contains(newer, "format version 3 is newer than the version this program reads (2)"))
       << newer;
   const std::string older = load_error(patched(bytes, 8, uint32_t{0}));
-  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (1)"))
+  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (2)"))
       << older;
 
   const std::string swapped = load_error(patched(bytes, 12, uint32_t{0x04030201}));
@@ -415,6 +472,9 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
   const uint64_t names = section_offset(bytes, DatabaseSection::SkeletonNames);
   const uint64_t schema = section_offset(bytes, DatabaseSection::Schema);
   const uint64_t clips = section_offset(bytes, DatabaseSection::Clips);
+  const uint64_t columns = section_offset(bytes, DatabaseSection::PositionColumns);
+  const uint64_t codes = section_offset(bytes, DatabaseSection::RotationCodes);
+  const uint8_t escaped_code = std::to_integer<uint8_t>(bytes[codes + 5]) | uint8_t{31 << 3};
   const uint64_t table = 88;
   const std::vector<Case> cases = {
       {"huge frame count", patched(bytes, 36, uint32_t{0xFFFFFFF0}),
@@ -422,15 +482,26 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
       {"huge joint count", patched(bytes, 32, uint32_t{100000}),
        "joint_count 100000 is outside the valid range"},
       {"frame count one more", patched(bytes, 36, uint32_t{21}),
-       "section 'local_positions': 960 bytes, expected 1008"},
+       "section 'rotation_components': 960 bytes, expected 1008"},
       {"zero channels", patched(bytes, 52, uint32_t{0}), "channel_count 0 is outside"},
       {"too many tags", patched(bytes, 44, uint32_t{65}), "tag_count 65 is outside"},
       {"more clips than the section holds", patched(bytes, 40, uint32_t{20}), "section 'clips'"},
-      {"section past the end", patched(bytes, table + 16 * 14, uint64_t{1} << 40),
-       "section 'tag_names': offset 1099511627776"},
+      {"section past the end", patched(bytes, table + 16 * 16, uint64_t{1} << 40),
+       "section 'searchable': offset 1099511627776"},
       {"misaligned section",
-       patched(bytes, table + 16 * 4, section_offset(bytes, DatabaseSection::LocalPositions) + 4),
-       "section 'local_positions': offset"},
+       patched(bytes, table + 16 * 9,
+               section_offset(bytes, DatabaseSection::RotationComponents) + 4),
+       "section 'rotation_components': offset"},
+      {"position flag 2", patched(bytes, columns + 1, uint8_t{2}),
+       "section 'position_columns': clip 0, joint 1: flag 2, expected 0 or 1"},
+      {"varying column marked constant", patched(bytes, columns, uint8_t{1}),
+       "section 'constant_positions': 12 bytes, but position_columns and the clips call for 2 "
+       "positions"},
+      {"varying positions not whole", patched(bytes, table + 16 * 8 + 8, uint64_t{68 * 12 - 4}),
+       "section 'varying_positions': 812 bytes cannot hold"},
+      {"escape code without exception", patched(bytes, codes + 5, escaped_code),
+       "section 'rotation_exceptions': no exception for the escape code of sample 5 [frame 1, "
+       "joint 1]"},
       {"huge string length", patched(bytes, names, uint32_t{0x7FFFFFFF}),
        "section 'skeleton_names': string 0 claims 2147483647 bytes"},
       // Channel 0: kind, 3 padding, name "left_foot_position" (4 + 18), bone "left_foot"
@@ -456,7 +527,7 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
   const uint64_t clip1 = clips + 24 + db.clips[0].name.size();
   const uint64_t features = section_offset(bytes, DatabaseSection::Features);
   const uint64_t scale = section_offset(bytes, DatabaseSection::FeatureScale);
-  const uint64_t rotations = section_offset(bytes, DatabaseSection::LocalRotations);
+  const uint64_t rotations = section_offset(bytes, DatabaseSection::RotationComponents);
   const uint64_t contacts = section_offset(bytes, DatabaseSection::Contacts);
   const uint64_t searchable = section_offset(bytes, DatabaseSection::Searchable);
   struct Case {
@@ -478,7 +549,7 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
       {"NaN feature", patched(bytes, features + 4 * (3 * kDims + 2), nan),
        "features[frame 3, column 2] is not finite"},
       {"zero scale", patched(bytes, scale + 4 * 5, 0.0f), "feature_scale[5] is 0"},
-      {"non-unit quaternion", patched(bytes, rotations + 16 * 6 + 12, 2.0f),
+      {"non-unit quaternion", patched(bytes, rotations + 12 * 6 + 8, 2.0f),
        "local_rotations[frame 1, joint 2 'Foot_L'] is not a finite unit quaternion"},
       {"contact of 2", patched(bytes, contacts + 7, uint8_t{2}), "contacts[frame 3, right] is 2"},
       {"searchable of 3", patched(bytes, searchable + 4, uint8_t{3}), "searchable[4] is 3"},
@@ -490,6 +561,88 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
     const std::string message = load_error(c.file);
     EXPECT_TRUE(contains(message, "fixture.mmdb: ")) << c.what << ": " << message;
     EXPECT_TRUE(contains(message, c.expected)) << c.what << ": " << message;
+  }
+}
+
+TEST(DatabaseFile, FormatVersion1FileIsRefusedWithARebuildMessage) {
+  // A version-1 file has the same magic, version and endianness fields, then its own layout.
+  const std::vector<std::byte> version1 = patched(serialize_database(make_database()), 8, 1u);
+  const auto path = test::scratch_dir() / "version1.mmdb";
+  write_file(path, version1);
+  for (const std::string& message : {load_error(version1), load_database(path).message(),
+                                     read_database_header(path).message()}) {
+    EXPECT_TRUE(contains(message,
+                         "format version 1 is older than the version this program "
+                         "reads (2); rebuild the database with `mm build`"))
+        << message;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// What the compact layout derives or encodes: bit-exact rotations, recomputed velocities.
+
+TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
+  Database db = make_database();
+  // Quaternions the "smallest three" code cannot predict to within 15 ulps (not exactly unit,
+  // though within validation's 1e-3) go to the exception list; signed zeros, a negative left-out
+  // component and a rotation of exactly 180 degrees (w = 0) round-trip too.
+  db.local_rotations[0] = glm::quat(1.0004f, 0.0f, 0.0f, 0.0f);
+  db.local_rotations[1] = glm::quat(-0.0f, 0.0f, -1.0f, 0.0f);
+  db.local_rotations[2] = glm::quat(0.0f, 0.6f, -0.0f, -0.8f);
+  db.local_rotations[7] = glm::normalize(glm::quat(0.3f, -0.2f, 0.9f, 0.1f)) * 0.9997f;
+  db.local_rotations[45] = glm::quat(-0.5f, -0.5f, -0.5f, -0.5f);
+  derive_velocities(db);
+  ASSERT_TRUE(db.validate().ok()) << db.validate().message();
+  const std::vector<std::byte> bytes = serialize_database(db);
+  Result<DatabaseFileInfo> info = parse_database_header(bytes, "fixture");
+  ASSERT_TRUE(info.ok()) << info.message();
+  EXPECT_EQ(info->section(DatabaseSection::RotationExceptions).length, 2u * 16);
+  Result<Database> loaded = deserialize_database(bytes, "fixture");
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  ASSERT_EQ(loaded->local_rotations.size(), db.local_rotations.size());
+  EXPECT_EQ(std::memcmp(loaded->local_rotations.data(), db.local_rotations.data(),
+                        db.local_rotations.size() * sizeof(glm::quat)),
+            0);
+  expect_same_database(db, *loaded);
+
+  // The exceptions are records {sample, value, 0} in sample order, one per escape code.
+  const uint64_t exceptions = info->section(DatabaseSection::RotationExceptions).offset;
+  uint64_t first = 0;
+  std::memcpy(&first, bytes.data() + exceptions, 8);
+  EXPECT_EQ(first, 0u);
+  const std::string unmatched = load_error(patched(bytes, exceptions, uint64_t{3}));
+  EXPECT_TRUE(contains(unmatched,
+                       "section 'rotation_exceptions': no exception for the escape "
+                       "code of sample 0 [frame 0, joint 0]"))
+      << unmatched;
+  const std::string misplaced = load_error(patched(bytes, exceptions + 16, uint64_t{8}));
+  EXPECT_TRUE(contains(misplaced,
+                       "section 'rotation_exceptions': no exception for the escape "
+                       "code of sample 7"))
+      << misplaced;
+  const std::string unordered = load_error(patched(bytes, exceptions, uint64_t{7}));
+  EXPECT_TRUE(contains(unordered, "exception 1: sample 7 is not in increasing order")) << unordered;
+  const std::string padding = load_error(patched(bytes, exceptions + 12, uint32_t{1}));
+  EXPECT_TRUE(contains(padding, "exception 0 padding: non-zero padding")) << padding;
+}
+
+TEST(DatabaseFile, VelocitiesAreRecomputedOnLoadClipByClip) {
+  Database db = make_database();
+  // Whatever velocities the database holds, the file keeps only the poses.
+  for (glm::vec3& v : db.local_velocities) v = glm::vec3(7.0f);
+  for (glm::vec3& v : db.local_angular_velocities) v = glm::vec3(-7.0f);
+  Result<Database> loaded = deserialize_database(serialize_database(db), "fixture");
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  derive_velocities(db);
+  expect_same_database(db, *loaded);
+  // At the boundary between the clips (frames 11 | 12) the differences are one-sided, inside
+  // each clip: frame 11 looks back at frame 10, frame 12 ahead at frame 13.
+  const float inv_dt = 1.0f / db.frame_time;
+  for (int j = 0; j < kJoints; ++j) {
+    const auto p = [&](int f) { return db.local_positions[f * kJoints + j]; };
+    EXPECT_EQ(loaded->local_velocities[11 * kJoints + j], (p(11) - p(10)) * inv_dt) << j;
+    EXPECT_EQ(loaded->local_velocities[12 * kJoints + j], (p(13) - p(12)) * inv_dt) << j;
+    EXPECT_EQ(loaded->local_velocities[5 * kJoints + j], (p(6) - p(4)) * (inv_dt / 2.0f)) << j;
   }
 }
 

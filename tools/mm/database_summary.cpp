@@ -56,12 +56,14 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
   } else {
     std::fprintf(out, "idle:        none\n");
   }
-  std::fprintf(
-      out, "joints:      %d (joint 0 '%s'); roles: hips %s, feet %s / %s, toes %s / %s, head %s\n",
-      db.joint_count(), db.joint_count() ? db.skeleton.name(0).c_str() : "-",
-      role_name(db, db.roles.hips).c_str(), role_name(db, db.roles.left_foot).c_str(),
-      role_name(db, db.roles.right_foot).c_str(), role_name(db, db.roles.left_toe).c_str(),
-      role_name(db, db.roles.right_toe).c_str(), role_name(db, db.roles.head).c_str());
+  std::fprintf(out, "joints:      %d (joint 0 '%s'); roles:", db.joint_count(),
+               db.joint_count() ? db.skeleton.name(0).c_str() : "-");
+  for (const JointRoleInfo& role : kJointRoles) {
+    std::fprintf(out, "%s %.*s %s", &role == kJointRoles.data() ? "" : ",",
+                 static_cast<int>(role.name.size()), role.name.data(),
+                 role_name(db, db.roles.*role.index).c_str());
+  }
+  std::fprintf(out, "\n");
   std::fprintf(out, "features:    %d dimensions in %zu channels:", db.feature_dims(),
                db.schema.channels.size());
   for (const FeatureChannel& c : db.schema.channels) std::fprintf(out, " %s", c.name.c_str());

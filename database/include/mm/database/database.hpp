@@ -13,6 +13,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/database/features.hpp"
+#include "mm/database/joint_roles.hpp"
 #include "mm/runtime/skeleton.hpp"
 
 namespace mm {
@@ -26,16 +27,6 @@ struct ClipRange {
   uint64_t tags = 0;  // bit i set when the clip carries Database::tag_names[i]
   bool mirrored = false;
   int frame_count() const { return end - start; }
-};
-
-// Joint indices of the roles the features and the controller need (-1 when absent).
-struct JointRoleIndices {
-  int hips = -1;
-  int left_foot = -1;
-  int right_foot = -1;
-  int left_toe = -1;
-  int right_toe = -1;
-  int head = -1;
 };
 
 struct Database {
@@ -81,5 +72,10 @@ struct Database {
   // Consistency of sizes and indices between all the arrays above.
   Status validate() const;
 };
+
+// The clip checks of Database::validate() on their own: the clips are named, tile
+// [0, frame_count) in order and carry only the bits of `tag_count` tags. The file loader runs
+// them before it lays out the per-clip sections.
+Status validate_clip_ranges(std::span<const ClipRange> clips, int frame_count, size_t tag_count);
 
 }  // namespace mm

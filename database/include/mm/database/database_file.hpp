@@ -4,8 +4,9 @@
 // string length, a 64-bit checksum over the whole file and finally Database::validate() are all
 // checked, and any failure comes back as a message naming the file, the section and the index.
 //
-// Layout of format version 1 (all integers and floats in the writer's native byte order, which
-// the endianness marker pins down; offsets in bytes from the start of the file):
+// Layout of format version 2 (all integers and floats in the writer's native byte order, which
+// the endianness marker pins down; offsets in bytes from the start of the file). docs/
+// database-file.md explains the choices and the measurements behind them.
 //
 //   0    magic            8 bytes  8A 'M' 'M' 'D' '\r' '\n' 1A '\n' (catches text-mode and
 //                                  7-bit transfers, which rewrite or strip these bytes)
@@ -16,16 +17,36 @@
 //   28   section_count    uint32   kDatabaseSectionCount
 //   32   joint_count, frame_count, clip_count, tag_count, feature_dims, channel_count: uint32 each
 //   56   frame_time       float32  seconds
-//   60   roles            int32 x 6: hips, left_foot, right_foot, left_toe, right_toe, head
+//   60   roles            int32 per row of kJointRoles, in its order (hips, left_foot,
+//                                  right_foot, left_toe, right_toe, head)
 //   84   reserved         uint32   0
 //   88   section table    kDatabaseSectionCount x {uint64 offset, uint64 length}, in
 //                                  DatabaseSection order
 //   ...  sections         each at a 16-byte aligned offset, in table order, zero padding between
 //   file_size - 8         checksum uint64   database_checksum() of every byte before it
 //
-// Fixed-size sections are plain arrays: quaternions as x, y, z, w; vec3 as x, y, z; a rest
-// transform as rotation (x, y, z, w), translation (x, y, z), scale (x, y, z). Variable sections
-// are records packed back to back with no padding:
+// Only what cannot be derived is stored, and losslessly: after loading, local positions,
+// rotations, contacts, features and everything else are bit for bit what was saved.
+//   - Positions: a joint whose local position is the same (bit for bit) on every frame of a clip
+//     (every joint but the roots and the hips in BVH data) is stored once for that clip.
+//     position_columns holds one uint8 per clip and joint (clip-major): 1 = constant in the
+//     clip, its value next in constant_positions; 0 = varies, its values in varying_positions
+//     (clip by clip, frame by frame, the varying joints in joint order).
+//   - Rotations: "smallest three" without loss. Per sample (frame-major, like the arrays),
+//     rotation_components holds the three components other than the largest one, in x, y, z, w
+//     order, and rotation_codes one byte: bits 0-1 the index (x, y, z, w) of the left-out
+//     component, bit 2 its sign, bits 3-7 (0..30) 16 + the distance in units in the last place
+//     between its magnitude and float(sqrt(1 - a*a - b*b - c*c)) computed in double from the
+//     three stored ones. Code 31 in bits 3-7 marks a value too far off (or not finite): the
+//     exact float is in rotation_exceptions, records {uint64 sample, float32 value, uint32 0}
+//     in increasing sample order, one per such code.
+//   - Velocities and angular velocities are not stored: load recomputes them clip by clip with
+//     compute_local_velocities() (preprocess.hpp), the builder's own function, so they equal
+//     the built ones bit for bit and never look across a clip boundary.
+//   - Features are stored (recomputing them from the poses costs more than reading them).
+// Fixed-size sections are plain arrays: vec3 as x, y, z; a rest transform as rotation (x, y, z,
+// w), translation (x, y, z), scale (x, y, z). Variable sections are records packed back to back
+// with no padding:
 //   string list (skeleton names, tag names): uint32 length, then the bytes (no terminator);
 //   schema channel: uint8 kind, 3 zero bytes, string name, string bone, uint32 time count, that
 //     many float32 times, float32 axis x, y, z, float32 weight;
@@ -46,8 +67,9 @@
 
 namespace mm {
 
-// The format version this program writes and the only one it reads.
-inline constexpr uint32_t kDatabaseFormatVersion = 1;
+// The format version this program writes and the only one it reads. Version 1 (every array
+// stored per frame and joint, velocities included) is refused with a message to rebuild.
+inline constexpr uint32_t kDatabaseFormatVersion = 2;
 // The value written in the endianness field; read back byte-swapped on a machine of the other
 // byte order.
 inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
@@ -55,29 +77,32 @@ inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
 inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M',  'M',  'D',
                                                                 '\r', '\n', 0x1A, '\n'};
 
-// The sections of a version-1 file, in the order they appear in the table and in the file.
+// The sections of a version-2 file, in the order they appear in the table and in the file.
 enum class DatabaseSection : uint32_t {
-  Schema = 0,              // feature channels (variable records)
-  SkeletonNames,           // joint names (string list)
-  SkeletonParents,         // int32 per joint
-  SkeletonRest,            // rest transform per joint (10 floats)
-  LocalPositions,          // vec3 per frame and joint
-  LocalRotations,          // quat per frame and joint
-  LocalVelocities,         // vec3 per frame and joint
-  LocalAngularVelocities,  // vec3 per frame and joint
-  Contacts,                // uint8 x 2 per frame
-  Features,                // float32 x feature_dims per frame
-  FeatureOffset,           // float32 x feature_dims
-  FeatureScale,            // float32 x feature_dims
-  Searchable,              // uint8 per frame
-  Clips,                   // clip records
-  TagNames,                // string list
-  Count,                   // not a section: the number of sections
+  Schema = 0,          // feature channels (variable records)
+  SkeletonNames,       // joint names (string list)
+  SkeletonParents,     // int32 per joint
+  SkeletonRest,        // rest transform per joint (10 floats)
+  Clips,               // clip records
+  TagNames,            // string list
+  PositionColumns,     // uint8 per clip and joint: 1 constant in the clip, 0 varying
+  ConstantPositions,   // vec3 per constant column
+  VaryingPositions,    // vec3 per frame and varying column, clip by clip
+  RotationComponents,  // 3 float32 per frame and joint
+  RotationCodes,       // uint8 per frame and joint
+  RotationExceptions,  // {uint64 sample, float32 value, uint32 0} per escape code
+  Contacts,            // uint8 x 2 per frame
+  Features,            // float32 x feature_dims per frame
+  FeatureOffset,       // float32 x feature_dims
+  FeatureScale,        // float32 x feature_dims
+  Searchable,          // uint8 per frame
+  Count,               // not a section: the number of sections
 };
-// Number of sections in a version-1 file.
+// Number of sections in a version-2 file.
 inline constexpr size_t kDatabaseSectionCount = static_cast<size_t>(DatabaseSection::Count);
-// Size of the fixed header including the section table, rounded up to 16 bytes.
-inline constexpr uint32_t kDatabaseHeaderSize = 336;
+// Size of the fixed header including the section table (88 + 16 per section), rounded up to 16
+// bytes.
+inline constexpr uint32_t kDatabaseHeaderSize = (88 + 16 * kDatabaseSectionCount + 15) / 16 * 16;
 
 // Largest counts a file may declare; anything larger is refused as corrupt before allocating.
 inline constexpr uint32_t kMaxDatabaseJoints = 4096;
@@ -122,7 +147,8 @@ struct DatabaseFileInfo {
 uint64_t database_checksum(std::span<const std::byte> bytes);
 
 // The exact bytes of the file save_database() writes. Writes whatever the arrays hold (an
-// inconsistent database gives a file that load refuses); does not validate.
+// inconsistent database gives a file that load refuses); does not validate. The velocities and
+// angular velocities are not written: load recomputes them from the poses.
 std::vector<std::byte> serialize_database(const Database& db);
 
 // Parses and checks the header of a file image (magic, endianness, version, header and total
@@ -131,8 +157,9 @@ std::vector<std::byte> serialize_database(const Database& db);
 Result<DatabaseFileInfo> parse_database_header(std::span<const std::byte> bytes,
                                                std::string_view name_for_messages);
 
-// Rebuilds a database from a file image, validating everything (see the top of this file), and
-// derives frame_clip. Never trusts a count or offset before checking it against the bytes.
+// Rebuilds a database from a file image, validating everything (see the top of this file),
+// recomputes the velocities and derives frame_clip. Never trusts a count or offset before
+// checking it against the bytes.
 Result<Database> deserialize_database(std::span<const std::byte> bytes,
                                       std::string_view name_for_messages);
 

@@ -29,11 +29,7 @@
 
 namespace mm {
 
-// The role names a channel's bone may use instead of a joint name.
-inline constexpr const char* kFeatureRoleNames[] = {"hips",     "left_foot", "right_foot",
-                                                    "left_toe", "right_toe", "head"};
-
-// The joint index a bone string refers to: a role name (see kFeatureRoleNames) resolved through
+// The joint index a bone string refers to: a role name (see kJointRoles) resolved through
 // `roles`, otherwise an exact joint name; -1 when neither matches.
 int resolve_feature_bone(const std::string& bone, const Skeleton& skeleton,
                          const JointRoleIndices& roles);

@@ -27,25 +27,7 @@ namespace mm {
 
 // ---- Joint roles ---------------------------------------------------------------------------
 
-// The joint names each role may have, tried in order and compared case-insensitively; the
-// first candidate found in the skeleton wins. The defaults recognise the Bandai names (Hips,
-// Foot_L, Toes_L, Head, ...) and common BVH/Mixamo/Blender names (LeftFoot, LeftToeBase,
-// foot.L, ...). Override a role by replacing its list, e.g. roles.left_foot = {"l_ankle"}.
-struct JointRoles {
-  std::vector<std::string> hips = {"Hips", "Hip", "Pelvis", "mixamorig:Hips", "root_hips"};
-  std::vector<std::string> left_foot = {
-      "Foot_L",  "LeftFoot",           "L_Foot", "Foot.L", "LeftAnkle",
-      "l_ankle", "mixamorig:LeftFoot", "lFoot"};
-  std::vector<std::string> right_foot = {
-      "Foot_R",  "RightFoot",           "R_Foot", "Foot.R", "RightAnkle",
-      "r_ankle", "mixamorig:RightFoot", "rFoot"};
-  std::vector<std::string> left_toe = {"Toes_L", "LeftToeBase", "LeftToe", "L_Toe",
-                                       "Toe.L",  "Toes.L",      "l_toes",  "mixamorig:LeftToeBase"};
-  std::vector<std::string> right_toe = {
-      "Toes_R", "RightToeBase", "RightToe", "R_Toe",
-      "Toe.R",  "Toes.R",       "r_toes",   "mixamorig:RightToeBase"};
-  std::vector<std::string> head = {"Head", "mixamorig:Head"};
-};
+// JointRoles (the names each role may have) and the role table are in joint_roles.hpp.
 
 // Finds every role in `skeleton`. Hips and both feet are required (the default features and
 // the contacts need them): a missing one is an error naming the role, the names looked for and
