@@ -16,7 +16,7 @@
 #include "mm/database/files.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/database/io/gltf.hpp"
-#include "workers.hpp"
+#include "mm/runtime/workers.hpp"
 
 namespace mm {
 

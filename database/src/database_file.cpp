@@ -20,7 +20,7 @@
 #include "large_arrays.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/preprocess.hpp"
-#include "workers.hpp"
+#include "mm/runtime/workers.hpp"
 
 namespace mm {
 

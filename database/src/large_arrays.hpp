@@ -7,7 +7,7 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/files.hpp"
-#include "workers.hpp"
+#include "mm/runtime/workers.hpp"
 
 namespace mm::detail {
 

@@ -191,7 +191,6 @@ TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
     EXPECT_GT(json[key].get<double>(), 0.0) << key;
   }
   EXPECT_LE(json["search_share"].get<double>(), 1.0);
-  EXPECT_LE(json["update_us_mean"].get<double>(), json["update_us_p99"].get<double>());
   EXPECT_TRUE(json["same_result_every_thread_count"].get<bool>());
 
   const CommandRun bad = run_mm("crowd-bench --db '" + small_database().string() + "' --seconds 1");

@@ -16,6 +16,7 @@
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
+#include "mm/database/joint_roles.hpp"
 #include "number_parsing.hpp"
 #include "progress_bar.hpp"
 #include "shared_options.hpp"
@@ -29,16 +30,6 @@ struct Arguments {
   BuildOptions options;
   bool quiet = false;
 };
-
-// The joint-role fields by the names --role takes.
-std::vector<std::pair<std::string, std::vector<std::string> JointRoles::*>> role_fields() {
-  return {{"hips", &JointRoles::hips},
-          {"left_foot", &JointRoles::left_foot},
-          {"right_foot", &JointRoles::right_foot},
-          {"left_toe", &JointRoles::left_toe},
-          {"right_toe", &JointRoles::right_toe},
-          {"head", &JointRoles::head}};
-}
 
 // "X,Y,Z": three finite numbers, not all zero.
 std::optional<glm::vec3> parse_axis(const std::string& text) {
@@ -89,27 +80,22 @@ void add_input_options(CLI::App& app, Arguments& out) {
 }
 
 void add_skeleton_options(CLI::App& app, Arguments& out) {
-  std::vector<std::string> roles;
-  for (const auto& [name, field] : role_fields()) roles.push_back(name);
   app.add_option_function<std::vector<std::string>>(
          "--role",
          [&out](const std::vector<std::string>& values) {
            for (const std::string& value : values) {
              const auto [role, joint] = *split_assignment(value);
-             for (const auto& [name, field] : role_fields()) {
-               if (name == role) out.options.roles.*field = {joint};
-             }
+             out.options.roles.*(find_joint_role(role)->candidates) = {joint};
            }
          },
-         "the joint playing a role (" + CLI::detail::join(roles, ", ") +
+         "the joint playing a role (" + joint_role_names() +
              "), instead of the name-based default; repeatable")
       ->check(CLI::Validator(
-          [roles](std::string& value) -> std::string {
+          [](std::string& value) -> std::string {
             const auto assignment = split_assignment(value);
             if (!assignment) return "'" + value + "' is not ROLE=JOINT";
-            if (std::find(roles.begin(), roles.end(), assignment->first) != roles.end()) return {};
-            return "unknown role '" + assignment->first +
-                   "' (roles: " + CLI::detail::join(roles, ", ") + ")";
+            if (find_joint_role(assignment->first)) return {};
+            return "unknown role '" + assignment->first + "' (roles: " + joint_role_names() + ")";
           },
           ""))
       ->type_name("ROLE=JOINT")
