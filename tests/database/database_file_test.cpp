@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "database_helpers.hpp"
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/preprocess.hpp"
@@ -114,57 +115,6 @@ Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
   return db;
 }
 
-// Exact equality of every field, float for float.
-void expect_same_database(const Database& a, const Database& b) {
-  EXPECT_EQ(a.skeleton.names(), b.skeleton.names());
-  EXPECT_EQ(a.skeleton.parents(), b.skeleton.parents());
-  EXPECT_EQ(a.skeleton.subtree_sizes(), b.skeleton.subtree_sizes());
-  ASSERT_EQ(a.skeleton.rest().size(), b.skeleton.rest().size());
-  for (size_t j = 0; j < a.skeleton.rest().size(); ++j) {
-    EXPECT_EQ(a.skeleton.rest()[j].rotation, b.skeleton.rest()[j].rotation) << j;
-    EXPECT_EQ(a.skeleton.rest()[j].translation, b.skeleton.rest()[j].translation) << j;
-    EXPECT_EQ(a.skeleton.rest()[j].scale, b.skeleton.rest()[j].scale) << j;
-  }
-  EXPECT_EQ(a.roles.hips, b.roles.hips);
-  EXPECT_EQ(a.roles.left_foot, b.roles.left_foot);
-  EXPECT_EQ(a.roles.right_foot, b.roles.right_foot);
-  EXPECT_EQ(a.roles.left_toe, b.roles.left_toe);
-  EXPECT_EQ(a.roles.right_toe, b.roles.right_toe);
-  EXPECT_EQ(a.roles.head, b.roles.head);
-  EXPECT_EQ(a.frame_time, b.frame_time);
-  EXPECT_EQ(a.frame_count, b.frame_count);
-  EXPECT_TRUE(a.local_positions == b.local_positions);
-  EXPECT_TRUE(a.local_rotations == b.local_rotations);
-  EXPECT_TRUE(a.local_velocities == b.local_velocities);
-  EXPECT_TRUE(a.local_angular_velocities == b.local_angular_velocities);
-  EXPECT_EQ(a.contacts, b.contacts);
-  ASSERT_EQ(a.clips.size(), b.clips.size());
-  for (size_t c = 0; c < a.clips.size(); ++c) {
-    EXPECT_EQ(a.clips[c].name, b.clips[c].name);
-    EXPECT_EQ(a.clips[c].start, b.clips[c].start);
-    EXPECT_EQ(a.clips[c].end, b.clips[c].end);
-    EXPECT_EQ(a.clips[c].tags, b.clips[c].tags);
-    EXPECT_EQ(a.clips[c].mirrored, b.clips[c].mirrored);
-  }
-  EXPECT_EQ(a.tag_names, b.tag_names);
-  ASSERT_EQ(a.schema.channels.size(), b.schema.channels.size());
-  for (size_t c = 0; c < a.schema.channels.size(); ++c) {
-    const FeatureChannel& x = a.schema.channels[c];
-    const FeatureChannel& y = b.schema.channels[c];
-    EXPECT_EQ(x.name, y.name);
-    EXPECT_EQ(x.kind, y.kind);
-    EXPECT_EQ(x.bone, y.bone);
-    EXPECT_EQ(x.times, y.times);
-    EXPECT_EQ(x.axis, y.axis);
-    EXPECT_EQ(x.weight, y.weight);
-  }
-  EXPECT_EQ(a.features, b.features);
-  EXPECT_EQ(a.feature_offset, b.feature_offset);
-  EXPECT_EQ(a.feature_scale, b.feature_scale);
-  EXPECT_EQ(a.searchable, b.searchable);
-  EXPECT_EQ(a.frame_clip, b.frame_clip);
-}
-
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
@@ -210,7 +160,7 @@ TEST(DatabaseFile, SaveLoadRoundTripIsExact) {
 
   Result<Database> loaded = load_database(path);
   ASSERT_TRUE(loaded.ok()) << loaded.message();
-  expect_same_database(db, *loaded);
+  test::expect_same_database(db, *loaded);
   // Writing the loaded database again gives the identical bytes.
   EXPECT_EQ(serialize_database(db), serialize_database(*loaded));
 }
@@ -309,7 +259,7 @@ TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
   ASSERT_GT(bytes.size(), size_t{8} << 20);
   Result<Database> loaded = deserialize_database(bytes, "large");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
-  expect_same_database(db, *loaded);
+  test::expect_same_database(db, *loaded);
 
   // A NaN deep in the positions without resealing: the checksum reports it, not the NaN.
   const uint64_t varying = section_offset(bytes, DatabaseSection::VaryingPositions);
@@ -603,7 +553,7 @@ TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
   EXPECT_EQ(std::memcmp(loaded->local_rotations.data(), db.local_rotations.data(),
                         db.local_rotations.size() * sizeof(glm::quat)),
             0);
-  expect_same_database(db, *loaded);
+  test::expect_same_database(db, *loaded);
 
   // The exceptions are records {sample, value, 0} in sample order, one per escape code.
   const uint64_t exceptions = info->section(DatabaseSection::RotationExceptions).offset;
@@ -634,7 +584,7 @@ TEST(DatabaseFile, VelocitiesAreRecomputedOnLoadClipByClip) {
   Result<Database> loaded = deserialize_database(serialize_database(db), "fixture");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   derive_velocities(db);
-  expect_same_database(db, *loaded);
+  test::expect_same_database(db, *loaded);
   // At the boundary between the clips (frames 11 | 12) the differences are one-sided, inside
   // each clip: frame 11 looks back at frame 10, frame 12 ahead at frame 13.
   const float inv_dt = 1.0f / db.frame_time;

@@ -1,11 +1,14 @@
 #pragma once
-// Small readers of a built Database shared by the database test suites (header-only: the
-// support library itself does not link the database).
+// Small readers and comparisons of a built Database shared by the database test suites
+// (header-only: the support library itself does not link the database).
 
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "mm/database/database.hpp"
+#include "mm/database/joint_roles.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm::test {
@@ -27,6 +30,54 @@ inline std::vector<Transform> frame_globals(const Database& db, int frame) {
   }
   forward_kinematics(db.skeleton.parents(), local, global);
   return global;
+}
+
+// Exact equality of every field, float for float.
+inline void expect_same_database(const Database& a, const Database& b) {
+  EXPECT_EQ(a.skeleton.names(), b.skeleton.names());
+  EXPECT_EQ(a.skeleton.parents(), b.skeleton.parents());
+  EXPECT_EQ(a.skeleton.subtree_sizes(), b.skeleton.subtree_sizes());
+  ASSERT_EQ(a.skeleton.rest().size(), b.skeleton.rest().size());
+  for (size_t j = 0; j < a.skeleton.rest().size(); ++j) {
+    EXPECT_EQ(a.skeleton.rest()[j].rotation, b.skeleton.rest()[j].rotation) << j;
+    EXPECT_EQ(a.skeleton.rest()[j].translation, b.skeleton.rest()[j].translation) << j;
+    EXPECT_EQ(a.skeleton.rest()[j].scale, b.skeleton.rest()[j].scale) << j;
+  }
+  for (const JointRoleInfo& role : kJointRoles) {
+    EXPECT_EQ(a.roles.*role.index, b.roles.*role.index) << role.name;
+  }
+  EXPECT_EQ(a.frame_time, b.frame_time);
+  EXPECT_EQ(a.frame_count, b.frame_count);
+  EXPECT_TRUE(a.local_positions == b.local_positions);
+  EXPECT_TRUE(a.local_rotations == b.local_rotations);
+  EXPECT_TRUE(a.local_velocities == b.local_velocities);
+  EXPECT_TRUE(a.local_angular_velocities == b.local_angular_velocities);
+  EXPECT_EQ(a.contacts, b.contacts);
+  ASSERT_EQ(a.clips.size(), b.clips.size());
+  for (size_t c = 0; c < a.clips.size(); ++c) {
+    EXPECT_EQ(a.clips[c].name, b.clips[c].name);
+    EXPECT_EQ(a.clips[c].start, b.clips[c].start);
+    EXPECT_EQ(a.clips[c].end, b.clips[c].end);
+    EXPECT_EQ(a.clips[c].tags, b.clips[c].tags);
+    EXPECT_EQ(a.clips[c].mirrored, b.clips[c].mirrored);
+  }
+  EXPECT_EQ(a.tag_names, b.tag_names);
+  ASSERT_EQ(a.schema.channels.size(), b.schema.channels.size());
+  for (size_t c = 0; c < a.schema.channels.size(); ++c) {
+    const FeatureChannel& x = a.schema.channels[c];
+    const FeatureChannel& y = b.schema.channels[c];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.kind, y.kind);
+    EXPECT_EQ(x.bone, y.bone);
+    EXPECT_EQ(x.times, y.times);
+    EXPECT_EQ(x.axis, y.axis);
+    EXPECT_EQ(x.weight, y.weight);
+  }
+  EXPECT_EQ(a.features, b.features);
+  EXPECT_EQ(a.feature_offset, b.feature_offset);
+  EXPECT_EQ(a.feature_scale, b.feature_scale);
+  EXPECT_EQ(a.searchable, b.searchable);
+  EXPECT_EQ(a.frame_clip, b.frame_clip);
 }
 
 }  // namespace mm::test
