@@ -1,5 +1,7 @@
 #include "mm/database/database.hpp"
 
+#include "validation.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -338,8 +340,8 @@ Status check_clips(const Database& db) {
 }
 
 // Values: the large arrays last, with the vectorized scans.
-Status check_values(const Database& db) {
-  const size_t dims = static_cast<size_t>(db.feature_dims());
+// The per-frame joint arrays: finite unit rotations, finite positions and velocities.
+Status check_joint_values(const Database& db) {
   if (size_t i = first_non_unit(db.local_rotations); i != kNotFound) {
     const glm::quat& q = db.local_rotations[i];
     return Error{"database: local_rotations" + frame_joint(db, i) +
@@ -355,6 +357,12 @@ Status check_values(const Database& db) {
       return Error{"database: " + std::string(name) + frame_joint(db, i / 3) + " is not finite"};
     }
   }
+  return Status::success();
+}
+
+// The other per-frame values: contacts and searchable flags, features and their normalization.
+Status check_other_values(const Database& db) {
+  const size_t dims = static_cast<size_t>(db.feature_dims());
   if (size_t i = first_non_boolean(db.contacts); i != kNotFound) {
     return Error{"database: contacts[frame " + std::to_string(i / 2) + ", " +
                  (i % 2 == 0 ? "left" : "right") + "] is " + std::to_string(db.contacts[i]) +
@@ -383,16 +391,40 @@ Status check_values(const Database& db) {
 }  // namespace
 
 Status Database::validate() const {
-  if (!(frame_time > 0.0f) || !std::isfinite(frame_time)) {
-    return Error{"database: frame_time " + std::to_string(frame_time) +
+  if (Status s = detail::validate_except_joint_values(*this); !s) return s;
+  return check_joint_values(*this);
+}
+
+namespace detail {
+
+Status validate_except_joint_values(const Database& db) {
+  if (!(db.frame_time > 0.0f) || !std::isfinite(db.frame_time)) {
+    return Error{"database: frame_time " + std::to_string(db.frame_time) +
                  " s; expected a positive finite number of seconds"};
   }
   for (Status (*check)(const Database&) :
        {check_skeleton, check_roles, check_frame_arrays, check_schema_and_features, check_tags,
-        check_clips, check_values}) {
-    if (Status s = check(*this); !s) return s;
+        check_clips, check_other_values}) {
+    if (Status s = check(db); !s) return s;
   }
   return Status::success();
 }
+
+bool joint_values_valid(const Database& db, size_t first, size_t count) {
+  if (count == 0) return true;
+  const size_t end = first + count;
+  if (first_non_unit_serial(glm::value_ptr(db.local_rotations[0]), first, end) != kNotFound) {
+    return false;
+  }
+  for (const std::vector<glm::vec3>* array :
+       {&db.local_positions, &db.local_velocities, &db.local_angular_velocities}) {
+    if (first_non_finite_serial(glm::value_ptr((*array)[0]), 3 * first, 3 * end) != kNotFound) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace detail
 
 }  // namespace mm

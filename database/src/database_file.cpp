@@ -21,6 +21,7 @@
 #include "mm/database/files.hpp"
 #include "mm/database/preprocess.hpp"
 #include "mm/runtime/workers.hpp"
+#include "validation.hpp"
 
 namespace mm {
 
@@ -859,12 +860,21 @@ uint64_t hash_and_allocate(std::span<const std::byte> file, const DatabaseFileIn
 
 // Phase 3 of a load, on two threads pulling clips: decode_clip() for every clip. Returns the
 // failure of the first clip that failed.
+// Sets `joint_values_valid` to whether every decoded joint value passed
+// detail::joint_values_valid (checked clip by clip while the values are in cache).
 Status decode_clips(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                    const LoadPlan& plan, std::string_view name, int threads, Database& db) {
+                    const LoadPlan& plan, std::string_view name, int threads, Database& db,
+                    bool& joint_values_valid) {
   std::vector<Status> status(db.clips.size());
+  std::vector<uint8_t> valid(db.clips.size(), 0);
   detail::run_workers(db.clips.size(), threads, [&](int, size_t c) {
     status[c] = decode_clip(file, info, plan, c, name, db);
+    const size_t joints = info.joint_count;
+    valid[c] = status[c] &&
+               detail::joint_values_valid(db, static_cast<size_t>(db.clips[c].start) * joints,
+                                          static_cast<size_t>(db.clips[c].frame_count()) * joints);
   });
+  joint_values_valid = std::all_of(valid.begin(), valid.end(), [](uint8_t v) { return v != 0; });
   for (const Status& s : status) {
     if (!s) return s;
   }
@@ -1167,6 +1177,7 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
   Database db;
   LoadPlan plan;
   Status phase1;
+  bool joint_values_valid = false;
   Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
   try {
     phase1 = header ? read_small_sections(bytes, *header, name, db, plan) : Error{header.message()};
@@ -1185,13 +1196,16 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
         computed != stored) {
       return checksum_error(computed);
     }
-    if (Status s = decode_clips(bytes, *header, plan, name, threads, db); !s) {
+    if (Status s = decode_clips(bytes, *header, plan, name, threads, db, joint_values_valid); !s) {
       return Error{s.message()};
     }
   } catch (const std::exception& e) {
     return Error{name + ": cannot load: " + e.what()};
   }
-  if (Status s = db.validate(); !s) return Error{name + ": " + s.message()};
+  // A bad joint value is reported by the full validation, which names the first one.
+  const Status valid =
+      joint_values_valid ? detail::validate_except_joint_values(db) : db.validate();
+  if (!valid) return Error{name + ": " + valid.message()};
   return db;
 }
 
