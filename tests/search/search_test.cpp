@@ -114,24 +114,18 @@ std::unique_ptr<Searcher> make(std::string_view method, const SearchInput& input
   return searcher.ok() ? std::move(searcher.value()) : nullptr;
 }
 
-// A tiny database written out by hand: 1-d features, so every distance is easy to verify.
+// A tiny database written out by hand in the synthetic data type: 1-d features, so every
+// distance is easy to verify.
 //   clip 0 "walk" (tag bit 0): frames 0..5, values 0,1,2,3,4,5; frame 5 not searchable
 //   clip 1 "run"  (tag bit 1): frames 6..11, values 10,11,12,13,14,15; frame 11 not searchable
 //   clip 2 "idle" (tags 0 and 2): frames 12..14, values 2.5, 2.5, 2.5 (exact duplicates)
-struct TinyDatabase {
-  std::vector<float> features{0, 1, 2, 3, 4, 5, 10, 11, 12, 13, 14, 15, 2.5f, 2.5f, 2.5f};
-  std::vector<uint8_t> searchable{1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1};
-  std::vector<int> frame_clip{0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 2};
-  std::vector<SearchClip> clips{{0, 6, 0b001}, {6, 12, 0b010}, {12, 15, 0b101}};
-
-  SearchInput input() const {
-    SearchInput view;
-    view.features = features;
-    view.dims = 1;
-    view.searchable = searchable;
-    view.frame_clip = frame_clip;
-    view.clips = clips;
-    return view;
+struct TinyDatabase : SyntheticSearchData {
+  TinyDatabase() {
+    dims = 1;
+    features = {0, 1, 2, 3, 4, 5, 10, 11, 12, 13, 14, 15, 2.5f, 2.5f, 2.5f};
+    searchable = {1, 1, 1, 1, 1, 0, 1, 1, 1, 1, 1, 0, 1, 1, 1};
+    frame_clip = {0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 2, 2, 2};
+    clips = {{0, 6, 0b001}, {6, 12, 0b010}, {12, 15, 0b101}};
   }
 };
 
