@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -14,6 +15,7 @@
 #include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/database/preprocess.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -74,6 +76,22 @@ TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
       for (size_t j = 0; j < joints; ++j) {
         EXPECT_LE(glm::length(a[j].translation - b[j].translation), 1e-6f)
             << clip.name << " frame " << f << " joint " << j;
+      }
+    }
+    // Every angular velocity (four joints at a time where possible) has the bits of the
+    // one-sample function: central inside the clip, one-sided at its ends.
+    for (int f = 0; f < clip.frame_count(); ++f) {
+      const int a = std::max(0, f - 1), b = std::min(clip.frame_count() - 1, f + 1);
+      if (a == b) break;
+      const float inv_dt = 1.0f / (static_cast<float>(b - a) * back.frame_time);
+      const glm::quat* rotation = back.local_rotations.data() + first;
+      for (size_t j = 0; j < joints; ++j) {
+        const glm::vec3 expected =
+            angular_velocity_between(rotation[a * joints + j], rotation[b * joints + j], inv_dt);
+        const glm::vec3& got = back.local_angular_velocities[first + f * joints + j];
+        ASSERT_TRUE(same_bits(&got, &expected, 1))
+            << clip.name << " frame " << f << " joint " << j << ": " << got.x << " " << got.y << " "
+            << got.z << " instead of " << expected.x << " " << expected.y << " " << expected.z;
       }
     }
     // No velocity looks across the boundary: the first and last frames of a clip (of more than

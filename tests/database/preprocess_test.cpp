@@ -7,6 +7,7 @@
 
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/preprocess.hpp"
+#include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
@@ -124,6 +125,58 @@ TEST(LocalVelocities, CentralInsideOneSidedAtTheEndsAndShortestPath) {
   compute_local_velocities(std::span(p).first(1), std::span(q).first(1), 1, 1, kDt, v1, a1);
   EXPECT_EQ(v1[0], glm::vec3(0.0f));
   EXPECT_EQ(a1[0], glm::vec3(0.0f));
+}
+
+TEST(LocalVelocities, EveryJointGetsTheSameBitsWhereverItSitsInTheFrame) {
+  // Four joints at a time go through SSE, the rest through the scalar code: the same column of
+  // samples must give the same bits at any joint index (so in any lane or in the tail), and agree
+  // with the exact rotation vector. Steps between frames from tiny to large (the series and the
+  // exact path), some with w < 0 (the shorter way round).
+  const int frames = 11, columns = 9;
+  std::vector<std::vector<glm::vec3>> p(columns, std::vector<glm::vec3>(frames));
+  std::vector<std::vector<glm::quat>> q(columns, std::vector<glm::quat>(frames));
+  for (int c = 0; c < columns; ++c) {
+    const glm::vec3 axis = glm::normalize(glm::vec3(1.0f + c, 2.0f - c, 0.5f * c - 1.0f));
+    glm::quat r = glm::angleAxis(0.3f * c, axis);
+    for (int f = 0; f < frames; ++f) {
+      p[c][f] = glm::vec3(0.1f * c * f, std::sin(0.7f * f + c), 0.01f * f * f);
+      q[c][f] = (c + f) % 3 == 0 ? -r : r;
+      // Central differences span two steps: up to the series' limit (~0.49 rad) and beyond.
+      constexpr float kSteps[] = {0.003f, 0.08f, 0.17f, 0.2f, 0.22f, 0.235f, 0.7f};
+      const float step = kSteps[(c * 3 + f) % 7];
+      r = glm::angleAxis(step, glm::normalize(axis + glm::vec3(0.0f, 0.1f * f, 0.0f))) * r;
+    }
+  }
+  std::vector<glm::vec3> first_velocity, first_angular;
+  for (int joints = columns; joints >= 1; --joints) {
+    std::vector<glm::vec3> pos(frames * joints), v(frames * joints), av(frames * joints);
+    std::vector<glm::quat> rot(frames * joints);
+    for (int f = 0; f < frames; ++f) {
+      for (int j = 0; j < joints; ++j) {
+        pos[f * joints + j] = p[j][f];
+        rot[f * joints + j] = q[j][f];
+      }
+    }
+    compute_local_velocities(pos, rot, frames, joints, kDt, v, av);
+    if (first_velocity.empty()) {
+      first_velocity = v;
+      first_angular = av;
+    }
+    for (int f = 0; f < frames; ++f) {
+      const int a = std::max(0, f - 1), b = std::min(frames - 1, f + 1);
+      for (int j = 0; j < joints; ++j) {
+        const size_t here = f * joints + j, there = f * columns + j;
+        ASSERT_EQ(v[here], first_velocity[there])
+            << joints << " joints, frame " << f << " joint " << j;
+        ASSERT_EQ(av[here], first_angular[there])
+            << joints << " joints, frame " << f << " joint " << j;
+        const glm::vec3 exact =
+            quat_to_scaled_angle_axis(q[j][b] * glm::conjugate(q[j][a])) / ((b - a) * kDt);
+        EXPECT_NEAR(glm::length(av[here] - exact), 0.0f, 1e-5f * (1.0f + glm::length(exact)))
+            << "frame " << f << " joint " << j;
+      }
+    }
+  }
 }
 
 // ---- Resampling --------------------------------------------------------------------------------

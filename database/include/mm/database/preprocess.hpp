@@ -172,6 +172,11 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
                        const PreprocessOptions& options, const ClipMotionOutput& out,
                        PreprocessScratch& scratch);
 
+// The angular velocity (radians / second, as a rotation vector) that turns `from` into `to` in
+// 1 / inv_dt seconds, one sample as compute_local_velocities computes it (which does four at a
+// time where it can, with the same bits).
+glm::vec3 angular_velocity_between(const glm::quat& from, const glm::quat& to, float inv_dt);
+
 // Finite-difference velocities and angular velocities of frame-major local positions and
 // rotations (frame_count * joint_count each) into the two output arrays of the same size:
 // central differences inside, one-sided at the ends, zero for a single frame.
