@@ -4,9 +4,8 @@
 #include <cassert>
 #include <cmath>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#include <xmmintrin.h>
+#if defined(__SSE2__) && defined(__GNUC__)
+#include <immintrin.h>
 #endif
 
 #include <glm/gtc/type_ptr.hpp>
@@ -91,56 +90,109 @@ glm::vec3 small_rotation_vector(const glm::quat& rotation) {
   return quat_to_scaled_angle_axis(q);
 }
 
-#if defined(__SSE2__)
-// angular_velocity_between of four joints at once, in SSE2 (part of every x86-64 CPU), with the
-// same float operations in the same order, so every value is bit for bit the scalar one. A lane
+#if defined(__SSE2__) && defined(__GNUC__)
+// Several joints at once: the same float operations as angular_velocity_between, in the same
+// order, so every value has the scalar bits (without FMA there is nothing to contract). A lane
 // whose rotation is too large for the series takes the scalar path.
-void angular_velocity_x4(const glm::quat* from, const glm::quat* to, float inv_dt, glm::vec3* out) {
-  // Four quaternions (x, y, z, w in memory) transposed into one register per component.
-  __m128 ax = _mm_loadu_ps(&from[0].x), ay = _mm_loadu_ps(&from[1].x);
-  __m128 az = _mm_loadu_ps(&from[2].x), aw = _mm_loadu_ps(&from[3].x);
-  _MM_TRANSPOSE4_PS(ax, ay, az, aw);
-  __m128 bx = _mm_loadu_ps(&to[0].x), by = _mm_loadu_ps(&to[1].x);
-  __m128 bz = _mm_loadu_ps(&to[2].x), bw = _mm_loadu_ps(&to[3].x);
-  _MM_TRANSPOSE4_PS(bx, by, bz, bw);
-  const __m128 sign = _mm_set1_ps(-0.0f);
-  const auto mul = [](__m128 a, __m128 b) { return _mm_mul_ps(a, b); };
-  const auto add = [](__m128 a, __m128 b) { return _mm_add_ps(a, b); };
-  const auto sub = [](__m128 a, __m128 b) { return _mm_sub_ps(a, b); };
-  // p * q with p = to and q = conjugate(from), written as glm's quaternion product.
-  const __m128 qx = _mm_xor_ps(ax, sign), qy = _mm_xor_ps(ay, sign), qz = _mm_xor_ps(az, sign);
-  __m128 w = sub(sub(sub(mul(bw, aw), mul(bx, qx)), mul(by, qy)), mul(bz, qz));
-  __m128 x = sub(add(add(mul(bw, qx), mul(bx, aw)), mul(by, qz)), mul(bz, qy));
-  __m128 y = sub(add(add(mul(bw, qy), mul(by, aw)), mul(bz, qx)), mul(bx, qz));
-  __m128 z = sub(add(add(mul(bw, qz), mul(bz, aw)), mul(bx, qy)), mul(by, qx));
-  // small_rotation_vector: the shorter way round, then the series.
-  const __m128 flip = _mm_and_ps(_mm_cmplt_ps(w, _mm_setzero_ps()), sign);
-  w = _mm_xor_ps(w, flip);
-  x = _mm_xor_ps(x, flip);
-  y = _mm_xor_ps(y, flip);
-  z = _mm_xor_ps(z, flip);
-  const __m128 s2 = add(add(mul(x, x), mul(y, y)), mul(z, z));
-  const int small = _mm_movemask_ps(_mm_cmplt_ps(s2, mul(mul(_mm_set1_ps(0.0625f), w), w)));
-  const __m128 t = _mm_div_ps(s2, mul(w, w));
-  const auto term = [&](__m128 inner, float c) { return add(_mm_set1_ps(c), mul(t, inner)); };
-  __m128 series = _mm_set1_ps(1.0f / 13);
-  series = term(series, -1.0f / 11);
-  series = term(series, 1.0f / 9);
-  series = term(series, -1.0f / 7);
-  series = term(series, 1.0f / 5);
-  series = term(series, -1.0f / 3);
-  series = term(series, 1.0f);
-  const __m128 k = _mm_div_ps(mul(_mm_set1_ps(2.0f), series), w);
-  const __m128 rate = _mm_set1_ps(inv_dt);
-  alignas(16) float result[3][4];
-  _mm_store_ps(result[0], mul(mul(x, k), rate));
-  _mm_store_ps(result[1], mul(mul(y, k), rate));
-  _mm_store_ps(result[2], mul(mul(z, k), rate));
-  for (int lane = 0; lane < 4; ++lane) {
-    out[lane] = (small >> lane & 1) != 0
-                    ? glm::vec3(result[0][lane], result[1][lane], result[2][lane])
-                    : angular_velocity_between(from[lane], to[lane], inv_dt);
+using Floats4 = float __attribute__((vector_size(16)));
+using Floats8 = float __attribute__((vector_size(32)));
+
+// Quaternions lane by lane (one vector per component).
+template <class V>
+struct QuatLanes {
+  V x, y, z, w;
+};
+
+// small_rotation_vector(to * conjugate(from)) * inv_dt for every lane into rate; returns the bit
+// mask of the lanes whose rotation the series covers (the others need the scalar path).
+template <class V>
+[[gnu::always_inline]] inline unsigned series_rates(const QuatLanes<V>& from,
+                                                    const QuatLanes<V>& to, float inv_dt,
+                                                    QuatLanes<V>& rate) {
+  // p * q with p = to and q = conjugate(from), as glm writes the quaternion product.
+  const V qx = -from.x, qy = -from.y, qz = -from.z, qw = from.w;
+  V w = to.w * qw - to.x * qx - to.y * qy - to.z * qz;
+  V x = to.w * qx + to.x * qw + to.y * qz - to.z * qy;
+  V y = to.w * qy + to.y * qw + to.z * qx - to.x * qz;
+  V z = to.w * qz + to.z * qw + to.x * qy - to.y * qx;
+  const auto flip = w < 0.0f;  // the shorter way round
+  w = flip ? -w : w;
+  x = flip ? -x : x;
+  y = flip ? -y : y;
+  z = flip ? -z : z;
+  const V s2 = x * x + y * y + z * z;
+  const auto small = s2 < 0.0625f * w * w;
+  const V t = s2 / (w * w);
+  const V series =
+      1.0f +
+      t * (-1.0f / 3 +
+           t * (1.0f / 5 + t * (-1.0f / 7 + t * (1.0f / 9 + t * (-1.0f / 11 + t * (1.0f / 13))))));
+  const V k = 2.0f * series / w;
+  rate.x = x * k * inv_dt;
+  rate.y = y * k * inv_dt;
+  rate.z = z * k * inv_dt;
+  unsigned bits = 0;
+  for (size_t lane = 0; lane < sizeof(V) / sizeof(float); ++lane) {
+    bits |= static_cast<unsigned>(small[lane] != 0) << lane;
   }
+  return bits;
+}
+
+template <class V>
+[[gnu::always_inline]] inline void store_rates(const QuatLanes<V>& rate, unsigned series,
+                                               const glm::quat* from, const glm::quat* to,
+                                               float inv_dt, glm::vec3* out) {
+  for (size_t lane = 0; lane < sizeof(V) / sizeof(float); ++lane) {
+    out[lane] = (series >> lane & 1) != 0 ? glm::vec3(rate.x[lane], rate.y[lane], rate.z[lane])
+                                          : angular_velocity_between(from[lane], to[lane], inv_dt);
+  }
+}
+
+// Four quaternions (x, y, z, w in memory) transposed into one vector per component.
+QuatLanes<Floats4> load_quats_x4(const glm::quat* q) {
+  __m128 x = _mm_loadu_ps(&q[0].x), y = _mm_loadu_ps(&q[1].x);
+  __m128 z = _mm_loadu_ps(&q[2].x), w = _mm_loadu_ps(&q[3].x);
+  _MM_TRANSPOSE4_PS(x, y, z, w);
+  return {x, y, z, w};
+}
+
+void angular_velocity_x4(const glm::quat* from, const glm::quat* to, float inv_dt, glm::vec3* out) {
+  QuatLanes<Floats4> rate;
+  const unsigned series = series_rates(load_quats_x4(from), load_quats_x4(to), inv_dt, rate);
+  store_rates(rate, series, from, to, inv_dt, out);
+}
+
+// Two quaternions in the two halves of one vector.
+__attribute__((target("avx"))) __m256 load_quat_pair(const glm::quat& low, const glm::quat& high) {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(&low.x)), _mm_loadu_ps(&high.x),
+                              1);
+}
+
+// Eight quaternions: lanes 0-3 in the low half of each vector, 4-7 in the high half.
+__attribute__((target("avx"))) QuatLanes<Floats8> load_quats_x8(const glm::quat* q) {
+  const __m256 r0 = load_quat_pair(q[0], q[4]), r1 = load_quat_pair(q[1], q[5]);
+  const __m256 r2 = load_quat_pair(q[2], q[6]), r3 = load_quat_pair(q[3], q[7]);
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpacklo_ps(r2, r3);
+  const __m256 t2 = _mm256_unpackhi_ps(r0, r1), t3 = _mm256_unpackhi_ps(r2, r3);
+  return {_mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(1, 0, 1, 0)),
+          _mm256_shuffle_ps(t0, t1, _MM_SHUFFLE(3, 2, 3, 2)),
+          _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(1, 0, 1, 0)),
+          _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2))};
+}
+
+__attribute__((target("avx"))) void angular_velocity_x8(const glm::quat* from, const glm::quat* to,
+                                                        float inv_dt, glm::vec3* out) {
+  QuatLanes<Floats8> rate;
+  const unsigned series = series_rates(load_quats_x8(from), load_quats_x8(to), inv_dt, rate);
+  store_rates(rate, series, from, to, inv_dt, out);
+}
+
+bool avx_supported() {
+  static const bool supported = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx");
+  }();
+  return supported;
 }
 #endif
 
@@ -161,7 +213,13 @@ struct FrameDifferences {
     for (size_t k = 0; k < 3 * count; ++k) velocity[k] = (to[k] - from[k]) * inv_dt;
 
     size_t i = first;
-#if defined(__SSE2__)
+#if defined(__SSE2__) && defined(__GNUC__)
+    if (avx_supported()) {
+      for (; i + 8 <= first + count; i += 8) {
+        angular_velocity_x8(&rotations[i - back], &rotations[i + ahead], inv_dt,
+                            &angular_velocities[i]);
+      }
+    }
     for (; i + 4 <= first + count; i += 4) {
       angular_velocity_x4(&rotations[i - back], &rotations[i + ahead], inv_dt,
                           &angular_velocities[i]);
