@@ -15,6 +15,11 @@
 #include <system_error>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#include <xmmintrin.h>
+#endif
+
 #include <glm/gtc/type_ptr.hpp>
 
 #include "large_arrays.hpp"
@@ -215,10 +220,89 @@ glm::quat decode_rotation(const float* components, uint8_t code, const float* ex
   }
 }
 
+#if defined(__SSE2__)
+// Lanes below, at and above a left-out index (0-3), for placing the left-out component.
+struct PlacementMasks {
+  alignas(16) uint32_t below[4][4];
+  alignas(16) uint32_t at[4][4];
+  alignas(16) uint32_t above[4][4];
+};
+constexpr PlacementMasks make_placement_masks() {
+  PlacementMasks m{};
+  for (int k = 0; k < 4; ++k) {
+    for (int lane = 0; lane < 4; ++lane) {
+      m.below[k][lane] = lane < k ? ~0u : 0u;
+      m.at[k][lane] = lane == k ? ~0u : 0u;
+      m.above[k][lane] = lane > k ? ~0u : 0u;
+    }
+  }
+  return m;
+}
+constexpr PlacementMasks kPlacement = make_placement_masks();
+
+// unit_complement of four samples: the same double-precision sums in the same order, and sqrtpd
+// rounds correctly like std::sqrt, so the bits are the scalar ones.
+__m128 unit_complement_x4(__m128 a, __m128 b, __m128 c) {
+  const auto half = [](__m128 low_a, __m128 low_b, __m128 low_c) {
+    const __m128d ad = _mm_cvtps_pd(low_a), bd = _mm_cvtps_pd(low_b), cd = _mm_cvtps_pd(low_c);
+    const __m128d sum =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(ad, ad), _mm_mul_pd(bd, bd)), _mm_mul_pd(cd, cd));
+    // max(x, 0) gives 0 for NaN too, as std::max(0.0, x) does.
+    return _mm_cvtpd_ps(
+        _mm_sqrt_pd(_mm_max_pd(_mm_sub_pd(_mm_set1_pd(1.0), sum), _mm_setzero_pd())));
+  };
+  return _mm_movelh_ps(half(a, b, c),
+                       half(_mm_movehl_ps(a, a), _mm_movehl_ps(b, b), _mm_movehl_ps(c, c)));
+}
+
+// decode_rotation of four consecutive samples, none of them an escape, in SSE2.
+void decode_rotations_x4(const std::byte* components, const uint8_t* codes, glm::quat* out) {
+  // Twelve floats a0 b0 c0 a1 | b1 c1 a2 b2 | c2 a3 b3 c3 into one register per component.
+  const auto load = [&](int k) {
+    return _mm_loadu_ps(reinterpret_cast<const float*>(components + 16 * k));
+  };
+  const __m128 m0 = load(0), m1 = load(1), m2 = load(2);
+  const __m128 a =
+      _mm_shuffle_ps(m0, _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
+  const __m128 b =
+      _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(0, 0, 1, 1)),
+                     _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(2, 2, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+  const __m128 c =
+      _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(1, 1, 2, 2)), m2, _MM_SHUFFLE(3, 0, 2, 0));
+  // The left-out component: the predicted magnitude moved by the code's ulps, with its sign.
+  uint32_t word;
+  std::memcpy(&word, codes, sizeof word);
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i code =
+      _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(word)), zero), zero);
+  const __m128i ulps = _mm_sub_epi32(_mm_srli_epi32(code, 3), _mm_set1_epi32(kUlpBias));
+  const __m128i sign =
+      _mm_slli_epi32(_mm_and_si128(_mm_srli_epi32(code, 2), _mm_set1_epi32(1)), 31);
+  __m128 value = _mm_castsi128_ps(
+      _mm_or_si128(_mm_add_epi32(_mm_castps_si128(unit_complement_x4(a, b, c)), ulps), sign));
+  // One register per sample, (a, b, c, value), then the value moved to its place.
+  __m128 rows[4] = {a, b, c, value};
+  _MM_TRANSPOSE4_PS(rows[0], rows[1], rows[2], rows[3]);
+  for (int i = 0; i < 4; ++i) {
+    const int k = codes[i] & 3;
+    const __m128 row = rows[i];
+    const __m128 shifted = _mm_castsi128_ps(_mm_slli_si128(_mm_castps_si128(row), 4));
+    const __m128 left_out = _mm_shuffle_ps(row, row, _MM_SHUFFLE(3, 3, 3, 3));
+    const auto mask = [](const uint32_t* lanes) {
+      return _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(lanes)));
+    };
+    const __m128 placed = _mm_or_ps(_mm_and_ps(mask(kPlacement.below[k]), row),
+                                    _mm_or_ps(_mm_and_ps(mask(kPlacement.at[k]), left_out),
+                                              _mm_and_ps(mask(kPlacement.above[k]), shifted)));
+    _mm_storeu_ps(&out[i].x, placed);
+  }
+}
+#endif
+
 // ---------------------------------------------------------------------------------------------
 // Positions: a column (one joint in one clip) whose value never changes is stored once.
 
-bool constant_column(const std::vector<glm::vec3>& positions, size_t joints, const ClipRange& clip,
+bool constant_column(std::span<const glm::vec3> positions, size_t joints, const ClipRange& clip,
                      size_t joint) {
   const size_t first = static_cast<size_t>(clip.start) * joints + joint;
   for (int f = clip.start + 1; f < clip.end; ++f) {
@@ -769,6 +853,76 @@ Status read_small_sections(std::span<const std::byte> file, const DatabaseFileIn
   return read_rotation_exceptions(file, info, name, plan.exceptions);
 }
 
+// The positions of one clip: its constant columns (one value for the whole clip) and its
+// varying ones (one value per frame, frame by frame, in joint order).
+void decode_positions(const std::byte* constant, const std::byte* varying,
+                      const uint8_t* is_constant, size_t joints, size_t frames, float* out) {
+  if (frames == 0) return;
+  for (size_t j = 0; j < joints; ++j) {
+    const std::byte*& from = is_constant[j] ? constant : varying;
+    std::memcpy(out + 3 * j, from, 12);
+    from += 12;
+  }
+  // Every later frame: the previous one, which has the constants, with the varying ones replaced.
+  for (size_t f = 1; f < frames; ++f) {
+    float* frame = out + 3 * joints * f;
+    std::memcpy(frame, frame - 3 * joints, 12 * joints);
+    for (size_t j = 0; j < joints; ++j) {
+      if (is_constant[j]) continue;
+      std::memcpy(frame + 3 * j, varying, 12);
+      varying += 12;
+    }
+  }
+}
+
+// The rotations of samples [first, first + count), with their exceptions in sample order.
+Status decode_rotations(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                        const LoadPlan& plan, size_t first, size_t count, std::string_view name,
+                        glm::quat* rotations) {
+  const std::byte* components =
+      section_bytes(file, info, DatabaseSection::RotationComponents).data() + 12 * first;
+  const auto* codes = reinterpret_cast<const uint8_t*>(
+      section_bytes(file, info, DatabaseSection::RotationCodes).data() + first);
+  auto exception = std::lower_bound(
+      plan.exceptions.begin(), plan.exceptions.end(), first,
+      [](const RotationException& e, uint64_t sample) { return e.sample < sample; });
+  const auto escape_free = [&](size_t i) {
+    return !is_escape(codes[i]) && !is_escape(codes[i + 1]) && !is_escape(codes[i + 2]) &&
+           !is_escape(codes[i + 3]);
+  };
+  size_t i = 0;
+  while (i < count) {
+#if defined(__SSE2__)
+    if (i + 4 <= count && escape_free(i)) {
+      decode_rotations_x4(components + 12 * i, codes + i, rotations + i);
+      i += 4;
+      continue;
+    }
+#endif
+    const float* exact = nullptr;
+    if (is_escape(codes[i])) {
+      if (exception == plan.exceptions.end() || exception->sample != first + i) {
+        return SectionReader({}, DatabaseSection::RotationExceptions, name)
+            .fail("no exception for the escape code of sample " + std::to_string(first + i) +
+                  " [frame " + std::to_string((first + i) / info.joint_count) + ", joint " +
+                  std::to_string(i % info.joint_count) + "]");
+      }
+      exact = &exception->value;
+      ++exception;
+    }
+    float three[3];
+    std::memcpy(three, components + 12 * i, sizeof three);
+    rotations[i] = decode_rotation(three, codes[i], exact);
+    ++i;
+  }
+  if (exception != plan.exceptions.end() && exception->sample < first + count) {
+    return SectionReader({}, DatabaseSection::RotationExceptions, name)
+        .fail("exception for sample " + std::to_string(exception->sample) +
+              ", whose rotation code is not an escape");
+  }
+  return Status::success();
+}
+
 // Positions, rotations and velocities of one clip, straight into the database's arrays.
 Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info,
                    const LoadPlan& plan, size_t c, std::string_view name, Database& db) {
@@ -778,56 +932,17 @@ Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info
   const size_t first = static_cast<size_t>(clip.start) * joints;
   const size_t count = frames * joints;
 
-  // Positions: constant columns broadcast, varying ones in frame order.
-  const std::byte* constant_bytes =
-      section_bytes(file, info, DatabaseSection::ConstantPositions).data();
-  const std::byte* varying_bytes =
-      section_bytes(file, info, DatabaseSection::VaryingPositions).data();
-  const uint8_t* is_constant = plan.positions.constant.data() + c * joints;
-  const std::byte* constant = constant_bytes + 12 * plan.positions.first_constant[c];
-  const std::byte* varying = varying_bytes + 12 * plan.positions.first_varying[c];
-  // Frame by frame: the constant columns (the same every frame), then the varying ones.
-  float* positions = glm::value_ptr(db.local_positions[first]);
-  for (size_t f = 0; f < frames; ++f, positions += 3 * joints) {
-    const std::byte* next_constant = constant;
-    for (size_t j = 0; j < joints; ++j) {
-      const std::byte*& from = is_constant[j] ? next_constant : varying;
-      std::memcpy(positions + 3 * j, from, 12);
-      from += 12;
-    }
+  decode_positions(section_bytes(file, info, DatabaseSection::ConstantPositions).data() +
+                       12 * plan.positions.first_constant[c],
+                   section_bytes(file, info, DatabaseSection::VaryingPositions).data() +
+                       12 * plan.positions.first_varying[c],
+                   plan.positions.constant.data() + c * joints, joints, frames,
+                   glm::value_ptr(db.local_positions[first]));
+  if (Status s =
+          decode_rotations(file, info, plan, first, count, name, db.local_rotations.data() + first);
+      !s) {
+    return s;
   }
-
-  // Rotations, with this clip's exceptions in sample order.
-  const std::byte* components =
-      section_bytes(file, info, DatabaseSection::RotationComponents).data() + 12 * first;
-  const auto* codes = reinterpret_cast<const uint8_t*>(
-      section_bytes(file, info, DatabaseSection::RotationCodes).data() + first);
-  auto exception = std::lower_bound(
-      plan.exceptions.begin(), plan.exceptions.end(), first,
-      [](const RotationException& e, uint64_t sample) { return e.sample < sample; });
-  glm::quat* rotations = db.local_rotations.data() + first;
-  for (size_t i = 0; i < count; ++i) {
-    float three[3];
-    std::memcpy(three, components + 12 * i, sizeof three);
-    const float* exact = nullptr;
-    if (is_escape(codes[i])) {
-      if (exception == plan.exceptions.end() || exception->sample != first + i) {
-        return SectionReader({}, DatabaseSection::RotationExceptions, name)
-            .fail("no exception for the escape code of sample " + std::to_string(first + i) +
-                  " [frame " + std::to_string((first + i) / joints) + ", joint " +
-                  std::to_string(i % joints) + "]");
-      }
-      exact = &exception->value;
-      ++exception;
-    }
-    rotations[i] = decode_rotation(three, codes[i], exact);
-  }
-  if (exception != plan.exceptions.end() && exception->sample < first + count) {
-    return SectionReader({}, DatabaseSection::RotationExceptions, name)
-        .fail("exception for sample " + std::to_string(exception->sample) +
-              ", whose rotation code is not an escape");
-  }
-
   compute_local_velocities(std::span(db.local_positions).subspan(first, count),
                            std::span(db.local_rotations).subspan(first, count), clip.frame_count(),
                            static_cast<int>(joints), db.frame_time,
@@ -836,55 +951,60 @@ Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info
   return Status::success();
 }
 
-// Phase 2 of a load, on two threads: the checksum, the allocation of the per-frame arrays
-// (fresh memory is faulted in by whoever first writes it, so the arrays are spread over the
-// threads) and the plain copies. Returns the computed checksum.
-uint64_t hash_and_allocate(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                           int threads, Database& db) {
-  const std::span<const std::byte> covered = file.first(file.size() - kChecksumSize);
-  const size_t samples = size_t{info.frame_count} * info.joint_count;
-  uint64_t computed = 0;
-  detail::size_joint_arrays(db, samples, threads, 2, [&](size_t job) {
-    if (job == 0) {
-      computed = database_checksum(covered);
-      return;
-    }
-    copy_array(file, info, DatabaseSection::Features, db.features);
-    copy_array(file, info, DatabaseSection::Contacts, db.contacts);
-    copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
-    copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
-    copy_array(file, info, DatabaseSection::Searchable, db.searchable);
-  });
-  return computed;
-}
+// Phases 2 and 3 of a load, on `threads` threads pulling jobs in order: the checksum, the plain
+// copies (features, contacts, searchable), then decode_clip() of every clip, whose joint values
+// are checked while they are in cache. Decoding does not wait for the checksum: it reads only
+// inside sections whose sizes phase 1 checked, so a damaged file decodes to values that are
+// dropped for the checksum mismatch.
+struct DecodedFile {
+  uint64_t checksum = 0;
+  Status status;                    // the first failing clip's, in clip order
+  bool joint_values_valid = false;  // every decoded value passed detail::joint_values_valid
+};
 
-// Phase 3 of a load, on two threads pulling clips: decode_clip() for every clip. Returns the
-// failure of the first clip that failed.
-// Sets `joint_values_valid` to whether every decoded joint value passed
-// detail::joint_values_valid (checked clip by clip while the values are in cache).
-Status decode_clips(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                    const LoadPlan& plan, std::string_view name, int threads, Database& db,
-                    bool& joint_values_valid) {
+DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                        const LoadPlan& plan, std::string_view name, int threads, Database& db) {
+  // Sized, not written: every value is written once, by the clip that owns it.
+  const size_t samples = size_t{info.frame_count} * info.joint_count;
+  detail::resize_large(db.local_rotations, samples);
+  detail::resize_large(db.local_positions, samples);
+  detail::resize_large(db.local_velocities, samples);
+  detail::resize_large(db.local_angular_velocities, samples);
+
+  DecodedFile out;
+  constexpr size_t kFirstClipJob = 2;
   std::vector<Status> status(db.clips.size());
   std::vector<uint8_t> valid(db.clips.size(), 0);
-  detail::run_workers(db.clips.size(), threads, [&](int, size_t c) {
-    status[c] = decode_clip(file, info, plan, c, name, db);
-    const size_t joints = info.joint_count;
-    valid[c] = status[c] &&
-               detail::joint_values_valid(db, static_cast<size_t>(db.clips[c].start) * joints,
-                                          static_cast<size_t>(db.clips[c].frame_count()) * joints);
+  detail::run_workers(kFirstClipJob + db.clips.size(), threads, [&](int, size_t job) {
+    if (job == 0) {
+      out.checksum = database_checksum(file.first(file.size() - kChecksumSize));
+    } else if (job == 1) {
+      copy_array(file, info, DatabaseSection::Features, db.features);
+      copy_array(file, info, DatabaseSection::Contacts, db.contacts);
+      copy_array(file, info, DatabaseSection::FeatureOffset, db.feature_offset);
+      copy_array(file, info, DatabaseSection::FeatureScale, db.feature_scale);
+      copy_array(file, info, DatabaseSection::Searchable, db.searchable);
+    } else {
+      const size_t c = job - kFirstClipJob;
+      status[c] = decode_clip(file, info, plan, c, name, db);
+      const size_t joints = info.joint_count;
+      valid[c] = status[c] && detail::joint_values_valid(
+                                  db, static_cast<size_t>(db.clips[c].start) * joints,
+                                  static_cast<size_t>(db.clips[c].frame_count()) * joints);
+    }
   });
-  joint_values_valid = std::all_of(valid.begin(), valid.end(), [](uint8_t v) { return v != 0; });
-  for (const Status& s : status) {
-    if (!s) return s;
-  }
+  out.joint_values_valid =
+      std::all_of(valid.begin(), valid.end(), [](uint8_t v) { return v != 0; });
+  const auto failed =
+      std::find_if(status.begin(), status.end(), [](const Status& s) { return !s; });
+  if (failed != status.end()) out.status = *failed;
   // frame_clip is derived, not stored (the clips tile the frames: checked before decoding).
   detail::resize_large(db.frame_clip, info.frame_count);
   for (size_t c = 0; c < db.clips.size(); ++c) {
     std::fill(db.frame_clip.begin() + db.clips[c].start, db.frame_clip.begin() + db.clips[c].end,
               static_cast<int>(c));
   }
-  return Status::success();
+  return out;
 }
 
 // Files at least this large are loaded on two threads.
@@ -1177,7 +1297,6 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
   Database db;
   LoadPlan plan;
   Status phase1;
-  bool joint_values_valid = false;
   Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
   try {
     phase1 = header ? read_small_sections(bytes, *header, name, db, plan) : Error{header.message()};
@@ -1191,20 +1310,17 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
     return Error{phase1.message()};
   }
 
+  DecodedFile decoded;
   try {
-    if (const uint64_t computed = hash_and_allocate(bytes, *header, threads, db);
-        computed != stored) {
-      return checksum_error(computed);
-    }
-    if (Status s = decode_clips(bytes, *header, plan, name, threads, db, joint_values_valid); !s) {
-      return Error{s.message()};
-    }
+    decoded = decode_file(bytes, *header, plan, name, threads, db);
   } catch (const std::exception& e) {
     return Error{name + ": cannot load: " + e.what()};
   }
+  if (decoded.checksum != stored) return checksum_error(decoded.checksum);
+  if (!decoded.status) return Error{decoded.status.message()};
   // A bad joint value is reported by the full validation, which names the first one.
   const Status valid =
-      joint_values_valid ? detail::validate_except_joint_values(db) : db.validate();
+      decoded.joint_values_valid ? detail::validate_except_joint_values(db) : db.validate();
   if (!valid) return Error{name + ": " + valid.message()};
   return db;
 }

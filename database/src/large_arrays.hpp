@@ -21,6 +21,20 @@ void resize_large(std::vector<T>& v, size_t n) {
   v.resize(n);
 }
 
+// The same for a per-frame array, whose new elements are left for the caller to write (every
+// one of them): the first write then also faults the fresh memory in, while it is in cache.
+template <class T>
+void resize_large(FrameArray<T>& v, size_t n) {
+  v.clear();
+  v.reserve(n);
+  advise_huge_pages(v.data(), n * sizeof(T));
+  struct Skip {
+    Skip() { skip_value_initialization = true; }
+    ~Skip() { skip_value_initialization = false; }
+  } skip;
+  v.resize(n);
+}
+
 // On up to `threads` threads: `job(k)` for k in [0, jobs) (started first), and the four
 // per-frame joint arrays of `db` sized to `samples` values each.
 template <class Job>

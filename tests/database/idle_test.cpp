@@ -71,7 +71,7 @@ Database hand_made_database() {
     }
     db.contacts.insert(db.contacts.end(), {1, 1});
   }
-  auto at = [&](std::vector<glm::vec3>& v, int f, int j) -> glm::vec3& {
+  auto at = [&](FrameArray<glm::vec3>& v, int f, int j) -> glm::vec3& {
     return v[static_cast<size_t>(f) * kJoints + j];
   };
   at(db.local_angular_velocities, 0, kHead) = {1.0f, 0.0f, 0.0f};

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -29,6 +31,39 @@ struct ClipRange {
   int frame_count() const { return end - start; }
 };
 
+namespace detail {
+// Set only while the builder or the loader sizes arrays it is about to fill completely
+// (detail::resize_large): value-initializing ~200 MB first would write every byte twice.
+inline thread_local bool skip_value_initialization = false;
+}  // namespace detail
+
+// std::allocator, except that while detail::skip_value_initialization is set, a value-initialized
+// element (resize(n), vector(n)) is left unwritten. Every other use behaves as std::allocator.
+template <class T>
+struct FrameAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = FrameAllocator<U>;
+  };
+  FrameAllocator() = default;
+  template <class U>
+  FrameAllocator(const FrameAllocator<U>&) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    // GLM's vectors and quaternions are plain floats (with GLM_FORCE_CTOR_INIT their
+    // constructors only zero them, so they do not count as trivially copyable).
+    if constexpr (sizeof...(Args) == 0 && std::is_standard_layout_v<U> &&
+                  std::is_trivially_destructible_v<U>) {
+      if (detail::skip_value_initialization) return;
+    }
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// The per-frame arrays of the database: a std::vector with that allocator.
+template <class T>
+using FrameArray = std::vector<T, FrameAllocator<T>>;
+
 struct Database {
   // Joint 0 is the simulation root (hips projected on the ground, smoothed facing); the source
   // skeleton's joints follow it, depth-first. Rest transforms are the first clip's.
@@ -39,10 +74,10 @@ struct Database {
 
   // Per-frame, per-joint arrays, frame-major: [frame * joint_count + joint]. Local to the
   // parent; joint 0's values are relative to the world (its clip's origin).
-  std::vector<glm::vec3> local_positions;           // metres
-  std::vector<glm::quat> local_rotations;           // unit
-  std::vector<glm::vec3> local_velocities;          // metres / second, in the parent's frame
-  std::vector<glm::vec3> local_angular_velocities;  // radians / second, in the parent's frame
+  FrameArray<glm::vec3> local_positions;           // metres
+  FrameArray<glm::quat> local_rotations;           // unit
+  FrameArray<glm::vec3> local_velocities;          // metres / second, in the parent's frame
+  FrameArray<glm::vec3> local_angular_velocities;  // radians / second, in the parent's frame
   // Per-frame foot contacts: [frame * 2 + 0] left, [frame * 2 + 1] right; 1 = in contact.
   std::vector<uint8_t> contacts;
 
