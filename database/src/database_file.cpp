@@ -89,8 +89,8 @@ class ByteWriter {
     pod(static_cast<uint32_t>(s.size()));
     raw(s.data(), s.size());
   }
-  template <class T>
-  void array(const std::vector<T>& values) {
+  template <class T, class Allocator>
+  void array(const std::vector<T, Allocator>& values) {
     if (values.empty()) return;
     if constexpr (std::is_trivially_copyable_v<T>) {
       raw(values.data(), values.size() * sizeof(T));
@@ -657,9 +657,9 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
 }
 
 // Copies a fixed-size section whose length parse_header() already matched to the counts.
-template <class T>
+template <class T, class Allocator>
 void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
-                std::vector<T>& out) {
+                std::vector<T, Allocator>& out) {
   static_assert(std::is_trivially_copyable_v<T>);
   const std::span<const std::byte> bytes = section_bytes(file, info, s);
   detail::resize_large(out, bytes.size() / sizeof(T));

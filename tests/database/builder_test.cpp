@@ -267,7 +267,7 @@ TEST(BuilderRealClips, MirroredBuildDoublesTheClipsAndMirrorsTheFeatures) {
   EXPECT_FALSE(has_tag(*db, db->clips[0], "mirrored"));
 
   // Raw features of a mirrored frame: left and right feet swap, x flips; trajectory x flips.
-  std::vector<float> raw = db->features;
+  FrameArray<float> raw = db->features;
   denormalize_features(raw, db->feature_offset, db->feature_scale);
   const ClipRange& a = db->clips[0];
   const ClipRange& m = db->clips[1];
@@ -541,7 +541,7 @@ TEST(BuilderOptions, GltfInputBuildsLikeTheBvhItCameFrom) {
   ASSERT_EQ(a->joint_count(), b->joint_count());
   EXPECT_EQ(a->skeleton.names(), b->skeleton.names());
   ASSERT_EQ(a->features.size(), b->features.size());
-  std::vector<float> raw_a = a->features, raw_b = b->features;
+  FrameArray<float> raw_a = a->features, raw_b = b->features;
   denormalize_features(raw_a, a->feature_offset, a->feature_scale);
   denormalize_features(raw_b, b->feature_offset, b->feature_scale);
   for (size_t i = 0; i < raw_a.size(); ++i) ASSERT_NEAR(raw_a[i], raw_b[i], 1e-3f) << i;

@@ -274,6 +274,25 @@ TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
       << message;
 }
 
+TEST(DatabaseFile, PerFrameArraysStillValueInitializeOutsideTheLoader) {
+  // The loader sizes the per-frame arrays without zero-filling them (it writes every value);
+  // after a load, growing one of them, or refilling one that held values, gives value-initialized
+  // elements as a std::vector does (zeros, and the identity for GLM's quaternions).
+  Result<Database> loaded = deserialize_database(serialize_database(make_database(300, 7)), "db");
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  FrameArray<glm::vec3>& positions = loaded->local_positions;
+  const size_t size = positions.size();
+  positions.resize(size + 5);
+  for (size_t i = size; i < size + 5; ++i) EXPECT_EQ(positions[i], glm::vec3(0.0f)) << i;
+  FrameArray<glm::quat> rotations;
+  rotations.assign(64, glm::quat(0.5f, 0.5f, 0.5f, 0.5f));
+  rotations.clear();
+  rotations.resize(64);  // the same block, which still holds the old values
+  for (const glm::quat& q : rotations) EXPECT_EQ(q, glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+  FrameArray<float> features(16);
+  for (const float f : features) EXPECT_EQ(f, 0.0f);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Damaged files.
 

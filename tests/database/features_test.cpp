@@ -429,7 +429,7 @@ TEST(FeatureExtraction, DatabaseFeaturesNeverReadAcrossClips) {
   int searchable = 0;
   for (uint8_t s : db.searchable) searchable += s;
   EXPECT_EQ(searchable, (n0 - 30) + (n1 - 30));
-  std::vector<float> raw = db.features;
+  FrameArray<float> raw = db.features;
   denormalize_features(raw, db.feature_offset, db.feature_scale);
   const int dims = 27;
   // Frame n0 - 5 of clip 0: 4 frames left, every future time clamps to 4 frames of motion.

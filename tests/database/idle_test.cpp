@@ -303,7 +303,7 @@ TEST(IdleBuild, FeaturesStandStillAndTheFramesAreSearchable) {
     EXPECT_EQ(db.searchable[f], f < idle.end - 30 ? 1 : 0) << f;
   }
   const size_t dims = static_cast<size_t>(db.feature_dims());
-  std::vector<float> raw = db.features;
+  FrameArray<float> raw = db.features;
   denormalize_features(raw, db.feature_offset, db.feature_scale);
   const int source = reported_source_frame(db, b.report);
   const float* held = raw.data() + static_cast<size_t>(source) * dims;

@@ -88,7 +88,7 @@ struct Database {
   // features[f * dims + c] = (raw - feature_offset[c]) / feature_scale[c]. The plain squared
   // Euclidean distance between rows is the weighted distance the search minimizes.
   FeatureSchema schema;
-  std::vector<float> features;
+  FrameArray<float> features;
   std::vector<float> feature_offset;  // dims: per-column mean
   std::vector<float> feature_scale;   // dims: group standard deviation / weight (never 0)
   // 1 when the frame may be matched: every feature time of the frame lies inside its clip.
