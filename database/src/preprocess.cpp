@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 
 #if defined(__SSE2__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -138,11 +139,42 @@ template <class V>
   return bits;
 }
 
+// Four vec3 from the lanes of x, y and z: rows of a transpose stored 16 bytes at a time, each
+// one's spare float overwritten by the next row, the last row 12 bytes.
+inline void store_vec3_x4(Floats4 x, Floats4 y, Floats4 z, glm::vec3* out) {
+  __m128 r0 = x, r1 = y, r2 = z, r3 = _mm_setzero_ps();
+  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+  _mm_storeu_ps(&out[0].x, r0);
+  _mm_storeu_ps(&out[1].x, r1);
+  _mm_storeu_ps(&out[2].x, r2);
+  alignas(16) float last[4];
+  _mm_store_ps(last, r3);
+  std::memcpy(&out[3].x, last, sizeof(glm::vec3));
+}
+
+inline void store_vec3(const QuatLanes<Floats4>& v, glm::vec3* out) {
+  store_vec3_x4(v.x, v.y, v.z, out);
+}
+
+inline void store_vec3(const QuatLanes<Floats8>& v, glm::vec3* out) {
+  const auto low = [](Floats8 f) { return Floats4(__builtin_shufflevector(f, f, 0, 1, 2, 3)); };
+  const auto high = [](Floats8 f) { return Floats4(__builtin_shufflevector(f, f, 4, 5, 6, 7)); };
+  store_vec3_x4(low(v.x), low(v.y), low(v.z), out);
+  store_vec3_x4(high(v.x), high(v.y), high(v.z), out + 4);
+}
+
+// The rates into out: all lanes at once when the series covered them all (the common case),
+// else lane by lane with the scalar path for the others.
 template <class V>
 [[gnu::always_inline]] inline void store_rates(const QuatLanes<V>& rate, unsigned series,
                                                const glm::quat* from, const glm::quat* to,
                                                float inv_dt, glm::vec3* out) {
-  for (size_t lane = 0; lane < sizeof(V) / sizeof(float); ++lane) {
+  constexpr size_t kLanes = sizeof(V) / sizeof(float);
+  if (series == (1u << kLanes) - 1) {
+    store_vec3(rate, out);
+    return;
+  }
+  for (size_t lane = 0; lane < kLanes; ++lane) {
     out[lane] = (series >> lane & 1) != 0 ? glm::vec3(rate.x[lane], rate.y[lane], rate.z[lane])
                                           : angular_velocity_between(from[lane], to[lane], inv_dt);
   }
@@ -156,10 +188,17 @@ QuatLanes<Floats4> load_quats_x4(const glm::quat* q) {
   return {x, y, z, w};
 }
 
-void angular_velocity_x4(const glm::quat* from, const glm::quat* to, float inv_dt, glm::vec3* out) {
-  QuatLanes<Floats4> rate;
-  const unsigned series = series_rates(load_quats_x4(from), load_quats_x4(to), inv_dt, rate);
-  store_rates(rate, series, from, to, inv_dt, out);
+// angular_velocity_between for samples [0, count) four at a time; returns how many it did.
+size_t angular_velocities_x4(const glm::quat* from, const glm::quat* to, size_t count, float inv_dt,
+                             glm::vec3* out) {
+  size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    QuatLanes<Floats4> rate;
+    const unsigned series =
+        series_rates(load_quats_x4(from + i), load_quats_x4(to + i), inv_dt, rate);
+    store_rates(rate, series, from + i, to + i, inv_dt, out + i);
+  }
+  return i;
 }
 
 // Two quaternions in the two halves of one vector.
@@ -180,11 +219,18 @@ __attribute__((target("avx"))) QuatLanes<Floats8> load_quats_x8(const glm::quat*
           _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2))};
 }
 
-__attribute__((target("avx"))) void angular_velocity_x8(const glm::quat* from, const glm::quat* to,
-                                                        float inv_dt, glm::vec3* out) {
-  QuatLanes<Floats8> rate;
-  const unsigned series = series_rates(load_quats_x8(from), load_quats_x8(to), inv_dt, rate);
-  store_rates(rate, series, from, to, inv_dt, out);
+// The same eight at a time, with AVX.
+__attribute__((target("avx"))) size_t angular_velocities_x8(const glm::quat* from,
+                                                            const glm::quat* to, size_t count,
+                                                            float inv_dt, glm::vec3* out) {
+  size_t i = 0;
+  for (; i + 8 <= count; i += 8) {
+    QuatLanes<Floats8> rate;
+    const unsigned series =
+        series_rates(load_quats_x8(from + i), load_quats_x8(to + i), inv_dt, rate);
+    store_rates(rate, series, from + i, to + i, inv_dt, out + i);
+  }
+  return i;
 }
 
 bool avx_supported() {
@@ -214,16 +260,12 @@ struct FrameDifferences {
 
     size_t i = first;
 #if defined(__SSE2__) && defined(__GNUC__)
-    if (avx_supported()) {
-      for (; i + 8 <= first + count; i += 8) {
-        angular_velocity_x8(&rotations[i - back], &rotations[i + ahead], inv_dt,
-                            &angular_velocities[i]);
-      }
-    }
-    for (; i + 4 <= first + count; i += 4) {
-      angular_velocity_x4(&rotations[i - back], &rotations[i + ahead], inv_dt,
-                          &angular_velocities[i]);
-    }
+    const auto run = [&](auto kernel) {
+      i += kernel(&rotations[i - back], &rotations[i + ahead], first + count - i, inv_dt,
+                  &angular_velocities[i]);
+    };
+    if (avx_supported()) run(angular_velocities_x8);
+    run(angular_velocities_x4);
 #endif
     for (; i < first + count; ++i) {
       angular_velocities[i] =
