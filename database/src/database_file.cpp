@@ -66,6 +66,9 @@ inline uint64_t avalanche(uint64_t h) {
   return h;
 }
 
+// Files (and rotation sections) at least this large are loaded (and written) on two threads.
+constexpr size_t kParallelBytes = size_t{8} << 20;
+
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
@@ -101,6 +104,12 @@ class ByteWriter {
     }
   }
   void zeros(size_t count) { bytes_.insert(bytes_.end(), count, std::byte{0}); }
+  // Appends `count` bytes for the caller to fill; returns their offset.
+  size_t extend(size_t count) {
+    const size_t offset = bytes_.size();
+    bytes_.resize(offset + count);
+    return offset;
+  }
   void align16() { zeros((16 - bytes_.size() % 16) % 16); }
 
   size_t size() const { return bytes_.size(); }
@@ -169,14 +178,18 @@ struct EncodedRotation {
 
 EncodedRotation encode_rotation(const glm::quat& q) {
   const float c[4] = {q.x, q.y, q.z, q.w};
+  // The first of the largest magnitudes, without branches (the index is data, not a pattern).
   int largest = 0;
+  float best = std::abs(c[0]);
   for (int k = 1; k < 4; ++k) {
-    if (std::abs(c[k]) > std::abs(c[largest])) largest = k;
+    const float magnitude = std::abs(c[k]);
+    const bool larger = magnitude > best;
+    largest = larger ? k : largest;
+    best = larger ? magnitude : best;
   }
+  constexpr int kOthers[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
   EncodedRotation out{};
-  for (int k = 0, n = 0; k < 4; ++k) {
-    if (k != largest) out.components[n++] = c[k];
-  }
+  for (int n = 0; n < 3; ++n) out.components[n] = c[kOthers[largest][n]];
   const uint32_t bits = std::bit_cast<uint32_t>(c[largest]);
   const uint32_t sign = bits >> 31;
   const uint32_t magnitude = bits & 0x7FFFFFFFu;
@@ -302,16 +315,18 @@ void decode_rotations_x4(const std::byte* components, const uint8_t* codes, glm:
 // ---------------------------------------------------------------------------------------------
 // Positions: a column (one joint in one clip) whose value never changes is stored once.
 
-bool constant_column(std::span<const glm::vec3> positions, size_t joints, const ClipRange& clip,
-                     size_t joint) {
-  const size_t first = static_cast<size_t>(clip.start) * joints + joint;
+// flags[j] = 1 when joint j's local position has the same bits on every frame of the clip
+// (read frame by frame, in memory order).
+void find_constant_columns(std::span<const glm::vec3> positions, size_t joints,
+                           const ClipRange& clip, uint8_t* flags) {
+  std::fill(flags, flags + joints, uint8_t{1});
+  const glm::vec3* first = positions.data() + static_cast<size_t>(clip.start) * joints;
   for (int f = clip.start + 1; f < clip.end; ++f) {
-    if (std::memcmp(&positions[static_cast<size_t>(f) * joints + joint], &positions[first],
-                    sizeof(glm::vec3)) != 0) {
-      return false;
+    const glm::vec3* frame = positions.data() + static_cast<size_t>(f) * joints;
+    for (size_t j = 0; j < joints; ++j) {
+      flags[j] &= static_cast<uint8_t>(std::memcmp(&frame[j], &first[j], sizeof(glm::vec3)) == 0);
     }
   }
-  return true;
 }
 
 // Where each clip's positions lie in the two position sections, in values.
@@ -344,9 +359,8 @@ PositionLayout position_layout_of(const Database& db) {
   PositionLayout layout;
   layout.constant.resize(db.clips.size() * joints);
   for (size_t c = 0; c < db.clips.size(); ++c) {
-    for (size_t j = 0; j < joints; ++j) {
-      layout.constant[c * joints + j] = constant_column(db.local_positions, joints, db.clips[c], j);
-    }
+    find_constant_columns(db.local_positions, joints, db.clips[c],
+                          layout.constant.data() + c * joints);
   }
   lay_out_positions(db.clips, joints, layout);
   return layout;
@@ -1007,9 +1021,6 @@ DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo&
   return out;
 }
 
-// Files at least this large are loaded on two threads.
-constexpr size_t kParallelHashBytes = size_t{8} << 20;
-
 std::string errno_text(int error) {
   return std::generic_category().message(error);
 }
@@ -1137,45 +1148,66 @@ void write_clips(ByteWriter& w, const std::vector<ClipRange>& clips) {
 void write_positions(ByteWriter& w, const Database& db, const PositionLayout& layout,
                      bool constant) {
   const size_t joints = static_cast<size_t>(db.joint_count());
+  const size_t offset = w.extend(12 * (constant ? layout.constant_count : layout.varying_count));
+  std::byte* out = w.bytes().data() + offset;
   for (size_t c = 0; c < db.clips.size(); ++c) {
     const ClipRange& clip = db.clips[c];
     const uint8_t* flags = layout.constant.data() + c * joints;
     const int last = constant ? clip.start + 1 : clip.end;  // a constant column once
     for (int f = clip.start; f < last; ++f) {
+      const glm::vec3* frame = db.local_positions.data() + static_cast<size_t>(f) * joints;
       for (size_t j = 0; j < joints; ++j) {
-        if (flags[j] == (constant ? 1 : 0)) {
-          w.raw(glm::value_ptr(db.local_positions[static_cast<size_t>(f) * joints + j]), 12);
-        }
+        if (flags[j] != (constant ? 1 : 0)) continue;
+        std::memcpy(out, glm::value_ptr(frame[j]), 12);
+        out += 12;
       }
     }
   }
 }
 
 // The three rotation sections: components and codes sample by sample, then the exceptions.
+// Rotations [begin, end) into their 12 bytes of components and their code byte, the escapes'
+// exact values appended to `exceptions` in sample order.
+void encode_rotations(std::span<const glm::quat> rotations, size_t begin, size_t end,
+                      std::byte* components, std::byte* codes,
+                      std::vector<RotationException>& exceptions) {
+  for (size_t i = begin; i < end; ++i) {
+    const EncodedRotation e = encode_rotation(rotations[i]);
+    std::memcpy(components + 12 * i, e.components, sizeof e.components);
+    codes[i] = std::byte{e.code};
+    if (is_escape(e.code)) exceptions.push_back({i, e.exact});
+  }
+}
+
 void write_rotations(ByteWriter& w, const Database& db,
                      std::array<DatabaseFileSection, kDatabaseSectionCount>& table) {
   const size_t samples = db.local_rotations.size();
-  std::vector<uint8_t> codes(samples);
-  std::vector<RotationException> exceptions;
   w.align16();
-  const size_t start = w.size();
-  for (size_t i = 0; i < samples; ++i) {
-    const EncodedRotation e = encode_rotation(db.local_rotations[i]);
-    w.raw(e.components, sizeof e.components);
-    codes[i] = e.code;
-    if (is_escape(e.code)) exceptions.push_back({i, e.exact});
-  }
-  table[static_cast<size_t>(DatabaseSection::RotationComponents)] = {start, w.size() - start};
+  const size_t components = w.extend(12 * samples);
   w.align16();
-  table[static_cast<size_t>(DatabaseSection::RotationCodes)] = {w.size(), codes.size()};
-  w.array(codes);
+  const size_t codes = w.extend(samples);
+  table[static_cast<size_t>(DatabaseSection::RotationComponents)] = {components, 12 * samples};
+  table[static_cast<size_t>(DatabaseSection::RotationCodes)] = {codes, samples};
+  // In chunks on two threads for a large database, each chunk's exceptions kept apart and then
+  // joined in chunk order, so they stay in sample order.
+  const size_t chunks = samples * 16 >= kParallelBytes ? 8 : 1;
+  std::vector<std::vector<RotationException>> exceptions(chunks);
+  std::byte* bytes = w.bytes().data();
+  detail::run_workers(chunks, chunks > 1 ? 2 : 1, [&](int, size_t chunk) {
+    encode_rotations(db.local_rotations, samples * chunk / chunks, samples * (chunk + 1) / chunks,
+                     bytes + components, bytes + codes, exceptions[chunk]);
+  });
   w.align16();
+  size_t count = 0;
+  for (const auto& list : exceptions) count += list.size();
   table[static_cast<size_t>(DatabaseSection::RotationExceptions)] = {
-      w.size(), exceptions.size() * kRotationExceptionBytes};
-  for (const RotationException& e : exceptions) {
-    w.pod(e.sample);
-    w.pod(e.value);
-    w.zeros(4);
+      w.size(), count * kRotationExceptionBytes};
+  for (const auto& list : exceptions) {
+    for (const RotationException& e : list) {
+      w.pod(e.sample);
+      w.pod(e.value);
+      w.zeros(4);
+    }
   }
 }
 
@@ -1292,7 +1324,7 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
     return Error{name + ": checksum mismatch (stored " + hex(stored) + ", computed " +
                  hex(computed) + "): the file was changed or damaged after it was written"};
   };
-  const int threads = bytes.size() >= kParallelHashBytes ? 2 : 1;
+  const int threads = bytes.size() >= kParallelBytes ? 2 : 1;
 
   Database db;
   LoadPlan plan;
