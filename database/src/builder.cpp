@@ -389,29 +389,21 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
   return assign_tags(db, state.clip_tag_lists);
 }
 
-// Phase 2d: the database arrays, allocated in parallel (large_arrays.hpp).
+// Phase 2d: the database arrays, sized. The per-frame ones are left unwritten (large_arrays.hpp):
+// processing writes every value of every clip.
 void allocate_arrays(BuildState& state) {
   Database& db = state.db;
   const size_t frames = state.total_frames;
   const size_t values = frames * static_cast<size_t>(db.joint_count());
-  const size_t dims = static_cast<size_t>(state.context.dims);
   db.frame_count = static_cast<int>(frames);
-  detail::size_joint_arrays(db, values, state.threads, 4, [&](size_t array) {
-    switch (array) {
-      case 0:
-        detail::resize_large(db.features, frames * dims);
-        break;
-      case 1:
-        detail::resize_large(db.frame_clip, frames);
-        break;
-      case 2:
-        detail::resize_large(db.contacts, frames * 2);
-        break;
-      default:
-        detail::resize_large(db.searchable, frames);
-        break;
-    }
-  });
+  detail::resize_large(db.local_positions, values);
+  detail::resize_large(db.local_rotations, values);
+  detail::resize_large(db.local_velocities, values);
+  detail::resize_large(db.local_angular_velocities, values);
+  detail::resize_large(db.features, frames * static_cast<size_t>(state.context.dims));
+  detail::resize_large(db.frame_clip, frames);
+  detail::resize_large(db.contacts, frames * 2);
+  detail::resize_large(db.searchable, frames);
   for (size_t r = 0; r < db.clips.size(); ++r) {
     std::fill(db.frame_clip.begin() + db.clips[r].start, db.frame_clip.begin() + db.clips[r].end,
               static_cast<int>(r));
