@@ -965,7 +965,7 @@ Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info
   return Status::success();
 }
 
-// Phases 2 and 3 of a load, on `threads` threads pulling jobs in order: the checksum, the plain
+// Phase 2 of a load, on `threads` threads pulling jobs in order: the checksum, the plain
 // copies (features, contacts, searchable), then decode_clip() of every clip, whose joint values
 // are checked while they are in cache. Decoding does not wait for the checksum: it reads only
 // inside sections whose sizes phase 1 checked, so a damaged file decodes to values that are
@@ -1308,10 +1308,10 @@ Result<DatabaseFileInfo> parse_database_header(std::span<const std::byte> bytes,
 }
 
 // Phases: 1. identity, header and the small sections (schema, skeleton, clips, tags, the layout
-// of the position and rotation sections); 2. checksum, allocation and plain copies; 3. the
-// clips' positions, rotations and velocities; 4. Database::validate(). A checksum mismatch is
-// reported in preference to anything phase 1 found; phases 2 and 3 read only what phase 1
-// checked, and phase 3 runs only on a file whose checksum matched.
+// of the position and rotation sections); 2. on two threads, the checksum, the plain copies and
+// the clips' positions, rotations and velocities (decode_file); 3. Database::validate(). A
+// checksum mismatch is reported in preference to anything else; phase 2 reads only what phase 1
+// checked.
 Result<Database> deserialize_database(std::span<const std::byte> bytes,
                                       std::string_view name_for_messages) {
   const std::string name(name_for_messages);
