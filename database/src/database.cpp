@@ -30,16 +30,12 @@ constexpr size_t kParallelThreshold = size_t{1} << 20;
 constexpr float kMinUnitNormSquared = (1.0f - 1e-3f) * (1.0f - 1e-3f);
 constexpr float kMaxUnitNormSquared = (1.0f + 1e-3f) * (1.0f + 1e-3f);
 
-bool is_finite_bits(float v) {
-  return (std::bit_cast<uint32_t>(v) & 0x7f800000u) != 0x7f800000u;
-}
-
 size_t first_non_finite_serial(const float* values, size_t begin, size_t end) {
   for (size_t block = begin; block < end; block += kBlock) {
     const size_t block_end = std::min(end, block + kBlock);
     uint32_t bad = 0;
     for (size_t i = block; i < block_end; ++i)
-      bad |= static_cast<uint32_t>(!is_finite_bits(values[i]));
+      bad |= static_cast<uint32_t>(!detail::finite_bits(values[i]));
     if (bad != 0) {
       for (size_t i = block; i < block_end; ++i) {
         if (!std::isfinite(values[i])) return i;
@@ -436,19 +432,8 @@ Status validate_except_joint_values(const Database& db) {
   return Status::success();
 }
 
-bool joint_values_valid(const Database& db, size_t first, size_t count) {
-  if (count == 0) return true;
-  const size_t end = first + count;
-  if (first_non_unit_serial(glm::value_ptr(db.local_rotations[0]), first, end) != kNotFound) {
-    return false;
-  }
-  for (const FrameArray<glm::vec3>* array :
-       {&db.local_positions, &db.local_velocities, &db.local_angular_velocities}) {
-    if (first_non_finite_serial(glm::value_ptr((*array)[0]), 3 * first, 3 * end) != kNotFound) {
-      return false;
-    }
-  }
-  return true;
+bool rotations_unit(const glm::quat* rotations, size_t count) {
+  return count == 0 || first_non_unit_serial(glm::value_ptr(rotations[0]), 0, count) == kNotFound;
 }
 
 }  // namespace detail

@@ -16,12 +16,12 @@
 #include <type_traits>
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
-#include <xmmintrin.h>
+#include <immintrin.h>
 #endif
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "cpu_features.hpp"
 #include "large_arrays.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/preprocess.hpp"
@@ -253,6 +253,37 @@ constexpr PlacementMasks make_placement_masks() {
 }
 constexpr PlacementMasks kPlacement = make_placement_masks();
 
+// The same placement as a permutation of (a, b, c, value), for AVX's variable permute.
+alignas(16) constexpr int32_t kPlacementOrder[4][4] = {
+    {3, 0, 1, 2}, {0, 3, 1, 2}, {0, 1, 3, 2}, {0, 1, 2, 3}};
+
+// Twelve floats a0 b0 c0 a1 | b1 c1 a2 b2 | c2 a3 b3 c3 into one register per component.
+[[gnu::always_inline]] inline void load_components_x4(const std::byte* components, __m128& a,
+                                                      __m128& b, __m128& c) {
+  const auto load = [&](int k) {
+    return _mm_loadu_ps(reinterpret_cast<const float*>(components + 16 * k));
+  };
+  const __m128 m0 = load(0), m1 = load(1), m2 = load(2);
+  a = _mm_shuffle_ps(m0, _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
+  b = _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(0, 0, 1, 1)),
+                     _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(2, 2, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+  c = _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(1, 1, 2, 2)), m2, _MM_SHUFFLE(3, 0, 2, 0));
+}
+
+// The left-out components of four samples: each predicted magnitude moved by its code's ulps,
+// with its sign.
+[[gnu::always_inline]] inline __m128 left_out_x4(__m128 predicted, const uint8_t* codes) {
+  uint32_t word;
+  std::memcpy(&word, codes, sizeof word);
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i code =
+      _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(word)), zero), zero);
+  const __m128i ulps = _mm_sub_epi32(_mm_srli_epi32(code, 3), _mm_set1_epi32(kUlpBias));
+  const __m128i sign =
+      _mm_slli_epi32(_mm_and_si128(_mm_srli_epi32(code, 2), _mm_set1_epi32(1)), 31);
+  return _mm_castsi128_ps(_mm_or_si128(_mm_add_epi32(_mm_castps_si128(predicted), ulps), sign));
+}
+
 // unit_complement of four samples: the same double-precision sums in the same order, and sqrtpd
 // rounds correctly like std::sqrt, so the bits are the scalar ones.
 __m128 unit_complement_x4(__m128 a, __m128 b, __m128 c) {
@@ -270,31 +301,10 @@ __m128 unit_complement_x4(__m128 a, __m128 b, __m128 c) {
 
 // decode_rotation of four consecutive samples, none of them an escape, in SSE2.
 void decode_rotations_x4(const std::byte* components, const uint8_t* codes, glm::quat* out) {
-  // Twelve floats a0 b0 c0 a1 | b1 c1 a2 b2 | c2 a3 b3 c3 into one register per component.
-  const auto load = [&](int k) {
-    return _mm_loadu_ps(reinterpret_cast<const float*>(components + 16 * k));
-  };
-  const __m128 m0 = load(0), m1 = load(1), m2 = load(2);
-  const __m128 a =
-      _mm_shuffle_ps(m0, _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
-  const __m128 b =
-      _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(0, 0, 1, 1)),
-                     _mm_shuffle_ps(m1, m2, _MM_SHUFFLE(2, 2, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
-  const __m128 c =
-      _mm_shuffle_ps(_mm_shuffle_ps(m0, m1, _MM_SHUFFLE(1, 1, 2, 2)), m2, _MM_SHUFFLE(3, 0, 2, 0));
-  // The left-out component: the predicted magnitude moved by the code's ulps, with its sign.
-  uint32_t word;
-  std::memcpy(&word, codes, sizeof word);
-  const __m128i zero = _mm_setzero_si128();
-  const __m128i code =
-      _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(word)), zero), zero);
-  const __m128i ulps = _mm_sub_epi32(_mm_srli_epi32(code, 3), _mm_set1_epi32(kUlpBias));
-  const __m128i sign =
-      _mm_slli_epi32(_mm_and_si128(_mm_srli_epi32(code, 2), _mm_set1_epi32(1)), 31);
-  __m128 value = _mm_castsi128_ps(
-      _mm_or_si128(_mm_add_epi32(_mm_castps_si128(unit_complement_x4(a, b, c)), ulps), sign));
+  __m128 a, b, c;
+  load_components_x4(components, a, b, c);
   // One register per sample, (a, b, c, value), then the value moved to its place.
-  __m128 rows[4] = {a, b, c, value};
+  __m128 rows[4] = {a, b, c, left_out_x4(unit_complement_x4(a, b, c), codes)};
   _MM_TRANSPOSE4_PS(rows[0], rows[1], rows[2], rows[3]);
   for (int i = 0; i < 4; ++i) {
     const int k = codes[i] & 3;
@@ -308,6 +318,25 @@ void decode_rotations_x4(const std::byte* components, const uint8_t* codes, glm:
                                     _mm_or_ps(_mm_and_ps(mask(kPlacement.at[k]), left_out),
                                               _mm_and_ps(mask(kPlacement.above[k]), shifted)));
     _mm_storeu_ps(&out[i].x, placed);
+  }
+}
+
+// The same with AVX: the four square roots in one instruction and the placement by permute.
+__attribute__((target("avx"))) void decode_rotations_x4_avx(const std::byte* components,
+                                                            const uint8_t* codes, glm::quat* out) {
+  __m128 a, b, c;
+  load_components_x4(components, a, b, c);
+  const __m256d ad = _mm256_cvtps_pd(a), bd = _mm256_cvtps_pd(b), cd = _mm256_cvtps_pd(c);
+  const __m256d sum = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ad, ad), _mm256_mul_pd(bd, bd)),
+                                    _mm256_mul_pd(cd, cd));
+  const __m128 predicted = _mm256_cvtpd_ps(
+      _mm256_sqrt_pd(_mm256_max_pd(_mm256_sub_pd(_mm256_set1_pd(1.0), sum), _mm256_setzero_pd())));
+  __m128 rows[4] = {a, b, c, left_out_x4(predicted, codes)};
+  _MM_TRANSPOSE4_PS(rows[0], rows[1], rows[2], rows[3]);
+  for (int i = 0; i < 4; ++i) {
+    const __m128i order =
+        _mm_load_si128(reinterpret_cast<const __m128i*>(kPlacementOrder[codes[i] & 3]));
+    _mm_storeu_ps(&out[i].x, _mm_permutevar_ps(rows[i], order));
   }
 }
 #endif
@@ -868,13 +897,19 @@ Status read_small_sections(std::span<const std::byte> file, const DatabaseFileIn
 }
 
 // The positions of one clip: its constant columns (one value for the whole clip) and its
-// varying ones (one value per frame, frame by frame, in joint order).
-void decode_positions(const std::byte* constant, const std::byte* varying,
+// varying ones (one value per frame, frame by frame, in joint order). Returns whether every
+// value is finite (each stored value is checked once, as it is read).
+bool decode_positions(const std::byte* constant, const std::byte* varying,
                       const uint8_t* is_constant, size_t joints, size_t frames, float* out) {
-  if (frames == 0) return;
+  if (frames == 0) return true;
+  uint32_t infinite = 0;
+  const auto copy = [&](float* to, const std::byte* from) {
+    std::memcpy(to, from, 12);
+    for (int k = 0; k < 3; ++k) infinite |= static_cast<uint32_t>(!detail::finite_bits(to[k]));
+  };
   for (size_t j = 0; j < joints; ++j) {
     const std::byte*& from = is_constant[j] ? constant : varying;
-    std::memcpy(out + 3 * j, from, 12);
+    copy(out + 3 * j, from);
     from += 12;
   }
   // Every later frame: the previous one, which has the constants, with the varying ones replaced.
@@ -883,10 +918,11 @@ void decode_positions(const std::byte* constant, const std::byte* varying,
     std::memcpy(frame, frame - 3 * joints, 12 * joints);
     for (size_t j = 0; j < joints; ++j) {
       if (is_constant[j]) continue;
-      std::memcpy(frame + 3 * j, varying, 12);
+      copy(frame + 3 * j, varying);
       varying += 12;
     }
   }
+  return infinite == 0;
 }
 
 // The rotations of samples [first, first + count), with their exceptions in sample order.
@@ -904,11 +940,14 @@ Status decode_rotations(std::span<const std::byte> file, const DatabaseFileInfo&
     return !is_escape(codes[i]) && !is_escape(codes[i + 1]) && !is_escape(codes[i + 2]) &&
            !is_escape(codes[i + 3]);
   };
+#if defined(__SSE2__)
+  const auto decode_x4 = detail::cpu_has_avx() ? &decode_rotations_x4_avx : &decode_rotations_x4;
+#endif
   size_t i = 0;
   while (i < count) {
 #if defined(__SSE2__)
     if (i + 4 <= count && escape_free(i)) {
-      decode_rotations_x4(components + 12 * i, codes + i, rotations + i);
+      decode_x4(components + 12 * i, codes + i, rotations + i);
       i += 4;
       continue;
     }
@@ -938,30 +977,30 @@ Status decode_rotations(std::span<const std::byte> file, const DatabaseFileInfo&
 }
 
 // Positions, rotations and velocities of one clip, straight into the database's arrays.
+// `valid` tells whether they are all what validate() accepts (finite, unit rotations).
 Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                   const LoadPlan& plan, size_t c, std::string_view name, Database& db) {
+                   const LoadPlan& plan, size_t c, std::string_view name, Database& db,
+                   bool& valid) {
   const ClipRange& clip = db.clips[c];
   const size_t joints = info.joint_count;
   const size_t frames = static_cast<size_t>(clip.frame_count());
   const size_t first = static_cast<size_t>(clip.start) * joints;
   const size_t count = frames * joints;
-
-  decode_positions(section_bytes(file, info, DatabaseSection::ConstantPositions).data() +
-                       12 * plan.positions.first_constant[c],
-                   section_bytes(file, info, DatabaseSection::VaryingPositions).data() +
-                       12 * plan.positions.first_varying[c],
-                   plan.positions.constant.data() + c * joints, joints, frames,
-                   glm::value_ptr(db.local_positions[first]));
-  if (Status s =
-          decode_rotations(file, info, plan, first, count, name, db.local_rotations.data() + first);
-      !s) {
-    return s;
-  }
-  compute_local_velocities(std::span(db.local_positions).subspan(first, count),
-                           std::span(db.local_rotations).subspan(first, count), clip.frame_count(),
-                           static_cast<int>(joints), db.frame_time,
-                           std::span(db.local_velocities).subspan(first, count),
-                           std::span(db.local_angular_velocities).subspan(first, count));
+  const bool positions_finite =
+      decode_positions(section_bytes(file, info, DatabaseSection::ConstantPositions).data() +
+                           12 * plan.positions.first_constant[c],
+                       section_bytes(file, info, DatabaseSection::VaryingPositions).data() +
+                           12 * plan.positions.first_varying[c],
+                       plan.positions.constant.data() + c * joints, joints, frames,
+                       glm::value_ptr(db.local_positions[first]));
+  glm::quat* rotations = db.local_rotations.data() + first;
+  if (Status s = decode_rotations(file, info, plan, first, count, name, rotations); !s) return s;
+  const bool velocities_finite = compute_local_velocities(
+      std::span(db.local_positions).subspan(first, count), std::span(rotations, count),
+      clip.frame_count(), static_cast<int>(joints), db.frame_time,
+      std::span(db.local_velocities).subspan(first, count),
+      std::span(db.local_angular_velocities).subspan(first, count));
+  valid = positions_finite && velocities_finite && detail::rotations_unit(rotations, count);
   return Status::success();
 }
 
@@ -973,7 +1012,7 @@ Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info
 struct DecodedFile {
   uint64_t checksum = 0;
   Status status;                    // the first failing clip's, in clip order
-  bool joint_values_valid = false;  // every decoded value passed detail::joint_values_valid
+  bool joint_values_valid = false;  // every clip's values passed decode_clip's checks
 };
 
 DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo& info,
@@ -1000,11 +1039,9 @@ DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo&
       copy_array(file, info, DatabaseSection::Searchable, db.searchable);
     } else {
       const size_t c = job - kFirstClipJob;
-      status[c] = decode_clip(file, info, plan, c, name, db);
-      const size_t joints = info.joint_count;
-      valid[c] = status[c] && detail::joint_values_valid(
-                                  db, static_cast<size_t>(db.clips[c].start) * joints,
-                                  static_cast<size_t>(db.clips[c].frame_count()) * joints);
+      bool clip_valid = false;
+      status[c] = decode_clip(file, info, plan, c, name, db, clip_valid);
+      valid[c] = status[c] && clip_valid;
     }
   });
   out.joint_values_valid =

@@ -11,12 +11,18 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "cpu_features.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
+#include "validation.hpp"
 
 namespace mm {
 
 namespace {
+
+bool finite3(const glm::vec3& v) {
+  return detail::finite_bits(v.x) && detail::finite_bits(v.y) && detail::finite_bits(v.z);
+}
 
 // The reflection of a global transform across the YZ plane (x -> -x). The rotation R becomes
 // S R S with S = diag(-1, 1, 1): the axis (x, y, z) turns into (-x, y, z) and the angle changes
@@ -164,20 +170,28 @@ inline void store_vec3(const QuatLanes<Floats8>& v, glm::vec3* out) {
 }
 
 // The rates into out: all lanes at once when the series covered them all (the common case),
-// else lane by lane with the scalar path for the others.
+// else lane by lane with the scalar path for the others. Returns whether all are finite.
 template <class V>
-[[gnu::always_inline]] inline void store_rates(const QuatLanes<V>& rate, unsigned series,
+[[gnu::always_inline]] inline bool store_rates(const QuatLanes<V>& rate, unsigned series,
                                                const glm::quat* from, const glm::quat* to,
                                                float inv_dt, glm::vec3* out) {
   constexpr size_t kLanes = sizeof(V) / sizeof(float);
   if (series == (1u << kLanes) - 1) {
     store_vec3(rate, out);
-    return;
+    // x - x is 0 for a finite x and NaN otherwise.
+    const auto finite =
+        (rate.x - rate.x == 0.0f) & (rate.y - rate.y == 0.0f) & (rate.z - rate.z == 0.0f);
+    bool all = true;
+    for (size_t lane = 0; lane < kLanes; ++lane) all &= finite[lane] != 0;
+    return all;
   }
+  bool all = true;
   for (size_t lane = 0; lane < kLanes; ++lane) {
     out[lane] = (series >> lane & 1) != 0 ? glm::vec3(rate.x[lane], rate.y[lane], rate.z[lane])
                                           : angular_velocity_between(from[lane], to[lane], inv_dt);
+    all &= finite3(out[lane]);
   }
+  return all;
 }
 
 // Four quaternions (x, y, z, w in memory) transposed into one vector per component.
@@ -188,15 +202,16 @@ QuatLanes<Floats4> load_quats_x4(const glm::quat* q) {
   return {x, y, z, w};
 }
 
-// angular_velocity_between for samples [0, count) four at a time; returns how many it did.
+// angular_velocity_between for samples [0, count) four at a time; returns how many it did and
+// clears `finite` if one of them is not.
 size_t angular_velocities_x4(const glm::quat* from, const glm::quat* to, size_t count, float inv_dt,
-                             glm::vec3* out) {
+                             glm::vec3* out, bool& finite) {
   size_t i = 0;
   for (; i + 4 <= count; i += 4) {
     QuatLanes<Floats4> rate;
     const unsigned series =
         series_rates(load_quats_x4(from + i), load_quats_x4(to + i), inv_dt, rate);
-    store_rates(rate, series, from + i, to + i, inv_dt, out + i);
+    finite &= store_rates(rate, series, from + i, to + i, inv_dt, out + i);
   }
   return i;
 }
@@ -222,24 +237,18 @@ __attribute__((target("avx"))) QuatLanes<Floats8> load_quats_x8(const glm::quat*
 // The same eight at a time, with AVX.
 __attribute__((target("avx"))) size_t angular_velocities_x8(const glm::quat* from,
                                                             const glm::quat* to, size_t count,
-                                                            float inv_dt, glm::vec3* out) {
+                                                            float inv_dt, glm::vec3* out,
+                                                            bool& finite) {
   size_t i = 0;
   for (; i + 8 <= count; i += 8) {
     QuatLanes<Floats8> rate;
     const unsigned series =
         series_rates(load_quats_x8(from + i), load_quats_x8(to + i), inv_dt, rate);
-    store_rates(rate, series, from + i, to + i, inv_dt, out + i);
+    finite &= store_rates(rate, series, from + i, to + i, inv_dt, out + i);
   }
   return i;
 }
 
-bool avx_supported() {
-  static const bool supported = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx");
-  }();
-  return supported;
-}
 #endif
 
 // Finite differences over runs of samples (frame-major joint values) of one clip.
@@ -250,27 +259,35 @@ struct FrameDifferences {
   std::span<glm::vec3> angular_velocities;
 
   // For samples i in [first, first + count): the rates from sample i - back to i + ahead.
-  void differences(size_t first, size_t count, size_t back, size_t ahead, float inv_dt) const {
-    if (count == 0) return;
+  // Returns whether every rate is finite.
+  bool differences(size_t first, size_t count, size_t back, size_t ahead, float inv_dt) const {
+    if (count == 0) return true;
     // Linear: every float of a vec3 alike.
     const float* from = glm::value_ptr(positions[first - back]);
     const float* to = glm::value_ptr(positions[first + ahead]);
     float* velocity = glm::value_ptr(velocities[first]);
-    for (size_t k = 0; k < 3 * count; ++k) velocity[k] = (to[k] - from[k]) * inv_dt;
+    uint32_t infinite = 0;
+    for (size_t k = 0; k < 3 * count; ++k) {
+      velocity[k] = (to[k] - from[k]) * inv_dt;
+      infinite |= static_cast<uint32_t>(!detail::finite_bits(velocity[k]));
+    }
+    bool finite = infinite == 0;
 
     size_t i = first;
 #if defined(__SSE2__) && defined(__GNUC__)
     const auto run = [&](auto kernel) {
       i += kernel(&rotations[i - back], &rotations[i + ahead], first + count - i, inv_dt,
-                  &angular_velocities[i]);
+                  &angular_velocities[i], finite);
     };
-    if (avx_supported()) run(angular_velocities_x8);
+    if (detail::cpu_has_avx()) run(angular_velocities_x8);
     run(angular_velocities_x4);
 #endif
     for (; i < first + count; ++i) {
       angular_velocities[i] =
           angular_velocity_between(rotations[i - back], rotations[i + ahead], inv_dt);
+      finite &= finite3(angular_velocities[i]);
     }
+    return finite;
   }
 };
 
@@ -376,7 +393,7 @@ glm::vec3 angular_velocity_between(const glm::quat& from, const glm::quat& to, f
   return small_rotation_vector(to * glm::conjugate(from)) * inv_dt;
 }
 
-void compute_local_velocities(std::span<const glm::vec3> positions,
+bool compute_local_velocities(std::span<const glm::vec3> positions,
                               std::span<const glm::quat> rotations, int frame_count,
                               int joint_count, float frame_time, std::span<glm::vec3> velocities,
                               std::span<glm::vec3> angular_velocities) {
@@ -389,16 +406,17 @@ void compute_local_velocities(std::span<const glm::vec3> positions,
   if (frames < 2) {
     std::fill(velocities.begin(), velocities.end(), glm::vec3(0.0f));
     std::fill(angular_velocities.begin(), angular_velocities.end(), glm::vec3(0.0f));
-    return;
+    return true;
   }
   // Frame f differences frames a = max(0, f - 1) and b = min(last, f + 1) over (b - a) frames:
   // the first and last frames one-sided, all the others (one run of samples) central.
   const auto inv_dt = [&](int frame_steps) {
     return 1.0f / (static_cast<float>(frame_steps) * frame_time);
   };
-  from.differences(0, joints, 0, joints, inv_dt(1));
-  from.differences(joints, (frames - 2) * joints, joints, joints, inv_dt(2));
-  from.differences((frames - 1) * joints, joints, joints, 0, inv_dt(1));
+  const bool first = from.differences(0, joints, 0, joints, inv_dt(1));
+  const bool inside = from.differences(joints, (frames - 2) * joints, joints, joints, inv_dt(2));
+  const bool last = from.differences((frames - 1) * joints, joints, joints, 0, inv_dt(1));
+  return first && inside && last;
 }
 
 Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,

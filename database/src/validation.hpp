@@ -1,17 +1,24 @@
 #pragma once
 // Database::validate in two parts, for the file loader: it checks each clip's per-frame joint
-// values as it decodes them, while they are still in cache, and then validates the rest
-// without scanning those arrays a second time.
+// values as it decodes them (positions as it copies them, velocities as it computes them,
+// rotations with rotations_unit while they are in cache), and then validates the rest without
+// scanning those arrays a second time.
 
+#include <bit>
 #include <cstddef>
+#include <cstdint>
 
 #include "mm/database/database.hpp"
 
 namespace mm::detail {
 
-// True when the joint values of samples [first, first + count) (frame * joints + joint) are
-// what validate() accepts: finite unit rotations, finite positions and velocities.
-bool joint_values_valid(const Database& db, size_t first, size_t count);
+// True when every one of `count` rotations is what validate() accepts: a finite unit quaternion.
+bool rotations_unit(const glm::quat* rotations, size_t count);
+
+// True when every float is finite, tested as validate() tests it.
+inline bool finite_bits(float v) {
+  return (std::bit_cast<uint32_t>(v) & 0x7f800000u) != 0x7f800000u;
+}
 
 // Everything validate() checks but the per-frame joint arrays; validate() is this and then
 // those arrays.

@@ -274,6 +274,18 @@ TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
       << message;
 }
 
+TEST(DatabaseFile, VelocitiesThatOverflowOnLoadAreRefusedByName) {
+  // Finite positions whose difference overflows: the velocities recomputed on load are
+  // infinite, and the load fails naming the first one (frame 4 differences frames 3 and 5).
+  Database db = make_database();
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  db.local_positions[5 * joints + 1].x = 3e38f;
+  db.local_positions[6 * joints + 1].x = -3e38f;
+  const std::string message = load_error(serialize_database(db));
+  EXPECT_TRUE(contains(message, "local_velocities[frame 4, joint 1 'Hips'] is not finite"))
+      << message;
+}
+
 TEST(DatabaseFile, PerFrameArraysStillValueInitializeOutsideTheLoader) {
   // The loader sizes the per-frame arrays without zero-filling them (it writes every value);
   // after a load, growing one of them, or refilling one that held values, gives value-initialized

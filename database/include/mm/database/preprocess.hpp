@@ -179,8 +179,9 @@ glm::vec3 angular_velocity_between(const glm::quat& from, const glm::quat& to, f
 
 // Finite-difference velocities and angular velocities of frame-major local positions and
 // rotations (frame_count * joint_count each) into the two output arrays of the same size:
-// central differences inside, one-sided at the ends, zero for a single frame.
-void compute_local_velocities(std::span<const glm::vec3> positions,
+// central differences inside, one-sided at the ends, zero for a single frame. Returns whether
+// every value written is finite (finite positions far apart can give an infinite velocity).
+bool compute_local_velocities(std::span<const glm::vec3> positions,
                               std::span<const glm::quat> rotations, int frame_count,
                               int joint_count, float frame_time, std::span<glm::vec3> velocities,
                               std::span<glm::vec3> angular_velocities);
