@@ -202,18 +202,26 @@ QuatLanes<Floats4> load_quats_x4(const glm::quat* q) {
   return {x, y, z, w};
 }
 
-// angular_velocity_between for samples [0, count) four at a time; returns how many it did and
-// clears `finite` if one of them is not.
-size_t angular_velocities_x4(const glm::quat* from, const glm::quat* to, size_t count, float inv_dt,
-                             glm::vec3* out, bool& finite) {
+// angular_velocity_between for samples [0, count), a vector's lanes at a time, the quaternions
+// read by `load`; returns how many it did and clears `finite` if one of them is not.
+template <class V, class Load>
+[[gnu::always_inline]] inline size_t angular_velocity_run(Load load, const glm::quat* from,
+                                                          const glm::quat* to, size_t count,
+                                                          float inv_dt, glm::vec3* out,
+                                                          bool& finite) {
+  constexpr size_t kLanes = sizeof(V) / sizeof(float);
   size_t i = 0;
-  for (; i + 4 <= count; i += 4) {
-    QuatLanes<Floats4> rate;
-    const unsigned series =
-        series_rates(load_quats_x4(from + i), load_quats_x4(to + i), inv_dt, rate);
+  for (; i + kLanes <= count; i += kLanes) {
+    QuatLanes<V> rate;
+    const unsigned series = series_rates(load(from + i), load(to + i), inv_dt, rate);
     finite &= store_rates(rate, series, from + i, to + i, inv_dt, out + i);
   }
   return i;
+}
+
+size_t angular_velocities_x4(const glm::quat* from, const glm::quat* to, size_t count, float inv_dt,
+                             glm::vec3* out, bool& finite) {
+  return angular_velocity_run<Floats4>(load_quats_x4, from, to, count, inv_dt, out, finite);
 }
 
 // Two quaternions in the two halves of one vector.
@@ -239,14 +247,7 @@ __attribute__((target("avx"))) size_t angular_velocities_x8(const glm::quat* fro
                                                             const glm::quat* to, size_t count,
                                                             float inv_dt, glm::vec3* out,
                                                             bool& finite) {
-  size_t i = 0;
-  for (; i + 8 <= count; i += 8) {
-    QuatLanes<Floats8> rate;
-    const unsigned series =
-        series_rates(load_quats_x8(from + i), load_quats_x8(to + i), inv_dt, rate);
-    finite &= store_rates(rate, series, from + i, to + i, inv_dt, out + i);
-  }
-  return i;
+  return angular_velocity_run<Floats8>(load_quats_x8, from, to, count, inv_dt, out, finite);
 }
 
 #endif
