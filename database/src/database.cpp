@@ -143,10 +143,6 @@ std::span<const float> floats_of(std::span<const glm::vec3> v) {
   return {v.empty() ? nullptr : glm::value_ptr(v[0]), v.size() * 3};
 }
 
-bool finite3(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 // The joint a role name refers to in this database, or -2 when the name is not a role.
 int role_joint(const JointRoleIndices& roles, std::string_view name) {
   const JointRoleInfo* role = find_joint_role(name);
@@ -232,7 +228,7 @@ Status check_skeleton(const Database& db) {
     const Transform& t = db.skeleton.rest(j);
     const glm::quat& q = t.rotation;
     const float n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
-    if (!finite3(t.translation) || !finite3(t.scale) ||
+    if (!detail::finite3(t.translation) || !detail::finite3(t.scale) ||
         !(n2 >= kMinUnitNormSquared && n2 <= kMaxUnitNormSquared)) {
       return Error{"database: skeleton rest transform of joint " + std::to_string(j) + " '" +
                    db.skeleton.name(j) + "' is not finite or its rotation is not unit length"};

@@ -1202,7 +1202,6 @@ void write_positions(ByteWriter& w, const Database& db, const PositionLayout& la
   }
 }
 
-// The three rotation sections: components and codes sample by sample, then the exceptions.
 // Rotations [begin, end) into their 12 bytes of components and their code byte, the escapes'
 // exact values appended to `exceptions` in sample order.
 void encode_rotations(std::span<const glm::quat> rotations, size_t begin, size_t end,
@@ -1216,6 +1215,7 @@ void encode_rotations(std::span<const glm::quat> rotations, size_t begin, size_t
   }
 }
 
+// The three rotation sections: components and codes sample by sample, then the exceptions.
 void write_rotations(ByteWriter& w, const Database& db,
                      std::array<DatabaseFileSection, kDatabaseSectionCount>& table) {
   const size_t samples = db.local_rotations.size();

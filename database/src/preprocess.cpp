@@ -20,10 +20,6 @@ namespace mm {
 
 namespace {
 
-bool finite3(const glm::vec3& v) {
-  return detail::finite_bits(v.x) && detail::finite_bits(v.y) && detail::finite_bits(v.z);
-}
-
 // The reflection of a global transform across the YZ plane (x -> -x). The rotation R becomes
 // S R S with S = diag(-1, 1, 1): the axis (x, y, z) turns into (-x, y, z) and the angle changes
 // sign, which as a quaternion is (w, x, -y, -z).
@@ -189,7 +185,7 @@ template <class V>
   for (size_t lane = 0; lane < kLanes; ++lane) {
     out[lane] = (series >> lane & 1) != 0 ? glm::vec3(rate.x[lane], rate.y[lane], rate.z[lane])
                                           : angular_velocity_between(from[lane], to[lane], inv_dt);
-    all &= finite3(out[lane]);
+    all &= detail::finite3(out[lane]);
   }
   return all;
 }
@@ -286,7 +282,7 @@ struct FrameDifferences {
     for (; i < first + count; ++i) {
       angular_velocities[i] =
           angular_velocity_between(rotations[i - back], rotations[i + ahead], inv_dt);
-      finite &= finite3(angular_velocities[i]);
+      finite &= detail::finite3(angular_velocities[i]);
     }
     return finite;
   }
@@ -403,7 +399,7 @@ bool compute_local_velocities(std::span<const glm::vec3> positions,
   assert(positions.size() == frames * joints);
   assert(rotations.size() == positions.size() && velocities.size() == positions.size() &&
          angular_velocities.size() == positions.size());
-  const FrameDifferences from{positions, rotations, velocities, angular_velocities};
+  const FrameDifferences clip{positions, rotations, velocities, angular_velocities};
   if (frames < 2) {
     std::fill(velocities.begin(), velocities.end(), glm::vec3(0.0f));
     std::fill(angular_velocities.begin(), angular_velocities.end(), glm::vec3(0.0f));
@@ -414,9 +410,9 @@ bool compute_local_velocities(std::span<const glm::vec3> positions,
   const auto inv_dt = [&](int frame_steps) {
     return 1.0f / (static_cast<float>(frame_steps) * frame_time);
   };
-  const bool first = from.differences(0, joints, 0, joints, inv_dt(1));
-  const bool inside = from.differences(joints, (frames - 2) * joints, joints, joints, inv_dt(2));
-  const bool last = from.differences((frames - 1) * joints, joints, joints, 0, inv_dt(1));
+  const bool first = clip.differences(0, joints, 0, joints, inv_dt(1));
+  const bool inside = clip.differences(joints, (frames - 2) * joints, joints, joints, inv_dt(2));
+  const bool last = clip.differences((frames - 1) * joints, joints, joints, 0, inv_dt(1));
   return first && inside && last;
 }
 

@@ -20,6 +20,10 @@ inline bool finite_bits(float v) {
   return (std::bit_cast<uint32_t>(v) & 0x7f800000u) != 0x7f800000u;
 }
 
+inline bool finite3(const glm::vec3& v) {
+  return finite_bits(v.x) && finite_bits(v.y) && finite_bits(v.z);
+}
+
 // Everything validate() checks but the per-frame joint arrays; validate() is this and then
 // those arrays.
 Status validate_except_joint_values(const Database& db);
