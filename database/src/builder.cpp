@@ -78,7 +78,12 @@ Status prepare_clip(Clip& clip, const std::string& input_name, const BuildOption
   } else {
     clip.frame_time = 1.0f / options.rate;
   }
-  Result<JointRoleIndices> roles = find_joint_roles(clip.skeleton, options.roles);
+  if (Status s = check_joint_map(clip.skeleton, options.role_map); !s) {
+    return Error{input_name + ": clip '" + clip.name + "': " + s.message()};
+  }
+  JointRoles names = options.roles;
+  apply_joint_map(names, options.role_map);
+  Result<JointRoleIndices> roles = find_joint_roles(clip.skeleton, names);
   if (!roles) return Error{input_name + ": clip '" + clip.name + "': " + roles.message()};
   if (clip.skeleton.find(kSimulationJointName) >= 0) {
     return Error{input_name + ": clip '" + clip.name + "': has a joint named '" +

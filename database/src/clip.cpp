@@ -21,6 +21,13 @@ Status Clip::validate() const {
     return Error{where + "expected " + std::to_string(frame_count * joint_count()) +
                  " local transforms, found " + std::to_string(local.size())};
   }
+  if (!end_sites.empty() && end_sites.size() != static_cast<size_t>(joint_count())) {
+    return Error{where + "expected no End Sites or one per joint (" +
+                 std::to_string(joint_count()) + "), found " + std::to_string(end_sites.size())};
+  }
+  for (const glm::vec3& end : end_sites) {
+    if (!finite(end)) return Error{where + "an End Site offset is not finite"};
+  }
   for (size_t i = 0; i < local.size(); ++i) {
     const Transform& t = local[i];
     const float n = glm::length(t.rotation);

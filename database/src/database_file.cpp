@@ -131,11 +131,9 @@ constexpr size_t kOffHeaderSize = 24;
 constexpr size_t kOffSectionCount = 28;
 constexpr size_t kOffCounts = 32;
 constexpr size_t kOffFrameTime = 56;
-constexpr size_t kOffRoles = 60;
-constexpr size_t kOffReserved = kOffRoles + 4 * kJointRoleCount;
+constexpr size_t kOffReserved = 60;
 constexpr size_t kOffSectionTable = 88;
 constexpr size_t kChecksumSize = 8;
-static_assert(kOffReserved + 4 == kOffSectionTable, "the roles fill the header up to the table");
 static_assert(kOffSectionTable + kDatabaseSectionCount * 16 <= kDatabaseHeaderSize);
 static_assert(kDatabaseHeaderSize % 16 == 0);
 static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::quat) == 16);
@@ -540,9 +538,6 @@ DatabaseFileInfo read_header_fields(std::span<const std::byte> prefix) {
   info.feature_dims = counts[4];
   info.channel_count = counts[5];
   info.frame_time = read_at<float>(prefix, kOffFrameTime);
-  for (size_t r = 0; r < kJointRoleCount; ++r) {
-    info.roles.*kJointRoles[r].index = read_at<int32_t>(prefix, kOffRoles + 4 * r);
-  }
   return info;
 }
 
@@ -598,6 +593,8 @@ SectionSize expected_section_size(DatabaseSection section, const DatabaseFileInf
       return {4 * uint64_t{info.joint_count}, 0, 0, 1, "joint_count x 4"};
     case DatabaseSection::SkeletonRest:
       return {kRestTransformBytes * info.joint_count, 0, 0, 1, "joint_count x 40"};
+    case DatabaseSection::SkeletonRoles:
+      return {4 * kJointRoleCount, 0, 0, 1, "one int32 per joint role"};
     case DatabaseSection::Clips:
       return records(kMinClipBytes, info.clip_count, "clip_count");
     case DatabaseSection::TagNames:
@@ -879,7 +876,13 @@ Status read_small_sections(std::span<const std::byte> file, const DatabaseFileIn
                  std::to_string(info.feature_dims)};
   }
   if (Status s = read_skeleton(file, info, name, db.skeleton); !s) return s;
-  db.roles = info.roles;
+  const std::span<const std::byte> roles =
+      section_bytes(file, info, DatabaseSection::SkeletonRoles);
+  for (size_t r = 0; r < kJointRoleCount; ++r) {
+    int32_t joint = 0;
+    std::memcpy(&joint, roles.data() + 4 * r, sizeof joint);
+    db.roles.*kJointRoles[r].index = joint;
+  }
   db.frame_time = info.frame_time;
   db.frame_count = static_cast<int>(info.frame_count);
   if (Status s = read_clips(file, info, name, db.clips); !s) return s;
@@ -1074,6 +1077,8 @@ const char* database_section_name(DatabaseSection section) {
       return "skeleton_parents";
     case DatabaseSection::SkeletonRest:
       return "skeleton_rest";
+    case DatabaseSection::SkeletonRoles:
+      return "skeleton_roles";
     case DatabaseSection::Clips:
       return "clips";
     case DatabaseSection::TagNames:
@@ -1137,7 +1142,7 @@ uint64_t database_checksum(std::span<const std::byte> bytes) {
 
 namespace {
 
-// The header and the small sections of a version-2 file, written in place.
+// The header and the small sections of a version-3 file, written in place.
 void write_header(ByteWriter& w, const Database& db) {
   w.raw(kDatabaseMagic.data(), kDatabaseMagic.size());
   w.pod(kDatabaseFormatVersion);
@@ -1153,9 +1158,6 @@ void write_header(ByteWriter& w, const Database& db) {
   w.patch(kOffSectionCount, static_cast<uint32_t>(kDatabaseSectionCount));
   w.patch(kOffCounts, counts);
   w.patch(kOffFrameTime, db.frame_time);
-  for (size_t r = 0; r < kJointRoleCount; ++r) {
-    w.patch(kOffRoles + 4 * r, static_cast<int32_t>(db.roles.*kJointRoles[r].index));
-  }
 }
 
 void write_schema(ByteWriter& w, const FeatureSchema& schema) {
@@ -1302,6 +1304,9 @@ std::vector<std::byte> serialize_database(const Database& db) {
   });
   section(DatabaseSection::SkeletonRest, [&] {
     for (const Transform& t : db.skeleton.rest()) write_rest(w, t);
+  });
+  section(DatabaseSection::SkeletonRoles, [&] {
+    for (const JointRoleInfo& role : kJointRoles) w.pod(static_cast<int32_t>(db.roles.*role.index));
   });
   section(DatabaseSection::Clips, [&] { write_clips(w, db.clips); });
   section(DatabaseSection::TagNames, [&] {

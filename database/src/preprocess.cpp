@@ -343,6 +343,7 @@ Clip resample_clip(const Clip& clip, float rate) {
   out.name = clip.name;
   out.source_path = clip.source_path;
   out.skeleton = clip.skeleton;
+  out.end_sites = clip.end_sites;
   out.frame_time = 1.0f / rate;
   if (!needs_resampling(clip, rate)) {
     out.frame_count = clip.frame_count;

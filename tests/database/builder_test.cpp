@@ -67,15 +67,28 @@ std::vector<Transform> source_globals(const Clip& clip, int frame) {
 }
 
 // A small, valid BVH with a different skeleton (Hips, LeftFoot, RightFoot), in centimetres.
+// Hips with two legs (upper leg, lower leg, foot) whose upper and lower legs sit at the hips:
+// 7 joints, every one with 3 rotation channels and the hips with 3 position channels too.
 std::string other_skeleton_bvh() {
+  auto leg = [](const char* side, const char* x) {
+    return std::string("  JOINT ") + side + "UpLeg\n  {\n    OFFSET " + x +
+           " 0 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n    JOINT " + side +
+           "Leg\n    {\n      OFFSET 0 -40 0\n      CHANNELS 3 Zrotation Xrotation "
+           "Yrotation\n      JOINT " +
+           side +
+           "Foot\n      {\n        OFFSET 0 -40 0\n        CHANNELS 3 Zrotation Xrotation "
+           "Yrotation\n        End Site\n        {\n          OFFSET 0 0 10\n        }\n"
+           "      }\n    }\n  }\n";
+  };
   std::string text =
       "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 6 Xposition Yposition Zposition "
-      "Zrotation Xrotation Yrotation\n  JOINT LeftFoot\n  {\n    OFFSET 10 -80 0\n    CHANNELS 3 "
-      "Zrotation Xrotation Yrotation\n    End Site\n    {\n      OFFSET 0 0 10\n    }\n  }\n"
-      "  JOINT RightFoot\n  {\n    OFFSET -10 -80 0\n    CHANNELS 3 Zrotation Xrotation "
-      "Yrotation\n    End Site\n    {\n      OFFSET 0 0 10\n    }\n  }\n}\nMOTION\nFrames: 40\n"
-      "Frame Time: 0.0333333\n";
-  for (int f = 0; f < 40; ++f) text += "0 90 " + std::to_string(f * 4) + " 0 0 0 0 0 0 0 0 0\n";
+      "Zrotation Xrotation Yrotation\n" +
+      leg("Left", "10") + leg("Right", "-10") + "}\nMOTION\nFrames: 40\nFrame Time: 0.0333333\n";
+  for (int f = 0; f < 40; ++f) {
+    text += "0 90 " + std::to_string(f * 4) + " 0 0 0";
+    for (int c = 0; c < 18; ++c) text += " 0";  // the six leg joints' rotations
+    text += "\n";
+  }
   return text;
 }
 
@@ -376,7 +389,7 @@ TEST(BuilderBadInputs, DifferentSkeletonIsRefused) {
   ASSERT_FALSE(db);
   EXPECT_NE(db.message().find("z_other.bvh"), std::string::npos) << db.message();
   EXPECT_NE(db.message().find("skeleton differs"), std::string::npos) << db.message();
-  EXPECT_NE(db.message().find("3 joints instead of 22"), std::string::npos) << db.message();
+  EXPECT_NE(db.message().find("7 joints instead of 22"), std::string::npos) << db.message();
 
   BuildOptions skip;
   skip.skip_bad = true;
@@ -388,12 +401,12 @@ TEST(BuilderBadInputs, DifferentSkeletonIsRefused) {
   ASSERT_EQ(report.refused.size(), 1u);
   EXPECT_EQ(report.refused[0].path.filename(), "z_other.bvh");
 
-  // On its own the other skeleton builds: Hips, LeftFoot and RightFoot are known role names.
+  // On its own the other skeleton builds: its joints have known role names.
   const fs::path other[] = {dir / "z_other.bvh"};
   db = build_database(other, BuildOptions{});
   ASSERT_TRUE(db) << db.message();
-  EXPECT_EQ(db->joint_count(), 4);
-  EXPECT_EQ(db->roles.left_foot, 2);
+  EXPECT_EQ(db->joint_count(), 8);
+  EXPECT_EQ(db->roles.left_foot, 4);
   EXPECT_EQ(db->roles.left_toe, -1);
 }
 
@@ -485,18 +498,20 @@ TEST(BuilderOptions, InMemoryClipsAndSingleClipWarnings) {
   // One clip that never turns: the trajectory direction channel has no deviation.
   Clip clip;
   clip.name = "straight";
-  Result<Skeleton> sk = Skeleton::create({"Hips", "LeftFoot", "RightFoot"}, {-1, 0, 0},
-                                         {Transform{}, Transform{}, Transform{}});
+  Result<Skeleton> sk = Skeleton::create(
+      {"Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg", "RightLeg", "RightFoot"},
+      {-1, 0, 1, 2, 0, 4, 5}, std::vector<Transform>(7));
   ASSERT_TRUE(sk);
   clip.skeleton = *sk;
   clip.frame_count = 60;
   for (int f = 0; f < 60; ++f) {
     Transform hips;
     hips.translation = {0.0f, 0.9f, f * 0.04f};
-    Transform left, right;
+    Transform left, right, at_parent;  // the upper and lower legs sit at the hips
     left.translation = {0.1f, -0.85f, 0.0f};
     right.translation = {-0.1f, -0.85f, 0.0f};
-    clip.local.insert(clip.local.end(), {hips, left, right});
+    clip.local.insert(clip.local.end(),
+                      {hips, at_parent, at_parent, left, at_parent, at_parent, right});
   }
   BuildReport report;
   Result<Database> db = build_database_from_clips(std::span(&clip, 1), BuildOptions{}, &report);

@@ -175,7 +175,7 @@ TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
   std::memcpy(&version, bytes.data() + 8, 4);
   std::memcpy(&marker, bytes.data() + 12, 4);
   std::memcpy(&size, bytes.data() + 16, 8);
-  EXPECT_EQ(version, 2u);
+  EXPECT_EQ(version, 3u);
   EXPECT_EQ(marker, 0x01020304u);
   EXPECT_EQ(size, bytes.size());
 
@@ -392,11 +392,11 @@ TEST(DatabaseFile, WrongMagicVersionAndEndiannessHaveSpecificMessages) {
   }
   EXPECT_TRUE(contains(load_error(mangled), "text-mode")) << load_error(mangled);
 
-  const std::string newer = load_error(patched(bytes, 8, uint32_t{3}));
-  EXPECT_TRUE(contains(newer, "format version 3 is newer than the version this program reads (2)"))
+  const std::string newer = load_error(patched(bytes, 8, uint32_t{4}));
+  EXPECT_TRUE(contains(newer, "format version 4 is newer than the version this program reads (3)"))
       << newer;
   const std::string older = load_error(patched(bytes, 8, uint32_t{0}));
-  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (2)"))
+  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (3)"))
       << older;
 
   const std::string swapped = load_error(patched(bytes, 12, uint32_t{0x04030201}));
@@ -467,10 +467,10 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
       {"zero channels", patched(bytes, 52, uint32_t{0}), "channel_count 0 is outside"},
       {"too many tags", patched(bytes, 44, uint32_t{65}), "tag_count 65 is outside"},
       {"more clips than the section holds", patched(bytes, 40, uint32_t{20}), "section 'clips'"},
-      {"section past the end", patched(bytes, table + 16 * 16, uint64_t{1} << 40),
+      {"section past the end", patched(bytes, table + 16 * 17, uint64_t{1} << 40),
        "section 'searchable': offset 1099511627776"},
       {"misaligned section",
-       patched(bytes, table + 16 * 9,
+       patched(bytes, table + 16 * 10,
                section_offset(bytes, DatabaseSection::RotationComponents) + 4),
        "section 'rotation_components': offset"},
       {"position flag 2", patched(bytes, columns + 1, uint8_t{2}),
@@ -478,7 +478,7 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
       {"varying column marked constant", patched(bytes, columns, uint8_t{1}),
        "section 'constant_positions': 12 bytes, but position_columns and the clips call for 2 "
        "positions"},
-      {"varying positions not whole", patched(bytes, table + 16 * 8 + 8, uint64_t{68 * 12 - 4}),
+      {"varying positions not whole", patched(bytes, table + 16 * 9 + 8, uint64_t{68 * 12 - 4}),
        "section 'varying_positions': 812 bytes cannot hold"},
       {"escape code without exception", patched(bytes, codes + 5, escaped_code),
        "section 'rotation_exceptions': no exception for the escape code of sample 5 [frame 1, "
@@ -534,7 +534,11 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
        "local_rotations[frame 1, joint 2 'Foot_L'] is not a finite unit quaternion"},
       {"contact of 2", patched(bytes, contacts + 7, uint8_t{2}), "contacts[frame 3, right] is 2"},
       {"searchable of 3", patched(bytes, searchable + 4, uint8_t{3}), "searchable[4] is 3"},
-      {"role out of range", patched(bytes, 60 + 4, int32_t{9}),
+      {"role out of range",
+       patched(bytes,
+               section_offset(bytes, DatabaseSection::SkeletonRoles) +
+                   4 * static_cast<uint64_t>(find_joint_role("left_foot") - kJointRoles.data()),
+               int32_t{9}),
        "role left_foot is joint 9, out of range [-1, 4)"},
       {"zero frame time", patched(bytes, 56, 0.0f), "frame_time"},
   };
@@ -554,7 +558,7 @@ TEST(DatabaseFile, FormatVersion1FileIsRefusedWithARebuildMessage) {
                                      read_database_header(path).message()}) {
     EXPECT_TRUE(contains(message,
                          "format version 1 is older than the version this program "
-                         "reads (2); rebuild the database with `mm build`"))
+                         "reads (3); rebuild the database with `mm build`"))
         << message;
   }
 }

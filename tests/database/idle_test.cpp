@@ -395,13 +395,14 @@ TEST(IdleBuild, FromAnInMemoryStandingClip) {
   // and grows away from it.
   Clip clip;
   clip.name = "stand";
-  std::vector<Transform> rest(5);
-  clip.skeleton = Skeleton::create({"Hips", "LeftFoot", "RightFoot", "Head", "LeftHand"},
-                                   {-1, 0, 0, 0, 0}, rest)
+  std::vector<Transform> rest(9);
+  clip.skeleton = Skeleton::create({"Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg",
+                                    "RightLeg", "RightFoot", "Head", "LeftHand"},
+                                   {-1, 0, 1, 2, 0, 4, 5, 0, 0}, rest)
                       .value();
   clip.frame_count = 40;
   for (int f = 0; f < clip.frame_count; ++f) {
-    Transform hips, left, right, head, hand;
+    Transform hips, left, right, head, hand, at_parent;  // the upper and lower legs: at the hips
     hips.translation = {0.0f, 0.9f, 0.0f};
     left.translation = {0.1f, -0.85f, 0.0f};
     right.translation = {-0.1f, -0.85f, 0.0f};
@@ -409,7 +410,8 @@ TEST(IdleBuild, FromAnInMemoryStandingClip) {
     hand.translation = {0.25f, -0.1f, 0.0f};
     const float angle = 0.002f * static_cast<float>((f - 25) * (f - 25));
     hand.rotation = glm::angleAxis(angle, glm::vec3(0.0f, 0.0f, 1.0f));
-    clip.local.insert(clip.local.end(), {hips, left, right, head, hand});
+    clip.local.insert(clip.local.end(),
+                      {hips, at_parent, at_parent, left, at_parent, at_parent, right, head, hand});
   }
   BuildReport report;
   Result<Database> db = build_database_from_clips(std::span(&clip, 1), BuildOptions{}, &report);

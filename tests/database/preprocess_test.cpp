@@ -33,16 +33,18 @@ float angle_difference(float a, float b) {
   return d;
 }
 
-// A minimal biped: Root -> Hips -> (UpperLeg_L -> Foot_L -> Toes_L), (UpperLeg_R -> Foot_R ->
-// Toes_R), Spine -> Head. Rest offsets are symmetric in x.
+// A minimal biped: Root -> Hips -> (UpperLeg_L -> LowerLeg_L -> Foot_L -> Toes_L), (UpperLeg_R
+// -> LowerLeg_R -> Foot_R -> Toes_R), Spine -> Head. Rest offsets are symmetric in x.
 Skeleton small_biped() {
-  std::vector<std::string> names = {"joint_Root", "Hips",   "UpperLeg_L", "Foot_L", "Toes_L",
-                                    "UpperLeg_R", "Foot_R", "Toes_R",     "Spine",  "Head"};
-  std::vector<int> parents = {-1, 0, 1, 2, 3, 1, 5, 6, 1, 8};
+  std::vector<std::string> names = {"joint_Root", "Hips",   "UpperLeg_L", "LowerLeg_L",
+                                    "Foot_L",     "Toes_L", "UpperLeg_R", "LowerLeg_R",
+                                    "Foot_R",     "Toes_R", "Spine",      "Head"};
+  std::vector<int> parents = {-1, 0, 1, 2, 3, 4, 1, 6, 7, 8, 1, 10};
   std::vector<Transform> rest(names.size());
-  const glm::vec3 offsets[] = {
-      {0, 0, 0},          {0, 0.9f, 0},   {0.1f, -0.05f, 0},  {0, -0.75f, 0}, {0, -0.06f, 0.12f},
-      {-0.1f, -0.05f, 0}, {0, -0.75f, 0}, {0, -0.06f, 0.12f}, {0, 0.2f, 0},   {0, 0.4f, 0}};
+  const glm::vec3 offsets[] = {{0, 0, 0},          {0, 0.9f, 0},   {0.1f, -0.05f, 0},
+                               {0, -0.4f, 0},      {0, -0.35f, 0}, {0, -0.06f, 0.12f},
+                               {-0.1f, -0.05f, 0}, {0, -0.4f, 0},  {0, -0.35f, 0},
+                               {0, -0.06f, 0.12f}, {0, 0.2f, 0},   {0, 0.4f, 0}};
   for (size_t i = 0; i < names.size(); ++i) rest[i].translation = offsets[i];
   Result<Skeleton> sk = Skeleton::create(names, parents, rest);
   EXPECT_TRUE(sk) << sk.message();
@@ -201,7 +203,7 @@ TEST(Resample, SixtyToThirtyAndTwentyFourToThirtyFollowTheMotion) {
       const Transform& got = out.pose(f)[1];
       EXPECT_NEAR(glm::distance(got.translation, expected.translation), 0.0f, 1e-5f) << f;
       EXPECT_NEAR(std::abs(glm::dot(got.rotation, expected.rotation)), 1.0f, 1e-5f) << f;
-      EXPECT_NEAR(glm::distance(out.pose(f)[3].translation, clip.skeleton.rest(3).translation),
+      EXPECT_NEAR(glm::distance(out.pose(f)[4].translation, clip.skeleton.rest(4).translation),
                   0.0f, 1e-6f);
     }
   }
@@ -220,7 +222,7 @@ TEST(Resample, BvhFrameTimeOfThirtyHertzNeedsNoResampling) {
 TEST(SimulationRoot, SkeletonGainsJointZero) {
   Result<Skeleton> db = add_simulation_root(small_biped());
   ASSERT_TRUE(db) << db.message();
-  EXPECT_EQ(db->joint_count(), 11);
+  EXPECT_EQ(db->joint_count(), 13);
   EXPECT_EQ(db->name(0), "Simulation");
   EXPECT_EQ(db->parent(0), -1);
   EXPECT_EQ(db->name(1), "joint_Root");
@@ -248,16 +250,16 @@ TEST(SimulationRoot, StraightWalkGivesExactFacingAndUnchangedGlobals) {
   ProcessedClip out;
   PreprocessScratch scratch;
   ASSERT_TRUE(preprocess_clip(clip, biped_roles(), PreprocessOptions{}, out, scratch));
-  ASSERT_EQ(out.joint_count, 11);
+  ASSERT_EQ(out.joint_count, 13);
   ASSERT_EQ(out.frame_count, 60);
   const Skeleton db_skeleton = *add_simulation_root(clip.skeleton);
   for (int f = 0; f < clip.frame_count; ++f) {
-    const glm::vec3 root = out.local_positions[static_cast<size_t>(f) * 11];
+    const glm::vec3 root = out.local_positions[static_cast<size_t>(f) * 13];
     const std::vector<Transform> source = globals_of(clip, f);
     EXPECT_EQ(root.y, 0.0f);
     EXPECT_NEAR(root.x, source[1].translation.x, 1e-5f);
     EXPECT_NEAR(root.z, source[1].translation.z, 1e-5f);
-    EXPECT_NEAR(angle_difference(yaw_of(out.local_rotations[static_cast<size_t>(f) * 11]), heading),
+    EXPECT_NEAR(angle_difference(yaw_of(out.local_rotations[static_cast<size_t>(f) * 13]), heading),
                 0.0f, 1e-4f)
         << f;
     // Re-rooting keeps every global transform.
@@ -268,9 +270,9 @@ TEST(SimulationRoot, StraightWalkGivesExactFacingAndUnchangedGlobals) {
     }
     // Joint 0 velocity = the hips' ground velocity (their own plus joint_Root's 0.3 m/s along
     // +Z); no turning.
-    EXPECT_NEAR(out.local_velocities[static_cast<size_t>(f) * 11].x, 1.2f * dir.x, 1e-3f);
-    EXPECT_NEAR(out.local_velocities[static_cast<size_t>(f) * 11].z, 1.2f * dir.z + 0.3f, 1e-3f);
-    EXPECT_NEAR(glm::length(out.local_angular_velocities[static_cast<size_t>(f) * 11]), 0.0f,
+    EXPECT_NEAR(out.local_velocities[static_cast<size_t>(f) * 13].x, 1.2f * dir.x, 1e-3f);
+    EXPECT_NEAR(out.local_velocities[static_cast<size_t>(f) * 13].z, 1.2f * dir.z + 0.3f, 1e-3f);
+    EXPECT_NEAR(glm::length(out.local_angular_velocities[static_cast<size_t>(f) * 13]), 0.0f,
                 1e-4f);
   }
 }
@@ -292,12 +294,12 @@ TEST(SimulationRoot, HipSwingIsSmoothedAndTurnsAreFollowed) {
   ASSERT_TRUE(preprocess_clip(clip, biped_roles(), PreprocessOptions{}, out, scratch));
   float worst_inside = 0.0f, worst_end = 0.0f;
   for (int f = 0; f < clip.frame_count; ++f) {
-    const float yaw = yaw_of(out.local_rotations[static_cast<size_t>(f) * 11]);
+    const float yaw = yaw_of(out.local_rotations[static_cast<size_t>(f) * 13]);
     const float error = std::abs(angle_difference(yaw, turn_rate * f * kDt));
     const bool inside = f >= 27 && f < clip.frame_count - 27;
     (inside ? worst_inside : worst_end) = std::max(inside ? worst_inside : worst_end, error);
     // Joint 0 turns about +Y only.
-    const glm::quat q = out.local_rotations[static_cast<size_t>(f) * 11];
+    const glm::quat q = out.local_rotations[static_cast<size_t>(f) * 13];
     EXPECT_NEAR(q.x, 0.0f, 1e-6f);
     EXPECT_NEAR(q.z, 0.0f, 1e-6f);
   }
@@ -312,7 +314,7 @@ TEST(SimulationRoot, HipSwingIsSmoothedAndTurnsAreFollowed) {
     const float t = f * kDt;
     const float expected = turn_rate * t + swing * std::sin(2.0f * 3.14159265f * t / 1.2f);
     EXPECT_NEAR(
-        angle_difference(yaw_of(out.local_rotations[static_cast<size_t>(f) * 11]), expected), 0.0f,
+        angle_difference(yaw_of(out.local_rotations[static_cast<size_t>(f) * 13]), expected), 0.0f,
         1e-4f);
   }
 }
@@ -350,7 +352,7 @@ TEST(Contacts, PlantedLiftedAndFlickerFiltered) {
   for (int f = 0; f < 30; ++f) {
     std::span<Transform> pose = clip.pose(f);
     if (f >= 10 && f < 20) pose[2].translation += glm::vec3(0.0f, 0.3f, 0.05f * (f - 10));
-    if (f == 5) pose[5].translation.y += 0.03f;
+    if (f == 5) pose[6].translation.y += 0.03f;
   }
   ProcessedClip out;
   PreprocessScratch scratch;
@@ -382,11 +384,15 @@ TEST(Contacts, PlantedLiftedAndFlickerFiltered) {
 TEST(JointRoleLookup, BandaiAndCommonBvhNamesIgnoringCase) {
   JointRoleIndices r = biped_roles();
   EXPECT_EQ(r.hips, 1);
-  EXPECT_EQ(r.left_foot, 3);
-  EXPECT_EQ(r.left_toe, 4);
-  EXPECT_EQ(r.right_foot, 6);
-  EXPECT_EQ(r.right_toe, 7);
-  EXPECT_EQ(r.head, 9);
+  EXPECT_EQ(r.left_upper_leg, 2);
+  EXPECT_EQ(r.left_lower_leg, 3);
+  EXPECT_EQ(r.left_foot, 4);
+  EXPECT_EQ(r.left_toe, 5);
+  EXPECT_EQ(r.right_foot, 8);
+  EXPECT_EQ(r.right_toe, 9);
+  EXPECT_EQ(r.spine, 10);
+  EXPECT_EQ(r.head, 11);
+  EXPECT_EQ(r.chest, -1);  // no arms to branch off it
 
   Result<Skeleton> cmu =
       Skeleton::create({"hips", "LeftUpLeg", "LeftLeg", "leftfoot", "LeftToeBase", "RightUpLeg",
@@ -404,8 +410,9 @@ TEST(JointRoleLookup, BandaiAndCommonBvhNamesIgnoringCase) {
 }
 
 TEST(JointRoleLookup, MissingRequiredRoleNamesWhatWasLookedFor) {
-  Result<Skeleton> sk =
-      Skeleton::create({"Hips", "Ankle_Left", "Foot_R"}, {-1, 0, 0}, std::vector<Transform>(3));
+  Result<Skeleton> sk = Skeleton::create(
+      {"Hips", "UpperLeg_L", "LowerLeg_L", "Ankle_Left", "UpperLeg_R", "LowerLeg_R", "Foot_R"},
+      {-1, 0, 1, 2, 0, 4, 5}, std::vector<Transform>(7));
   ASSERT_TRUE(sk);
   Result<JointRoleIndices> roles = find_joint_roles(*sk, JointRoles{});
   ASSERT_FALSE(roles);
@@ -416,7 +423,7 @@ TEST(JointRoleLookup, MissingRequiredRoleNamesWhatWasLookedFor) {
   custom.left_foot = {"ankle_left"};
   roles = find_joint_roles(*sk, custom);
   ASSERT_TRUE(roles) << roles.message();
-  EXPECT_EQ(roles->left_foot, 1);
+  EXPECT_EQ(roles->left_foot, 3);
 }
 
 // ---- Mirroring ---------------------------------------------------------------------------------
@@ -497,11 +504,11 @@ TEST(Mirror, TurningLeftBecomesTurningRight) {
   ASSERT_TRUE(preprocess_clip(clip, biped_roles(), PreprocessOptions{}, a, scratch));
   ASSERT_TRUE(preprocess_clip(mirrored, biped_roles(), PreprocessOptions{}, b, scratch));
   for (int f = 0; f < 60; ++f) {
-    EXPECT_NEAR(b.local_angular_velocities[f * 11].y, -a.local_angular_velocities[f * 11].y, 1e-4f)
+    EXPECT_NEAR(b.local_angular_velocities[f * 13].y, -a.local_angular_velocities[f * 13].y, 1e-4f)
         << f;
     // Inside the clip the smoothing window is whole and the turn rate is exact.
     if (f >= 27 && f < 33) {
-      EXPECT_NEAR(a.local_angular_velocities[f * 11].y, rate, 1e-3f) << f;
+      EXPECT_NEAR(a.local_angular_velocities[f * 13].y, rate, 1e-3f) << f;
     }
   }
 }

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -181,10 +182,40 @@ TEST(BvhParse, ScaleOptionConvertsUnits) {
 }
 
 TEST(BvhParse, RefusesInvalidScaleOption) {
-  Result<Clip> clip = parse_bvh(join(fixture_lines()), kFixturePath, BvhOptions{0.0f});
-  ASSERT_FALSE(clip.ok());
-  EXPECT_NE(clip.message().find(kFixturePath), std::string::npos);
-  EXPECT_NE(clip.message().find("expected BvhOptions::scale"), std::string::npos);
+  for (const float scale : {-1.0f, std::numeric_limits<float>::infinity()}) {
+    Result<Clip> clip = parse_bvh(join(fixture_lines()), kFixturePath, BvhOptions{scale});
+    ASSERT_FALSE(clip.ok());
+    EXPECT_NE(clip.message().find(kFixturePath), std::string::npos);
+    EXPECT_NE(clip.message().find("expected BvhOptions::scale"), std::string::npos);
+  }
+}
+
+TEST(BvhUnits, PickedFromTheSkeletonsSize) {
+  EXPECT_EQ(bvh_units_to_metres(0.9f), 1.0f);
+  EXPECT_EQ(bvh_units_to_metres(36.0f), 0.0254f);
+  EXPECT_EQ(bvh_units_to_metres(95.0f), 0.01f);
+  EXPECT_EQ(bvh_units_to_metres(950.0f), 0.001f);
+}
+
+TEST(BvhUnits, RealFilesInCentimetresAndMetresComeOutInMetres) {
+  // Bandai (centimetres) and ReActIdle (metres): with automatic units both legs measure
+  // 0.6-0.9 m, and the End Sites are kept in metres.
+  const std::filesystem::path files[] = {
+      test::clip_path("dataset-2_walk_normal_001"),
+      test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh"};
+  for (const std::filesystem::path& file : files) {
+    Result<Clip> clip = load_bvh(file, BvhOptions{0.0f});
+    ASSERT_TRUE(clip) << clip.message();
+    const Skeleton& sk = clip->skeleton;
+    const int foot = sk.find("Foot_L") >= 0 ? sk.find("Foot_L") : sk.find("foot.L");
+    ASSERT_GE(foot, 0) << file;
+    const float leg =
+        glm::length(sk.rest(foot).translation) + glm::length(sk.rest(sk.parent(foot)).translation);
+    EXPECT_GT(leg, 0.6f) << file;
+    EXPECT_LT(leg, 0.9f) << file;
+    ASSERT_EQ(clip->end_sites.size(), static_cast<size_t>(sk.joint_count()));
+    EXPECT_LT(glm::length(clip->end_sites[static_cast<size_t>(foot)]), 0.3f) << file;
+  }
 }
 
 // Global positions of a three-joint chain, each joint with a different rotation order, against

@@ -53,7 +53,10 @@ void add_weights_option(CLI::App& app, WeightMethod& method, const std::string& 
 }
 
 void add_bvh_scale_option(CLI::App& app, float& scale) {
-  app.add_option("--scale", scale, "BVH units to metres (default 0.01: centimetres)")
+  scale = 0.0f;  // automatic unless given
+  app.add_option("--scale", scale,
+                 "BVH units to metres (default: from each skeleton's size: metres, inches, "
+                 "centimetres or millimetres)")
       ->check(number_over(0.0, 1000.0))
       ->type_name("S");
 }

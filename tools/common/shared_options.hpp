@@ -26,7 +26,7 @@ void add_dt_option(CLI::App& app, float& dt, const std::string& default_text);
 // `--weights METHOD`: the generated body's skinning weights, one of the method names.
 void add_weights_option(CLI::App& app, WeightMethod& method, const std::string& description);
 
-// `--scale S` in (0, 1000]: BVH units to metres.
+// `--scale S` in (0, 1000]: BVH units to metres; without it, 0 (units found per file).
 void add_bvh_scale_option(CLI::App& app, float& scale);
 
 // After parsing: the settings as a whole (ranges, a known search method); -1 when they are

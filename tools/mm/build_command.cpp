@@ -27,6 +27,7 @@ namespace {
 struct Arguments {
   std::vector<std::string> inputs;
   std::string output;
+  std::string map_file;
   BuildOptions options;
   bool quiet = false;
 };
@@ -80,12 +81,17 @@ void add_input_options(CLI::App& app, Arguments& out) {
 }
 
 void add_skeleton_options(CLI::App& app, Arguments& out) {
+  app.add_option("--map", out.map_file,
+                 "joint map: lines \"role=Joint\" naming the joint of a role ('#' starts a "
+                 "comment); roles: " +
+                     joint_role_names())
+      ->type_name("FILE");
   app.add_option_function<std::vector<std::string>>(
          "--role",
          [&out](const std::vector<std::string>& values) {
            for (const std::string& value : values) {
              const auto [role, joint] = *split_assignment(value);
-             out.options.roles.*(find_joint_role(role)->candidates) = {joint};
+             out.options.role_map.push_back({role, joint, 0, {}});
            }
          },
          "the joint playing a role (" + joint_role_names() +
@@ -213,6 +219,16 @@ void print_summary(const std::string& output, const Database& db, const BuildRep
 int run_build(const std::vector<std::string>& args) {
   Arguments arguments;
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
+  if (!arguments.map_file.empty()) {
+    Result<std::vector<JointRoleAssignment>> map = load_joint_map(arguments.map_file);
+    if (!map) {
+      std::fprintf(stderr, "mm build: %s\n", map.message().c_str());
+      return 1;
+    }
+    // The map file first: --role on the command line overrides its lines.
+    map->insert(map->end(), arguments.options.role_map.begin(), arguments.options.role_map.end());
+    arguments.options.role_map = std::move(map).value();
+  }
   const auto start = std::chrono::steady_clock::now();
   BuildReport report;
   const std::optional<Database> db = build_and_save(arguments, report);

@@ -28,11 +28,18 @@ const char* kind_name(FeatureKind kind) {
   return "unknown";
 }
 
-std::string role_name(const Database& db, int joint) {
-  return joint >= 0 && joint < db.joint_count() ? db.skeleton.name(joint) : std::string("-");
-}
-
 }  // namespace
+
+void print_joint_map(FILE* out, const Skeleton& skeleton, const JointRoleIndices& roles) {
+  std::fprintf(out, "joint map:\n");
+  for (const JointRoleInfo& role : kJointRoles) {
+    const int joint = roles.*role.index;
+    const bool known = joint >= 0 && joint < skeleton.joint_count();
+    std::fprintf(out, "  %-16.*s %s%s\n", static_cast<int>(role.name.size()), role.name.data(),
+                 known ? skeleton.name(joint).c_str() : "-",
+                 known ? "" : (role.required ? "  (required, missing)" : "  (absent)"));
+  }
+}
 
 void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
                             const std::string& idle_source) {
@@ -56,14 +63,9 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
   } else {
     std::fprintf(out, "idle:        none\n");
   }
-  std::fprintf(out, "joints:      %d (joint 0 '%s'); roles:", db.joint_count(),
+  std::fprintf(out, "joints:      %d (joint 0 '%s')\n", db.joint_count(),
                db.joint_count() ? db.skeleton.name(0).c_str() : "-");
-  for (const JointRoleInfo& role : kJointRoles) {
-    std::fprintf(out, "%s %.*s %s", &role == kJointRoles.data() ? "" : ",",
-                 static_cast<int>(role.name.size()), role.name.data(),
-                 role_name(db, db.roles.*role.index).c_str());
-  }
-  std::fprintf(out, "\n");
+  print_joint_map(out, db.skeleton, db.roles);
   std::fprintf(out, "features:    %d dimensions in %zu channels:", db.feature_dims(),
                db.schema.channels.size());
   for (const FeatureChannel& c : db.schema.channels) std::fprintf(out, " %s", c.name.c_str());

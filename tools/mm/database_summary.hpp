@@ -18,6 +18,9 @@ namespace mm::cli {
 void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
                             const std::string& idle_source = {});
 
+// Prints one line per joint role: its name and the joint that plays it ("-" when absent).
+void print_joint_map(FILE* out, const Skeleton& skeleton, const JointRoleIndices& roles);
+
 // Prints one line per feature channel: name, kind, bone or times, columns, weight, and the
 // per-column mean and standard deviation (the normalization's offset and scale * weight).
 void print_feature_statistics(FILE* out, const Database& db);

@@ -182,12 +182,17 @@ class BvhParser {
         scale_(options.scale) {}
 
   Result<Clip> run() {
-    if (!std::isfinite(scale_) || !(scale_ > 0.0f)) {
+    if (!std::isfinite(scale_) || !(scale_ >= 0.0f)) {
       return Error{std::string(path_) +
-                   ": expected BvhOptions::scale to be finite and > 0, found " +
+                   ": expected BvhOptions::scale to be finite and >= 0 (0: automatic), found " +
                    std::to_string(scale_)};
     }
+    // Automatic units: the offsets are read as they are, then scaled once the skeleton's size
+    // is known.
+    const bool automatic = scale_ == 0.0f;
+    if (automatic) scale_ = 1.0f;
     if (auto error = parse_hierarchy()) return std::move(*error);
+    if (automatic) apply_scale(bvh_units_to_metres(rest_extent()));
     if (auto error = parse_motion_header()) return std::move(*error);
     if (auto error = parse_frames()) return std::move(*error);
     return build_clip();
@@ -361,6 +366,7 @@ class BvhParser {
     names_.emplace_back(name);
     parents_.push_back(parent);
     layouts_.push_back(layout);
+    end_sites_.emplace_back(0.0f);
     open_.push_back({joint, keyword_line});
     return nullptr;
   }
@@ -375,9 +381,30 @@ class BvhParser {
     if (auto error = expect_keyword("{", [] { return std::string("after 'End Site'"); })) {
       return error;
     }
-    glm::vec3 ignored{0.0f};
-    if (auto error = read_offset(owner, ignored)) return error;
+    glm::vec3 offset{0.0f};
+    if (auto error = read_offset(owner, offset)) return error;
+    glm::vec3& kept = end_sites_[static_cast<size_t>(open_.back().joint)];
+    if (kept == glm::vec3(0.0f)) kept = offset;  // the first End Site of a joint
     return expect_keyword("}", [&] { return "closing " + owner(); });
+  }
+
+  // The largest distance from the root of any joint or End Site in the rest pose, in file units.
+  float rest_extent() const {
+    std::vector<glm::vec3> position(layouts_.size());
+    float extent = 0.0f;
+    for (size_t j = 0; j < layouts_.size(); ++j) {
+      const int parent = parents_[j];
+      position[j] = parent < 0 ? glm::vec3(0.0f) : position[parent] + layouts_[j].offset;
+      extent =
+          std::max({extent, glm::length(position[j]), glm::length(position[j] + end_sites_[j])});
+    }
+    return extent;
+  }
+
+  void apply_scale(float scale) {
+    scale_ = scale;
+    for (JointLayout& layout : layouts_) layout.offset *= scale;
+    for (glm::vec3& end : end_sites_) end *= scale;
   }
 
   MaybeError parse_hierarchy() {
@@ -650,6 +677,7 @@ class BvhParser {
     clip.frame_time = frame_time_;
     clip.frame_count = declared_frames_;
     clip.local = std::move(local_);
+    clip.end_sites = std::move(end_sites_);
     return clip;
   }
 
@@ -669,6 +697,7 @@ class BvhParser {
   std::vector<std::string> names_;
   std::vector<int> parents_;
   std::vector<JointLayout> layouts_;
+  std::vector<glm::vec3> end_sites_;  // per joint, zero when it has none
   std::vector<int> channel_counts_;
   std::vector<int64_t> channel_count_line_;
   std::vector<OpenJoint> open_;
@@ -677,6 +706,13 @@ class BvhParser {
 };
 
 }  // namespace
+
+float bvh_units_to_metres(float extent) {
+  if (extent < 5.0f) return 1.0f;      // metres: a person is 1-2 m tall
+  if (extent < 50.0f) return 0.0254f;  // inches: 40-80
+  if (extent < 500.0f) return 0.01f;   // centimetres: 100-200
+  return 0.001f;                       // millimetres
+}
 
 Result<Clip> parse_bvh(std::string_view text, std::string_view path_for_messages,
                        const BvhOptions& options) {

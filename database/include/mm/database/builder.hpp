@@ -58,8 +58,11 @@ struct BuildOptions {
   std::filesystem::path tags_file;
   // Tag rules applied in addition to the manifest's (for programs that build in memory).
   std::vector<TagRule> tag_rules;
-  // Which joints are the hips, feet, toes and head.
+  // The name candidates of every joint role (joint_roles.hpp).
   JointRoles roles;
+  // Roles named by a map file or --role: each makes its joint the role's only candidate, and a
+  // joint it names must exist in every clip's skeleton.
+  std::vector<JointRoleAssignment> role_map;
   // How the simulation root (joint 0) is derived.
   SimulationRootOptions root;
   // How foot contacts are detected.

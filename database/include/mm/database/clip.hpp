@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "mm/runtime/result.hpp"
 #include "mm/runtime/skeleton.hpp"
 #include "mm/runtime/transform.hpp"
@@ -21,6 +23,9 @@ struct Clip {
   int frame_count = 0;
   // frame_count * joint_count local transforms, frame-major: local[f * joint_count + j].
   std::vector<Transform> local;
+  // Per joint: the offset of its End Site (a BVH leaf's tip, metres, in the joint's frame), zero
+  // where it has none. Empty when the importer knows of none (glTF).
+  std::vector<glm::vec3> end_sites;
 
   int joint_count() const { return skeleton.joint_count(); }
   float duration() const { return frame_count > 1 ? (frame_count - 1) * frame_time : 0.0f; }

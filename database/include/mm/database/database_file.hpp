@@ -4,7 +4,7 @@
 // string length, a 64-bit checksum over the whole file and finally Database::validate() are all
 // checked, and any failure comes back as a message naming the file, the section and the index.
 //
-// Layout of format version 2 (all integers and floats in the writer's native byte order, which
+// Layout of format version 3 (all integers and floats in the writer's native byte order, which
 // the endianness marker pins down; offsets in bytes from the start of the file). docs/
 // database-file.md explains the choices and the measurements behind them.
 //
@@ -17,9 +17,7 @@
 //   28   section_count    uint32   kDatabaseSectionCount
 //   32   joint_count, frame_count, clip_count, tag_count, feature_dims, channel_count: uint32 each
 //   56   frame_time       float32  seconds
-//   60   roles            int32 per row of kJointRoles, in its order (hips, left_foot,
-//                                  right_foot, left_toe, right_toe, head)
-//   84   reserved         uint32   0
+//   60   reserved         28 bytes of zeros
 //   88   section table    kDatabaseSectionCount x {uint64 offset, uint64 length}, in
 //                                  DatabaseSection order
 //   ...  sections         each at a 16-byte aligned offset, in table order, zero padding between
@@ -67,9 +65,10 @@
 
 namespace mm {
 
-// The format version this program writes and the only one it reads. Version 1 (every array
-// stored per frame and joint, velocities included) is refused with a message to rebuild.
-inline constexpr uint32_t kDatabaseFormatVersion = 2;
+// The format version this program writes and the only one it reads. Older versions are refused
+// with a message to rebuild: version 1 stored every array per frame and joint, velocities
+// included; version 2 held six joint roles in the header instead of the humanoid map's section.
+inline constexpr uint32_t kDatabaseFormatVersion = 3;
 // The value written in the endianness field; read back byte-swapped on a machine of the other
 // byte order.
 inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
@@ -77,12 +76,13 @@ inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
 inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M',  'M',  'D',
                                                                 '\r', '\n', 0x1A, '\n'};
 
-// The sections of a version-2 file, in the order they appear in the table and in the file.
+// The sections of a version-3 file, in the order they appear in the table and in the file.
 enum class DatabaseSection : uint32_t {
   Schema = 0,          // feature channels (variable records)
   SkeletonNames,       // joint names (string list)
   SkeletonParents,     // int32 per joint
   SkeletonRest,        // rest transform per joint (10 floats)
+  SkeletonRoles,       // int32 joint (or -1) per row of kJointRoles, in its order
   Clips,               // clip records
   TagNames,            // string list
   PositionColumns,     // uint8 per clip and joint: 1 constant in the clip, 0 varying
@@ -98,7 +98,7 @@ enum class DatabaseSection : uint32_t {
   Searchable,          // uint8 per frame
   Count,               // not a section: the number of sections
 };
-// Number of sections in a version-2 file.
+// Number of sections in a version-3 file.
 inline constexpr size_t kDatabaseSectionCount = static_cast<size_t>(DatabaseSection::Count);
 // Size of the fixed header including the section table (88 + 16 per section), rounded up to 16
 // bytes.
@@ -131,7 +131,6 @@ struct DatabaseFileInfo {
   uint32_t feature_dims = 0;    // columns of the feature matrix
   uint32_t channel_count = 0;   // feature schema channels
   float frame_time = 0.0f;      // seconds between frames
-  JointRoleIndices roles;       // as stored (range-checked by the full load only)
   std::array<DatabaseFileSection, kDatabaseSectionCount> sections{};  // in DatabaseSection order
   uint64_t stored_checksum = 0;  // the last 8 bytes of the file (0 when not read)
 

@@ -29,10 +29,15 @@ namespace mm {
 
 // JointRoles (the names each role may have) and the role table are in joint_roles.hpp.
 
-// Finds every role in `skeleton`. Hips and both feet are required (the default features and
-// the contacts need them): a missing one is an error naming the role, the names looked for and
-// the skeleton's joints. Toes and head are optional (-1 when absent).
+// Finds every role in `skeleton`, by name and then by structure (joint_roles.hpp). The hips,
+// upper legs, lower legs and feet are required: a missing one is an error naming the role, the
+// names looked for and the skeleton's joints; legs whose joints are not one chain below the hips
+// are refused too. Every other role is optional (-1 when absent).
 Result<JointRoleIndices> find_joint_roles(const Skeleton& skeleton, const JointRoles& roles);
+
+// Every joint a map (or --role) names exists in `skeleton`; otherwise an error naming the map
+// file and line, the role and the skeleton's joints.
+Status check_joint_map(const Skeleton& skeleton, std::span<const JointRoleAssignment> assignments);
 
 // ---- Mirroring -----------------------------------------------------------------------------
 

@@ -2,9 +2,9 @@
 // BVH (Biovision Hierarchy) importer: text in, Clip out, in one pass over the buffer.
 //
 // What it produces:
-// - Joints in file (depth-first) order, names kept. End Sites are not joints: their offsets
-//   are read and validated, then dropped, because they carry no channels and nothing animates
-//   them.
+// - Joints in file (depth-first) order, names kept. End Sites are not joints (they carry no
+//   channels and nothing animates them); the first End Site offset of each joint is kept in
+//   Clip::end_sites, where retargeting finds the direction of a bone that has no child joint.
 // - Rest transform of a joint = its OFFSET (scaled to metres), identity rotation.
 // - Per-frame local transform: the translation is the OFFSET, with every position channel the
 //   joint has replacing the matching component (the convention of the BVH files we read: their
@@ -29,10 +29,16 @@ namespace mm {
 
 // Settings of the BVH importer.
 struct BvhOptions {
-  // Multiplies every OFFSET and position channel: source units to metres. The BVH files of
-  // this project are in centimetres, hence 0.01. Must be finite and > 0.
+  // Multiplies every OFFSET and position channel: source units to metres. The Bandai files are
+  // in centimetres, hence 0.01. 0 picks the units from the skeleton's size (see
+  // bvh_units_to_metres). Must be finite and >= 0.
   float scale = 0.01f;
 };
+
+// The scale from file units to metres of a skeleton whose joints and End Sites reach at most
+// `extent` file units from its root in the rest pose (a person's reaches 0.7-1.1 m): metres
+// below 5, inches below 50, centimetres below 500, millimetres above.
+float bvh_units_to_metres(float extent);
 
 // Parses the whole text of a BVH file. path_for_messages names the file in error messages and
 // becomes the clip's source_path; its stem becomes the clip's name.
