@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include "large_arrays.hpp"
@@ -16,6 +18,7 @@
 #include "mm/database/files.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/database/io/gltf.hpp"
+#include "mm/database/retarget.hpp"
 #include "mm/runtime/workers.hpp"
 
 namespace mm {
@@ -167,22 +170,6 @@ Result<int> idle_frame_count(const BuildOptions& options) {
   return frames;
 }
 
-std::string topology_difference(const Skeleton& a, const Skeleton& b) {
-  if (a.joint_count() != b.joint_count()) {
-    return std::to_string(b.joint_count()) + " joints instead of " +
-           std::to_string(a.joint_count());
-  }
-  for (int j = 0; j < a.joint_count(); ++j) {
-    const std::string parent_a = a.parent(j) < 0 ? "none" : a.name(a.parent(j));
-    const std::string parent_b = b.parent(j) < 0 ? "none" : b.name(b.parent(j));
-    if (a.name(j) != b.name(j) || parent_a != parent_b) {
-      return "joint " + std::to_string(j) + " is '" + b.name(j) + "' (parent " + parent_b +
-             ") instead of '" + a.name(j) + "' (parent " + parent_a + ")";
-    }
-  }
-  return "the same joints";
-}
-
 // Checks the options before any input is read; returns the idle clip's frame count.
 Result<int> check_build_options(const BuildOptions& options, size_t input_count) {
   if (!(options.rate > 0.0f) || !(options.rate <= 1000.0f)) {
@@ -248,6 +235,13 @@ struct BuildState {
   std::vector<ClipJob> jobs;
   std::vector<std::vector<std::string>> clip_tag_lists;  // per database clip
   size_t total_frames = 0;
+  // The skeleton other skeletons are retargeted onto (the reference input's), once needed.
+  std::optional<RetargetSkeleton> retarget_target;
+  // Per retargeted source skeleton: its line in rep.retargeted and its clip count.
+  std::map<std::string, std::pair<size_t, size_t>> retargeted;
+  // The "idle" tag bit when clips of the data carry it (then no idle clip is synthesized).
+  uint64_t data_idle_tag = 0;
+  bool synthesize_idle = false;
 };
 
 // Phase 1, parallel over inputs: import, validate, resample, find roles.
@@ -283,8 +277,58 @@ void import_inputs(BuildState& state, const Load& load) {
   });
 }
 
-// Phase 2a, in input order: refuses what failed or does not match the first skeleton; returns
-// the index of the first usable input, whose skeleton the database takes.
+// Joint names and parents: equal for skeletons of the same topology.
+std::string topology_key(const RetargetSkeleton& s) {
+  std::string key;
+  for (int j = 0; j < s.skeleton.joint_count(); ++j) {
+    key += s.skeleton.name(j) + "/" + std::to_string(s.skeleton.parent(j)) + ";";
+  }
+  return key;
+}
+
+// One summary line per source skeleton that was retargeted.
+std::string retarget_summary(const std::string& input, size_t clips, const RetargetReport& r) {
+  std::string line = "skeleton of " + input + ": " + std::to_string(clips) +
+                     " clip(s) retargeted, " + std::to_string(r.matched.size()) +
+                     " joints matched, scale " + std::to_string(r.scale) + ", left at rest:";
+  for (const std::string& joint : r.left_at_rest) line += " " + joint;
+  return r.left_at_rest.empty() ? line + " none" : line;
+}
+
+// Phase 2a for an input on another skeleton than the reference's: its clips become clips of the
+// reference skeleton (retarget.hpp).
+Status retarget_input(BuildState& state, size_t reference_index, size_t i) {
+  const InputResult& reference = state.results[reference_index];
+  InputResult& result = state.results[i];
+  if (!state.retarget_target) {
+    Result<RetargetSkeleton> target = describe_for_retargeting(reference.clips[0], reference.roles);
+    if (!target) return Error{state.input_names[reference_index] + ": " + target.message()};
+    state.retarget_target = std::move(target).value();
+  }
+  Result<RetargetSkeleton> source = describe_for_retargeting(result.clips[0], result.roles);
+  if (!source) return Error{state.input_names[i] + ": " + source.message()};
+  RetargetReport report;
+  for (Clip& clip : result.clips) {
+    Result<Clip> moved = retarget_clip(clip, *source, *state.retarget_target, &report);
+    if (!moved) return Error{state.input_names[i] + ": " + moved.message()};
+    clip = std::move(moved).value();
+  }
+  result.roles = reference.roles;
+  // One line per source skeleton: inputs on a skeleton already reported add their clips to it.
+  const std::string key = topology_key(*source);
+  auto& [line_index, clips] = state.retargeted[key];
+  if (clips == 0) {
+    line_index = state.rep.retargeted.size();
+    state.rep.retargeted.emplace_back();
+  }
+  clips += result.clips.size();
+  state.rep.retargeted[line_index] = retarget_summary(state.input_names[i], clips, report);
+  return Status::success();
+}
+
+// Phase 2a, in input order: refuses what failed and retargets inputs of other skeletons onto
+// the first one's; returns the index of the first usable input, whose skeleton the database
+// takes.
 Result<size_t> choose_reference_input(BuildState& state) {
   const InputResult* reference = nullptr;
   size_t reference_index = 0;
@@ -295,10 +339,7 @@ Result<size_t> choose_reference_input(BuildState& state) {
     Status status = result.status;
     if (status && reference &&
         !reference->clips[0].skeleton.same_topology(result.clips[0].skeleton)) {
-      status = Error{state.input_names[i] + ": its skeleton differs from that of " +
-                     state.input_names[reference_index] + ": " +
-                     topology_difference(reference->clips[0].skeleton, result.clips[0].skeleton) +
-                     "; every clip of a database needs the same joints and parents"};
+      status = retarget_input(state, reference_index, i);
     }
     if (!status) {
       if (!state.options.skip_bad) return Error{status.message()};
@@ -371,9 +412,14 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
       }
     }
   }
+  // Real idle clips in the data replace the synthesized one, which is only the fallback.
+  const bool data_idles = std::any_of(
+      state.clip_tag_lists.begin(), state.clip_tag_lists.end(),
+      [](const auto& tags) { return std::find(tags.begin(), tags.end(), kIdleTag) != tags.end(); });
+  state.synthesize_idle = idle_frames > 0 && !data_idles;
   // The idle clip's frames are reserved now so that the arrays are allocated once; which pose
   // they hold is known only after phase 3 (it needs the contacts and velocities).
-  if (idle_frames > 0) {
+  if (state.synthesize_idle) {
     ClipRange range;
     range.name = kIdleClipName;
     range.start = static_cast<int>(state.total_frames);
@@ -391,7 +437,9 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
     tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
     state.clip_tag_lists.push_back(std::move(tags));
   }
-  return assign_tags(db, state.clip_tag_lists);
+  if (Status s = assign_tags(db, state.clip_tag_lists); !s) return s;
+  if (data_idles) state.data_idle_tag = db.tag_mask(std::vector<std::string>{kIdleTag});
+  return Status::success();
 }
 
 // Phase 2d: the database arrays, sized. The per-frame ones are left unwritten (large_arrays.hpp):
@@ -431,6 +479,8 @@ Status process_clips(BuildState& state) {
       Clip mirrored;
       if (job.mirrored) mirrored = mirror_clip(source, state.mirror_map);
       const Clip& clip = job.mirrored ? mirrored : source;
+      PreprocessOptions preprocess = state.context.preprocess;
+      preprocess.root.fixed = (range.tags & state.data_idle_tag) != 0;
       const size_t first = static_cast<size_t>(range.start) * joints;
       const size_t count = static_cast<size_t>(range.frame_count()) * joints;
       const std::span<glm::vec3> positions = std::span(db.local_positions).subspan(first, count);
@@ -442,9 +492,8 @@ Status process_clips(BuildState& state) {
                                  std::span(db.contacts)
                                      .subspan(static_cast<size_t>(range.start) * 2,
                                               static_cast<size_t>(range.frame_count()) * 2)};
-      Status status =
-          preprocess_clip(clip, state.results[job.input].roles, state.context.preprocess, out,
-                          state.scratch[static_cast<size_t>(worker)].preprocess);
+      Status status = preprocess_clip(clip, state.results[job.input].roles, preprocess, out,
+                                      state.scratch[static_cast<size_t>(worker)].preprocess);
       if (status) {
         extract_range_features(db, range, state.bones,
                                state.scratch[static_cast<size_t>(worker)].features);
@@ -579,7 +628,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   phase_start = Clock::now();
 
   if (Status s = process_clips(state); !s) return Error{s.message()};
-  if (*idle_frames > 0) {
+  if (state.synthesize_idle) {
     if (Status s = add_idle_clip(state); !s) return Error{s.message()};
   }
   rep.process_seconds = seconds_since(phase_start);

@@ -417,6 +417,23 @@ bool compute_local_velocities(std::span<const glm::vec3> positions,
   return first && inside && last;
 }
 
+namespace {
+
+// Every position becomes the mean position and every direction the mean direction (the raw
+// directions where they cancel out).
+void hold_at_mean(std::vector<glm::vec3>& positions, std::vector<glm::vec3>& directions) {
+  glm::dvec3 position(0.0), direction(0.0);
+  for (const glm::vec3& p : positions) position += glm::dvec3(p);
+  for (const glm::vec3& d : directions) direction += glm::dvec3(d);
+  const double n = static_cast<double>(std::max<size_t>(positions.size(), 1));
+  std::fill(positions.begin(), positions.end(), glm::vec3(position / n));
+  if (glm::length(direction) > 1e-6 * n) {
+    std::fill(directions.begin(), directions.end(), glm::vec3(glm::normalize(direction)));
+  }
+}
+
+}  // namespace
+
 Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
                        const PreprocessOptions& options, ProcessedClip& out,
                        PreprocessScratch& scratch) {
@@ -516,6 +533,7 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
     }
   }
 
+  if (options.root.fixed) hold_at_mean(scratch.positions, scratch.directions);
   // Joint 0 positions (smoothed or not) go straight into the output.
   smooth_gaussian_linear(scratch.positions, options.root.position_smoothing / dt, scratch.smoothed,
                          scratch.weights);

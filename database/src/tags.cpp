@@ -109,6 +109,10 @@ Result<std::vector<TagRule>> load_tag_manifest(const std::filesystem::path& path
 
 std::vector<std::string> tags_from_name(std::string_view clip_name) {
   const std::vector<std::string_view> parts = split(clip_name, '_');
+  if (parts.size() == 2 && !parts[0].empty() && all_digits(parts[0]) &&
+      (parts[1] == "genuine" || parts[1] == "acted")) {
+    return {"idle", "reactidle", std::string(parts[1])};  // sorted
+  }
   if (parts.size() != 4 || parts[0].substr(0, 8) != "dataset-" || !all_digits(parts[0].substr(8)) ||
       parts[1].empty() || parts[2].empty() || !all_digits(parts[3])) {
     return {};

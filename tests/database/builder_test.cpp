@@ -380,34 +380,59 @@ TEST(BuilderBadInputs, BrokenFileIsNamedAndSkippedOnRequest) {
   EXPECT_NE(report.refused[0].message.find("b_broken.bvh"), std::string::npos);
 }
 
-TEST(BuilderBadInputs, DifferentSkeletonIsRefused) {
+TEST(BuilderMixedSkeletons, AnotherSkeletonIsRetargetedOntoTheFirst) {
   const fs::path dir = test::scratch_dir();
   fs::copy_file(test::clip_path(kClips[0]), dir / "a_walk.bvh");
   std::ofstream(dir / "z_other.bvh") << other_skeleton_bvh();
   const fs::path inputs[] = {dir};
-  Result<Database> db = build_database(inputs, BuildOptions{});
-  ASSERT_FALSE(db);
-  EXPECT_NE(db.message().find("z_other.bvh"), std::string::npos) << db.message();
-  EXPECT_NE(db.message().find("skeleton differs"), std::string::npos) << db.message();
-  EXPECT_NE(db.message().find("7 joints instead of 22"), std::string::npos) << db.message();
-
-  BuildOptions skip;
-  skip.skip_bad = true;
-  skip.idle_seconds = 0.0f;  // the clips of the good files only
+  BuildOptions options;
+  options.idle_seconds = 0.0f;
   BuildReport report;
-  db = build_database(inputs, skip, &report);
+  Result<Database> db = build_database(inputs, options, &report);
   ASSERT_TRUE(db) << db.message();
-  EXPECT_EQ(db->clips.size(), 1u);
-  ASSERT_EQ(report.refused.size(), 1u);
-  EXPECT_EQ(report.refused[0].path.filename(), "z_other.bvh");
+  ASSERT_EQ(db->clips.size(), 2u);
+  EXPECT_EQ(db->joint_count(), 23);  // the Bandai skeleton and the simulation root
+  ASSERT_EQ(report.retargeted.size(), 1u);
+  EXPECT_NE(report.retargeted[0].find("z_other.bvh: 1 clip(s) retargeted"), std::string::npos)
+      << report.retargeted[0];
+  // The other skeleton has no arms, spine or toes: those Bandai joints stay at rest.
+  EXPECT_NE(report.retargeted[0].find("UpperArm_L"), std::string::npos) << report.retargeted[0];
 
-  // On its own the other skeleton builds: its joints have known role names.
-  const fs::path other[] = {dir / "z_other.bvh"};
-  db = build_database(other, BuildOptions{});
+  // A skeleton whose legs cannot be found is refused, naming the file and the role.
+  std::ofstream(dir / "zz_legless.bvh")
+      << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 90 0\n  CHANNELS 3 Xposition Yposition "
+         "Zposition\n  JOINT LeftFoot\n  {\n    OFFSET 10 -80 0\n    CHANNELS 0\n  }\n  JOINT "
+         "RightFoot\n  {\n    OFFSET -10 -80 0\n    CHANNELS 0\n  }\n}\nMOTION\nFrames: 2\n"
+         "Frame Time: 0.0333333\n0 90 0\n0 90 1\n";
+  db = build_database(inputs, options, &report);
+  ASSERT_FALSE(db);
+  EXPECT_NE(db.message().find("zz_legless.bvh"), std::string::npos) << db.message();
+  EXPECT_NE(db.message().find("required role 'left_upper_leg'"), std::string::npos) << db.message();
+}
+
+// Real idle clips (ReActIdle, on another skeleton) are retargeted, tagged idle, stand still at
+// joint 0 and replace the synthesized held-frame idle clip.
+TEST(BuilderMixedSkeletons, ReActIdleClipsBecomeStillStandingIdleClips) {
+  const fs::path inputs[] = {test::clip_path(kClips[0]),
+                             test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh"};
+  BuildOptions options;
+  options.bvh.scale = 0.0f;  // centimetres and metres
+  BuildReport report;
+  Result<Database> db = build_database(inputs, options, &report);
   ASSERT_TRUE(db) << db.message();
-  EXPECT_EQ(db->joint_count(), 8);
-  EXPECT_EQ(db->roles.left_foot, 4);
-  EXPECT_EQ(db->roles.left_toe, -1);
+  ASSERT_EQ(db->clips.size(), 2u);  // no synthesized idle clip
+  EXPECT_EQ(report.idle_frames, 0);
+  const ClipRange& idle = db->clips[1];
+  EXPECT_NE(idle.tags & db->tag_mask(std::vector<std::string>{"idle"}), 0u);
+  const size_t joints = static_cast<size_t>(db->joint_count());
+  const size_t first = static_cast<size_t>(idle.start) * joints;
+  for (int f = idle.start; f < idle.end; f += 50) {
+    const size_t at = static_cast<size_t>(f) * joints;
+    EXPECT_EQ(db->local_positions[at], db->local_positions[first]) << f;
+    EXPECT_EQ(db->local_rotations[at], db->local_rotations[first]) << f;
+  }
+  // The walk's joint 0 moves.
+  EXPECT_NE(db->local_positions[0], db->local_positions[joints * 30]);
 }
 
 TEST(BuilderBadInputs, MissingPathsEmptyFoldersAndBadOptions) {

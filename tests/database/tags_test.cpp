@@ -113,5 +113,13 @@ TEST(ClipTags, SwapLeftRight) {
   EXPECT_EQ(swap_left_right("bright-light"), "bright-light");
 }
 
+TEST(TagsFromName, ReActIdleNamesAreIdle) {
+  EXPECT_EQ(tags_from_name("003_genuine"),
+            (std::vector<std::string>{"idle", "reactidle", "genuine"}));
+  EXPECT_EQ(tags_from_name("012_acted"), (std::vector<std::string>{"idle", "reactidle", "acted"}));
+  EXPECT_TRUE(tags_from_name("x03_genuine").empty());
+  EXPECT_TRUE(tags_from_name("003_genuinely").empty());
+}
+
 }  // namespace
 }  // namespace mm

@@ -3,7 +3,8 @@
 //
 // Four phases. 1, parallel over inputs (workers pull input indices from a shared counter):
 // import (BVH or glTF), validate, resample to the database rate, find the joint roles. 2, in
-// input order: refuse failed inputs and skeletons other than the first input's, lay out the
+// input order: refuse failed inputs, retarget the clips of skeletons other than the first
+// input's onto it (retarget.hpp; one line per source skeleton in the report), lay out the
 // clip ranges (a mirrored copy right after its original), their tags and the database arrays.
 // 3, parallel over clips, each worker with its own reusable buffers: preprocess (simulation
 // root, velocities, contacts; see preprocess.hpp) and extract the raw features
@@ -12,7 +13,10 @@
 // result. Every per-clip step is independent of the others and the statistics are summed in
 // frame order, so the output is byte-for-byte the same whatever the number of threads.
 //
-// The idle clip (idle.hpp): unless options.idle_seconds is 0, phase 2 also reserves one clip
+// Idle clips of the data (tagged "idle" by name, e.g. ReActIdle's; see tags.hpp) keep joint 0
+// still at their mean place and facing (SimulationRootOptions::fixed), and replace the
+// synthesized idle clip. Without them, the synthesized one (idle.hpp): unless
+// options.idle_seconds is 0, phase 2 also reserves one clip
 // named "idle" and tagged "idle" after every other clip, and between phases 3 and 4 it is
 // filled with the calmest frame that stands on both feet, held still, and its raw features are
 // extracted like any clip's, so phase 4 normalizes them with the rest. When no frame
@@ -105,6 +109,9 @@ struct BuildReport {
   std::string idle_source_clip;       // the clip whose frame the idle clip holds
   int idle_source_frame = -1;         // that frame, counted from the start of its clip
   std::vector<std::string> warnings;  // e.g. feature channels that do not vary, no idle clip
+  // One line per source skeleton retargeted onto the database's: its first input, clips,
+  // joints matched, scale and the database joints left at rest.
+  std::vector<std::string> retargeted;
   std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)
 };
 

@@ -86,6 +86,10 @@ struct SimulationRootOptions {
   // The same for the ground position; 0 (the default) keeps exactly the hips projected to the
   // ground, including the hips' +-3 cm sideways sway.
   float position_smoothing = 0.0f;
+  // Holds joint 0 still at the clip's mean ground position and mean facing (the two smoothings
+  // are then moot): the builder sets it for idle clips, whose sways and weight shifts must
+  // move the body, never the character.
+  bool fixed = false;
 };
 
 // How foot contacts are detected. A foot is in contact on a frame when its toe joint is low and
