@@ -2,7 +2,8 @@
 // Preprocessing: what happens to one imported Clip before it joins a Database.
 //
 //   resample_clip       -> the database rate (slerp rotations, lerp translations and scales)
-//   mirror_clip         -> optional left/right mirror across the YZ plane (x -> -x)
+//   mirror_clip         -> optional left/right mirror across the YZ plane (x -> -x), each
+//                          bone kept in its own axis convention
 //   preprocess_clip     -> simulation root (joint 0), joint velocities and angular velocities,
 //                          foot contacts, in the database's per-frame layout
 //
