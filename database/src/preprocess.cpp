@@ -194,8 +194,8 @@ struct RestMirror {
   std::vector<std::vector<int>> children;
   std::vector<Mat3> rest;  // rest local rotations
   std::vector<BonePairs> bones;
-  std::vector<Mat3> n;
-  std::vector<uint8_t> known;
+  std::vector<Mat3> n;         // per joint: N, its frame -> its partner's, reflected
+  std::vector<uint8_t> known;  // N is set
 };
 
 RestMirror start_rest_mirror(const Skeleton& skeleton, std::span<const int> map) {
@@ -258,9 +258,11 @@ void carry_down_chains(RestMirror& m, const Skeleton& skeleton, std::span<const 
   }
 }
 
-// Phase 4: mirroring twice must be the identity, M R N_{m(j)} ... N_j = R: a joint's map and its
-// partner's are inverses, and a joint that is its own partner's is an involution. The phases
-// above give that up to rounding; this makes it exact.
+// Phase 4: mirroring twice turns a joint's rotation R into R N_m(j) N_j, so a joint's map and its
+// partner's must be inverses, and the map of a joint that is its own partner an involution. The
+// phases above give that up to rounding and to the small left/right differences of a real
+// actor's rest offsets; this makes it exact (the later joint of a pair takes the inverse of the
+// earlier one's map).
 void pair_up(RestMirror& m, std::span<const int> map) {
   for (size_t j = 0; j < m.n.size(); ++j) {
     const size_t partner = static_cast<size_t>(map[j]);
