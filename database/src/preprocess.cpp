@@ -1,6 +1,7 @@
 #include "mm/database/preprocess.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -28,6 +29,249 @@ Transform reflect_x(const Transform& t) {
   out.translation.x = -t.translation.x;
   out.rotation = glm::quat(t.rotation.w, t.rotation.x, -t.rotation.y, -t.rotation.z);
   return out;
+}
+
+// ---- Mirroring: the per-joint correction of the reflected rotations -------------------------
+//
+// A mirrored joint's global rotation is M R N, with M the world reflection x -> -x and N an
+// improper matrix in the joint's own frame (det -1) that says how the partner's local axes
+// map onto the joint's. The correction mirror_clip applies is C = M N (a rotation). The
+// matrices here are in double: they are constants of the skeleton and mirroring twice must
+// give the clip back to float precision.
+
+using Mat3 = glm::dmat3;
+using Vec3 = glm::dvec3;
+
+const Mat3 kReflectX(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+
+// Eigenvalues and eigenvectors (the columns of `vectors`) of a symmetric matrix, by cyclic
+// Jacobi rotations; a[i][j] is row i, column j.
+template <size_t L>
+using Square = std::array<std::array<double, L>, L>;
+
+template <size_t L>
+void symmetric_eigen(Square<L> a, Square<L>& vectors, std::array<double, L>& values) {
+  for (size_t i = 0; i < L; ++i) {
+    for (size_t k = 0; k < L; ++k) vectors[i][k] = i == k ? 1.0 : 0.0;
+  }
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    double off = 0.0;
+    for (size_t p = 0; p < L; ++p) {
+      for (size_t q = p + 1; q < L; ++q) off += a[p][q] * a[p][q];
+    }
+    if (off < 1e-30) break;
+    for (size_t p = 0; p < L; ++p) {
+      for (size_t q = p + 1; q < L; ++q) {
+        if (std::abs(a[p][q]) < 1e-300) continue;
+        const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+        const double t =
+            (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        for (size_t k = 0; k < L; ++k) {  // A J
+          const double kp = a[k][p], kq = a[k][q];
+          a[k][p] = c * kp - s * kq;
+          a[k][q] = s * kp + c * kq;
+        }
+        for (size_t k = 0; k < L; ++k) {  // J^T (A J)
+          const double pk = a[p][k], qk = a[q][k];
+          a[p][k] = c * pk - s * qk;
+          a[q][k] = s * pk + c * qk;
+        }
+        for (size_t k = 0; k < L; ++k) {  // V J
+          const double kp = vectors[k][p], kq = vectors[k][q];
+          vectors[k][p] = c * kp - s * kq;
+          vectors[k][q] = s * kp + c * kq;
+        }
+      }
+    }
+  }
+  for (size_t i = 0; i < L; ++i) values[i] = a[i][i];
+}
+
+// The rotation R that best maps each from[i] onto to[i] (least squares), by Horn's method: the
+// quaternion is the eigenvector of the largest eigenvalue of a symmetric 4x4 matrix.
+Mat3 best_rotation(std::span<const Vec3> from, std::span<const Vec3> to) {
+  Mat3 s(0.0);  // s[i][k] = sum from_i * to_k
+  for (size_t n = 0; n < from.size(); ++n) {
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < 3; ++k) s[i][k] += from[n][i] * to[n][k];
+    }
+  }
+  const double xx = s[0][0], xy = s[0][1], xz = s[0][2], yx = s[1][0], yy = s[1][1];
+  const double yz = s[1][2], zx = s[2][0], zy = s[2][1], zz = s[2][2];
+  const Square<4> horn = {{{xx + yy + zz, yz - zy, zx - xz, xy - yx},
+                           {yz - zy, xx - yy - zz, xy + yx, zx + xz},
+                           {zx - xz, xy + yx, -xx + yy - zz, yz + zy},
+                           {xy - yx, zx + xz, yz + zy, -xx - yy + zz}}};
+  Square<4> vectors;
+  std::array<double, 4> values;
+  symmetric_eigen(horn, vectors, values);
+  const size_t best =
+      static_cast<size_t>(std::max_element(values.begin(), values.end()) - values.begin());
+  const glm::dquat q(vectors[0][best], vectors[1][best], vectors[2][best], vectors[3][best]);
+  return glm::mat3_cast(glm::normalize(q));
+}
+
+// The symmetric improper matrix nearest to `n` (a reflection or -I): what a joint that is its
+// own partner needs so that mirroring twice is the identity.
+Mat3 nearest_involution(const Mat3& n) {
+  const Mat3 sym = 0.5 * (n + glm::transpose(n));
+  Square<3> a, vectors;
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) a[i][k] = sym[k][i];
+  }
+  std::array<double, 3> values;
+  symmetric_eigen(a, vectors, values);
+  Mat3 out(0.0);
+  for (int e = 0; e < 3; ++e) {
+    const Vec3 v(vectors[0][e], vectors[1][e], vectors[2][e]);
+    out += (values[e] < 0.0 ? -1.0 : 1.0) * glm::outerProduct(v, v);
+  }
+  return out;
+}
+
+// The rest offsets of a joint's children paired with those of its partner's matching children
+// (child offset -> partner's child offset), longest first; negligible offsets are left out.
+struct BonePairs {
+  std::vector<Vec3> own, partner;
+};
+
+BonePairs bone_pairs(const Skeleton& skeleton, std::span<const int> map, int joint,
+                     const std::vector<std::vector<int>>& children) {
+  std::vector<std::pair<Vec3, Vec3>> pairs;
+  for (const int c : children[joint]) {
+    const int mc = map[c];
+    if (skeleton.parent(mc) != map[joint]) continue;  // not a mirror image of this bone
+    const Vec3 a(skeleton.rest(c).translation), b(skeleton.rest(mc).translation);
+    if (glm::length(a) > 1e-6 && glm::length(b) > 1e-6) pairs.emplace_back(a, b);
+  }
+  std::sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) {
+    return glm::length(x.first) > glm::length(y.first);
+  });
+  BonePairs out;
+  for (const auto& [a, b] : pairs) {
+    out.own.push_back(a);
+    out.partner.push_back(b);
+  }
+  return out;
+}
+
+// Whether the bones point in at least two directions (then they fix the whole frame).
+bool spans_a_plane(const BonePairs& bones) {
+  for (size_t i = 0; i < bones.own.size(); ++i) {
+    for (size_t k = i + 1; k < bones.own.size(); ++k) {
+      const Vec3 cross = glm::cross(glm::normalize(bones.own[i]), glm::normalize(bones.own[k]));
+      if (glm::length(cross) > 0.1) return true;
+    }
+  }
+  return false;
+}
+
+// Whether n maps the joint's (longest) bone onto the same side as the partner's.
+bool keeps_bone_direction(const Mat3& n, const BonePairs& bones) {
+  return bones.own.empty() || glm::dot(n * bones.own[0], bones.partner[0]) > 0.0;
+}
+
+// n composed with a half turn about its mirror normal (the axis the reflection negates, made
+// perpendicular to the bone): the bone then points the other way while the mirror plane stays.
+// This is how a partner whose rest offsets are the negated ones (every axis flipped, as in
+// rigs that mirror joint orientations by behaviour) relates to a parent mirrored by a plane.
+Mat3 flip_bone(const Mat3& n, const Vec3& bone) {
+  const glm::dquat rotation = glm::quat_cast(-n);  // -n is a rotation about the normal
+  const Vec3 b = glm::normalize(bone);
+  Vec3 normal(rotation.x, rotation.y, rotation.z);
+  normal -= glm::dot(normal, b) * b;
+  if (glm::length(normal) < 1e-9) {  // no plane: any axis across the bone will do
+    normal = glm::cross(b, std::abs(b.x) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
+  }
+  normal = glm::normalize(normal);
+  const Mat3 half_turn = 2.0 * glm::outerProduct(normal, normal) - Mat3(1.0);
+  return n * half_turn;
+}
+
+// What the corrections are computed from, and the improper maps found so far.
+struct RestMirror {
+  std::vector<std::vector<int>> children;
+  std::vector<Mat3> rest;  // rest local rotations
+  std::vector<BonePairs> bones;
+  std::vector<Mat3> n;         // per joint: N, its frame -> its partner's, reflected
+  std::vector<uint8_t> known;  // N is set
+};
+
+RestMirror start_rest_mirror(const Skeleton& skeleton, std::span<const int> map) {
+  const int joints = skeleton.joint_count();
+  RestMirror m;
+  m.children.resize(joints);
+  for (int j = 0; j < joints; ++j) {
+    if (skeleton.parent(j) >= 0) m.children[skeleton.parent(j)].push_back(j);
+  }
+  for (int j = 0; j < joints; ++j) {
+    m.rest.push_back(glm::mat3_cast(glm::dquat(skeleton.rest(j).rotation)));
+    m.bones.push_back(bone_pairs(skeleton, map, j, m.children));
+  }
+  m.n.assign(joints, Mat3(1.0));
+  m.known.assign(joints, 0);
+  return m;
+}
+
+// Phase 1: a joint whose bones point in several directions is mirrored by the improper map
+// that best takes its bones onto its partner's (N = M R, R the rotation taking each bone onto
+// the reflection of the partner's).
+void fit_branching_joints(RestMirror& m) {
+  for (size_t j = 0; j < m.n.size(); ++j) {
+    const BonePairs& bones = m.bones[j];
+    if (!spans_a_plane(bones)) continue;
+    std::vector<Vec3> reflected;
+    for (const Vec3& b : bones.partner) reflected.push_back(kReflectX * b);
+    m.n[j] = kReflectX * best_rotation(bones.own, reflected);
+    m.known[j] = 1;
+  }
+}
+
+// Phase 2, children first: a joint with one bone takes its child's map carried through the rest
+// rotations (a spine segment is oriented like the chest it carries), when that keeps the bone
+// on the partner's side.
+void carry_up_chains(RestMirror& m, std::span<const int> map) {
+  for (int j = static_cast<int>(m.n.size()) - 1; j >= 0; --j) {
+    if (m.known[j] || m.children[j].size() != 1 || m.bones[j].own.empty()) continue;
+    const int c = m.children[j][0];
+    if (!m.known[c]) continue;
+    const Mat3 carried = m.rest[map[c]] * m.n[c] * glm::transpose(m.rest[c]);
+    if (!keeps_bone_direction(carried, m.bones[j])) continue;
+    m.n[j] = carried;
+    m.known[j] = 1;
+  }
+}
+
+// Phase 3, parents first: every other joint takes its parent's map (a root the world's, M)
+// carried through the rest rotations, turned half a turn when its bone would point away from
+// the partner's.
+void carry_down_chains(RestMirror& m, const Skeleton& skeleton, std::span<const int> map) {
+  for (size_t j = 0; j < m.n.size(); ++j) {
+    if (m.known[j]) continue;
+    const int p = skeleton.parent(static_cast<int>(j));
+    const Mat3 parent = p < 0 ? kReflectX : m.n[p];
+    Mat3 carried = glm::transpose(m.rest[map[j]]) * parent * m.rest[j];
+    if (!keeps_bone_direction(carried, m.bones[j])) carried = flip_bone(carried, m.bones[j].own[0]);
+    m.n[j] = carried;
+    m.known[j] = 1;
+  }
+}
+
+// Phase 4: mirroring twice turns a joint's rotation R into R N_m(j) N_j, so a joint's map and its
+// partner's must be inverses, and the map of a joint that is its own partner an involution. The
+// phases above give that up to rounding and to the small left/right differences of a real
+// actor's rest offsets; this makes it exact (the later joint of a pair takes the inverse of the
+// earlier one's map).
+void pair_up(RestMirror& m, std::span<const int> map) {
+  for (size_t j = 0; j < m.n.size(); ++j) {
+    const size_t partner = static_cast<size_t>(map[j]);
+    if (partner == j) {
+      m.n[j] = nearest_involution(m.n[j]);
+    } else if (j < partner) {
+      m.n[partner] = glm::transpose(m.n[j]);
+    }
+  }
 }
 
 // Gaussian-weighted local linear fit of `in` at every frame (window +-3 sigma frames, cut at
@@ -308,6 +552,19 @@ void majority_filter(std::span<const uint8_t> in, int width, int stride, int off
 
 }  // namespace
 
+std::vector<glm::quat> mirror_corrections(const Skeleton& skeleton,
+                                          std::span<const int> joint_map) {
+  assert(static_cast<int>(joint_map.size()) == skeleton.joint_count());
+  RestMirror m = start_rest_mirror(skeleton, joint_map);
+  fit_branching_joints(m);
+  carry_up_chains(m, joint_map);
+  carry_down_chains(m, skeleton, joint_map);
+  pair_up(m, joint_map);
+  std::vector<glm::quat> out;
+  for (const Mat3& n : m.n) out.push_back(glm::normalize(glm::quat(glm::quat_cast(kReflectX * n))));
+  return out;
+}
+
 Clip mirror_clip(const Clip& clip, std::span<const int> joint_map) {
   const int joints = clip.joint_count();
   assert(static_cast<int>(joint_map.size()) == joints);
@@ -319,10 +576,14 @@ Clip mirror_clip(const Clip& clip, std::span<const int> joint_map) {
   out.frame_count = clip.frame_count;
   out.local.resize(clip.local.size());
   const std::vector<int>& parents = clip.skeleton.parents();
+  const std::vector<glm::quat> corrections = mirror_corrections(clip.skeleton, joint_map);
   std::vector<Transform> global(joints), mirrored(joints);
   for (int f = 0; f < clip.frame_count; ++f) {
     forward_kinematics(parents, clip.pose(f), global);
-    for (int j = 0; j < joints; ++j) mirrored[j] = reflect_x(global[joint_map[j]]);
+    for (int j = 0; j < joints; ++j) {
+      mirrored[j] = reflect_x(global[joint_map[j]]);
+      mirrored[j].rotation = mirrored[j].rotation * corrections[j];
+    }
     std::span<Transform> local = out.pose(f);
     for (int j = 0; j < joints; ++j) {
       const int p = parents[j];

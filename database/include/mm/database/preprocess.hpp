@@ -2,7 +2,8 @@
 // Preprocessing: what happens to one imported Clip before it joins a Database.
 //
 //   resample_clip       -> the database rate (slerp rotations, lerp translations and scales)
-//   mirror_clip         -> optional left/right mirror across the YZ plane (x -> -x)
+//   mirror_clip         -> optional left/right mirror across the YZ plane (x -> -x), each
+//                          bone kept in its own axis convention
 //   preprocess_clip     -> simulation root (joint 0), joint velocities and angular velocities,
 //                          foot contacts, in the database's per-frame layout
 //
@@ -54,11 +55,31 @@ struct MirrorPair {
 Result<std::vector<int>> mirror_joint_map(const Skeleton& skeleton,
                                           std::span<const MirrorPair> overrides = {});
 
-// The clip mirrored across the YZ plane: every joint's GLOBAL transform is taken from its
-// mirror joint (joint_map from mirror_joint_map) and reflected (position x -> -x, rotation
-// quat(w, x, y, z) -> quat(w, x, -y, -z)), then locals are recomputed from the globals, so
-// mirrored local translations may differ from the rest offsets. Named "<name>_mirror".
-// Mirroring twice gives the original back (up to float rounding).
+// The constant rotation C_j, per joint, that mirror_clip puts behind each reflected rotation so
+// that the joint keeps its own bone-axis convention. It is computed from the rest pose: a joint
+// is mirrored by N_j = M C_j (M = diag(-1, 1, 1), N_j improper, in the joint's frame), where
+// - a joint whose child bones point in several directions (hips, chest) takes the N that best
+//   maps its rest child offsets onto its partner's (the plane its side bones are mirrored by);
+// - a joint with one child takes the child's N carried through the rest rotations when that
+//   keeps its bone on the partner's bone's side (a spine segment follows the chest it carries);
+// - any other joint takes its parent's N (a root: M, the world's) carried through the rest
+//   rotations, turned half a turn about the mirror normal when its bone would point away from
+//   the partner's (limbs whose right-side offsets are the negated left ones);
+// - a joint and its partner get inverse maps, and a joint that is its own partner an
+//   involution, so that mirroring twice is the identity.
+// For a rest pose that is already symmetric across the world's YZ plane, N_j = Q_m(j)^-1 M Q_j
+// with Q the rest global rotations, so C_j = identity where a joint's rest frame is the mirror
+// of its partner's. The result depends only on the rest transforms and joint_map.
+std::vector<glm::quat> mirror_corrections(const Skeleton& skeleton, std::span<const int> joint_map);
+
+// The clip mirrored across the world's YZ plane (x -> -x; the character's left/right plane when
+// it faces +Z): every joint's GLOBAL transform is taken from its mirror joint (joint_map from
+// mirror_joint_map) and reflected (position x -> -x, rotation R -> M R M, as a quaternion
+// (w, x, -y, -z)), then turned by the joint's mirror_corrections so that its local axes keep
+// the joint's own convention (no half turns against the original's local rotations); locals
+// are recomputed from the globals. Global positions are exactly the reflected partner's; local
+// translations equal the rest offsets where the skeleton is left/right symmetric. Named
+// "<name>_mirror". Mirroring twice gives the original back (up to float rounding).
 Clip mirror_clip(const Clip& clip, std::span<const int> joint_map);
 
 // ---- Resampling ----------------------------------------------------------------------------
