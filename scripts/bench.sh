@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# The measurements: the controller on every shipped input script (mm eval table), the crowd
+# The measurements: the controller on every shipped input script (mm eval: a table of the
+# feet, tracking, responses, standing and transitions, then a second of the body metrics: hips
+# turn rate, foot pivot, turns on the spot, strafing chest, idle head, lowest toe), the crowd
 # benchmark, every search method, on the database of ../shared/mocap/bandai-normal (or
 # $MM_DATA). Builds Release first; writes JSON of each to out/.
 set -euo pipefail
@@ -14,7 +16,7 @@ mkdir -p out
 printf '\n=== 1/4 Building the motion database from %s ===\n' "$data"
 "$mm" build "$data" -o out/database.mmdb
 
-printf '\n=== 2/4 Scripted controller runs (mm eval, every script in scripts/input, dt 1/60, IK on) ===\n'
+printf '\n=== 2/4 Scripted controller runs (mm eval, every script in scripts/input, dt 1/60, IK on; two tables) ===\n'
 scripts=()
 for f in scripts/input/*.txt; do scripts+=(--script "$f"); done
 "$mm" eval --db out/database.mmdb "${scripts[@]}" --json out/eval.json

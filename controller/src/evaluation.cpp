@@ -1,11 +1,16 @@
-// Scripted evaluation: run, record every frame, then measure (definitions in evaluation.hpp).
+// Scripted evaluation: run, hand every frame to the accumulator, measure (definitions in
+// evaluation.hpp).
 
 #include "mm/controller/evaluation.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <numeric>
 
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
@@ -30,85 +35,409 @@ double percentile(std::vector<double>& values, double p) {
   return values[rank];
 }
 
-double mean(const std::vector<double>& values) {
-  if (values.empty()) return 0.0;
+// A mean kept as a sum and a count: 0 for no values.
+struct RunningMean {
   double sum = 0.0;
-  for (double v : values) sum += v;
-  return sum / static_cast<double>(values.size());
-}
-
-// What one frame of the run leaves behind.
-struct FrameRecord {
-  float t = 0.0f;
-  glm::vec3 sim_position{0.0f};
-  float sim_yaw = 0.0f;
-  glm::vec3 root_position{0.0f};
-  float root_yaw = 0.0f;
-  glm::vec3 desired_velocity{0.0f};
-  float desired_yaw = 0.0f;
-  bool transition = false;
-  bool contact[2] = {false, false};
-  double update_seconds = 0.0;
-  bool searched = false;
-  double search_seconds = 0.0;
+  int count = 0;
+  void add(double value) {
+    sum += value;
+    ++count;
+  }
+  double value() const { return count > 0 ? sum / count : 0.0; }
 };
 
-// Acceleration magnitudes (second differences) of every joint but joint 0 at frame f of a run
-// whose joint positions are `positions` (frames x joints).
-void joint_accelerations(const std::vector<glm::vec3>& positions, size_t joints, size_t f, float dt,
-                         std::vector<double>& out) {
-  const glm::vec3* a = positions.data() + (f - 1) * joints;
-  const glm::vec3* b = positions.data() + f * joints;
-  const glm::vec3* c = positions.data() + (f + 1) * joints;
-  for (size_t j = 1; j < joints; ++j) {
+// The absolute angle between two yaws, in degrees, in [0, 180].
+double yaw_error_deg(float a, float b) {
+  return std::abs(glm::degrees(wrap_angle(a - b)));
+}
+
+// The yaw of a horizontal direction, or `fallback` when it has no horizontal length.
+float direction_yaw(const glm::vec3& v, float fallback) {
+  return std::hypot(v.x, v.z) > 1e-6f ? std::atan2(v.x, v.z) : fallback;
+}
+
+// The body yaw of a left/right pair: the yaw of (L - R) x up = (-(L - R).z, 0, (L - R).x).
+float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback) {
+  const glm::vec3 across = left - right;
+  return direction_yaw(glm::vec3(-across.z, 0.0f, across.x), fallback);
+}
+
+// Whole frames covering `seconds` at dt (at least one), so a settle time is compared as a
+// frame count without float drift.
+int frames_for(float seconds, float dt) {
+  return std::max(1, static_cast<int>(std::ceil(seconds / dt - 1e-3f)));
+}
+
+// Acceleration magnitudes (second differences) of every joint but joint 0 from three
+// consecutive frames' joint positions.
+void joint_accelerations(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                         std::span<const glm::vec3> c, float dt, std::vector<double>& out) {
+  for (size_t j = 1; j < b.size(); ++j) {
     out.push_back(glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt));
   }
 }
 
-void measure_responses(const std::vector<FrameRecord>& frames, float dt, EvaluationMetrics& m) {
-  // Speed: events where the desired speed jumps; done when the root speed is close to it.
-  std::vector<double> speed_times, heading_times;
-  int speed_start = -1, heading_start = -1;
-  float speed_from = 0.0f, speed_to = 0.0f, heading_to = 0.0f;
-  for (size_t f = 1; f < frames.size(); ++f) {
-    const FrameRecord& r = frames[f];
-    const float desired = glm::length(r.desired_velocity);
-    const float previous = glm::length(frames[f - 1].desired_velocity);
-    if (std::abs(desired - previous) >= kSpeedEventChange) {
-      if (speed_start >= 0) ++m.speed_events;
-      speed_start = static_cast<int>(f);
-      speed_from = previous;
-      speed_to = desired;
+// How long a value has stayed within a tolerance of the value it was last held at.
+struct HeldValue {
+  glm::vec3 anchor{0.0f};
+  int frames = 0;
+  // `value` this frame, compared with `changed(anchor, value)`.
+  template <typename Changed>
+  void update(const glm::vec3& value, Changed changed) {
+    if (frames == 0 || changed(anchor, value)) {
+      anchor = value;
+      frames = 0;
     }
-    if (speed_start >= 0) {
-      const float speed = horizontal_distance(r.root_position, frames[f - 1].root_position) / dt;
-      if (std::abs(speed - speed_to) <= 0.1f * std::abs(speed_to - speed_from)) {
-        speed_times.push_back((static_cast<double>(f) - speed_start) * dt);
-        ++m.speed_events;
-        speed_start = -1;
-      }
-    }
-    if (std::abs(wrap_angle(r.desired_yaw - frames[f - 1].desired_yaw)) >= kHeadingEventAngle) {
-      if (heading_start >= 0) ++m.heading_events;
-      heading_start = static_cast<int>(f);
-      heading_to = r.desired_yaw;
-    }
-    if (heading_start >= 0) {
-      heading_to = r.desired_yaw;  // a turn that keeps going is followed to its end
-      if (std::abs(wrap_angle(r.root_yaw - heading_to)) <= glm::radians(10.0f)) {
-        heading_times.push_back((static_cast<double>(f) - heading_start) * dt);
-        ++m.heading_events;
-        heading_start = -1;
-      }
+    ++frames;  // this frame counts, as the stand time does
+  }
+};
+
+// One turn on the spot being measured.
+struct StandTurn {
+  bool open = false;
+  int length = 0;         // frames so far
+  int settle_frame = -1;  // frames from the start to the first within the settle angle
+  double last_error_deg = 0.0;
+};
+
+// The sums the turn-on-the-spot metrics are made of.
+struct StandTurnSums {
+  int events = 0;
+  int unsettled = 0;
+  double response_s = 0.0;
+  double final_error_deg = 0.0;
+  double peak_rate_deg_s = 0.0;
+  void close(const StandTurn& turn, float dt) {
+    if (!turn.open) return;
+    ++events;
+    unsettled += turn.settle_frame < 0 ? 1 : 0;
+    response_s +=
+        (turn.settle_frame < 0 ? turn.length : turn.settle_frame) * static_cast<double>(dt);
+    final_error_deg += turn.last_error_deg;
+  }
+};
+
+// A response being timed: the frame it started on and its goal (-1: none open).
+struct ResponseEvent {
+  int start = -1;
+  float from = 0.0f;
+  float to = 0.0f;
+};
+
+}  // namespace
+
+// Everything the metrics need from earlier frames, and their running sums.
+struct EvaluationAccumulator::State {
+  JointRoleIndices roles;
+  size_t joint_count = 0;
+  float dt = 0.0f;
+  int toes[2] = {-1, -1};  // toe role, or the foot when the side has none
+  int lookback_frames = 1;
+  int stand_settle_frames = 1, idle_settle_frames = 1, strafe_settle_frames = 1;
+
+  int frames = 0;
+  EvaluationFrame previous;                  // its joints view `positions[1]`
+  std::vector<glm::vec3> positions[2];       // the frame before the previous, the previous
+  uint32_t transition_bits = 0;              // bit k: frame n-1-k transitioned
+  std::vector<float> desired_speed_history;  // ring over the look-back, by frame
+  std::vector<float> desired_yaw_history;
+
+  // Plain metrics.
+  std::vector<double> skate, accelerations, hips_rates;
+  RunningMean distance, facing, updates, searches, stand_root, stand_foot;
+  double distance_max = 0.0;
+  int transitions = 0;
+  ResponseEvent speed_event, heading_event;
+  int speed_events = 0, heading_events = 0;
+  RunningMean speed_times, heading_times;
+
+  // Held values.
+  int standing_frames = 0;  // consecutive frames with desired speed zero
+  HeldValue facing_held, velocity_held;
+
+  // Body metrics.
+  float hips_yaw = 0.0f, chest_yaw = 0.0f;
+  float pivot_yaw[2] = {0.0f, 0.0f};
+  bool pivot_ok[2] = {false, false};  // the toe was low and slow on the previous frame
+  RunningMean pivot, strafe_chest, idle_head;
+  bool stand_turn_condition = false;  // held on the previous frame
+  StandTurn stand_turn;
+  StandTurnSums stand_turn_sums;
+  float toe_height_min = std::numeric_limits<float>::infinity();
+
+  bool has_pair(int left, int right) const { return left >= 0 && right >= 0; }
+  bool has_hips() const { return has_pair(roles.left_upper_leg, roles.right_upper_leg); }
+  bool has_chest() const { return has_pair(roles.left_upper_arm, roles.right_upper_arm); }
+
+  void measure_plain(const EvaluationFrame& r);
+  void measure_responses(const EvaluationFrame& r);
+  void update_held(const EvaluationFrame& r);
+  void measure_feet(const EvaluationFrame& r);
+  void measure_pivot(const EvaluationFrame& r, int side, float toe_speed);
+  float measure_hips(const EvaluationFrame& r);
+  void measure_stand_turn(const EvaluationFrame& r, float hips_rate);
+  void measure_chest_and_head(const EvaluationFrame& r);
+  void measure_transition_accel(const EvaluationFrame& r);
+  void remember(const EvaluationFrame& r);
+};
+
+EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count,
+                                             float dt, size_t expected_frames)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.roles = roles;
+  s.joint_count = joint_count;
+  s.dt = dt;
+  s.toes[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
+  s.toes[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+  s.lookback_frames = std::max(1, static_cast<int>(std::lround(kStandTurnLookback / dt)));
+  s.stand_settle_frames = frames_for(kStandSettleSeconds, dt);
+  s.idle_settle_frames = frames_for(kIdleSettleSeconds, dt);
+  s.strafe_settle_frames = frames_for(kStrafeSettleSeconds, dt);
+  for (std::vector<glm::vec3>& p : s.positions) p.assign(joint_count, glm::vec3(0.0f));
+  s.desired_speed_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
+  s.desired_yaw_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
+  s.skate.reserve(2 * expected_frames);
+  s.hips_rates.reserve(expected_frames);
+}
+
+EvaluationAccumulator::~EvaluationAccumulator() = default;
+
+void EvaluationAccumulator::add(const EvaluationFrame& frame) {
+  State& s = *state_;
+  assert(frame.joints.size() == s.joint_count);
+  s.measure_plain(frame);
+  s.update_held(frame);
+  s.measure_feet(frame);
+  const float hips_rate = s.measure_hips(frame);
+  s.measure_stand_turn(frame, hips_rate);
+  s.measure_chest_and_head(frame);
+  s.measure_transition_accel(frame);
+  s.remember(frame);
+}
+
+// Distance and facing to the simulation, timings, transitions, the responses.
+void EvaluationAccumulator::State::measure_plain(const EvaluationFrame& r) {
+  const double d = 100.0 * horizontal_distance(r.root_position, r.sim_position);
+  distance.add(d);
+  distance_max = std::max(distance_max, d);
+  facing.add(yaw_error_deg(r.root_yaw, r.sim_yaw));
+  updates.add(r.update_seconds * 1e6);
+  if (r.searched) searches.add(r.search_seconds * 1e6);
+  transitions += r.transition ? 1 : 0;
+  if (frames > 0) measure_responses(r);
+}
+
+// Speed: events where the desired speed jumps, done when the root speed is close to it.
+// Heading: events where the desired facing jumps, done when the root faces it.
+void EvaluationAccumulator::State::measure_responses(const EvaluationFrame& r) {
+  const float desired = glm::length(r.desired_velocity);
+  const float previous_desired = glm::length(previous.desired_velocity);
+  if (std::abs(desired - previous_desired) >= kSpeedEventChange) {
+    if (speed_event.start >= 0) ++speed_events;
+    speed_event = {frames, previous_desired, desired};
+  }
+  if (speed_event.start >= 0) {
+    const float speed = horizontal_distance(r.root_position, previous.root_position) / dt;
+    if (std::abs(speed - speed_event.to) <= 0.1f * std::abs(speed_event.to - speed_event.from)) {
+      speed_times.add((static_cast<double>(frames) - speed_event.start) * dt);
+      ++speed_events;
+      speed_event.start = -1;
     }
   }
-  if (speed_start >= 0) ++m.speed_events;
-  if (heading_start >= 0) ++m.heading_events;
-  m.speed_events_reached = static_cast<int>(speed_times.size());
-  m.heading_events_reached = static_cast<int>(heading_times.size());
-  m.speed_response_s = mean(speed_times);
-  m.heading_response_s = mean(heading_times);
+  if (std::abs(wrap_angle(r.desired_yaw - previous.desired_yaw)) >= kHeadingEventAngle) {
+    if (heading_event.start >= 0) ++heading_events;
+    heading_event.start = frames;
+  }
+  if (heading_event.start >= 0) {
+    // A turn that keeps going is followed to its end.
+    if (yaw_error_deg(r.root_yaw, r.desired_yaw) <= kSettleAngleDegrees) {
+      heading_times.add((static_cast<double>(frames) - heading_event.start) * dt);
+      ++heading_events;
+      heading_event.start = -1;
+    }
+  }
 }
+
+// How long the stick has been released and the desired facing and velocity held.
+void EvaluationAccumulator::State::update_held(const EvaluationFrame& r) {
+  standing_frames = glm::length(r.desired_velocity) == 0.0f ? standing_frames + 1 : 0;
+  const float facing_tolerance = glm::radians(kFacingToleranceDegrees);
+  facing_held.update(glm::vec3(r.desired_yaw, 0.0f, 0.0f), [&](glm::vec3 a, glm::vec3 b) {
+    return std::abs(wrap_angle(a.x - b.x)) > facing_tolerance;
+  });
+  velocity_held.update(r.desired_velocity, [](glm::vec3 a, glm::vec3 b) {
+    return glm::length(a - b) > kVelocityTolerance;
+  });
+}
+
+// Foot skating, standing feet, pivots, the lowest toe.
+void EvaluationAccumulator::State::measure_feet(const EvaluationFrame& r) {
+  const bool standing =
+      standing_frames >= stand_settle_frames && facing_held.frames >= stand_settle_frames;
+  for (int side = 0; side < 2; ++side) {
+    if (toes[side] < 0) continue;
+    const glm::vec3& toe = r.joints[static_cast<size_t>(toes[side])];
+    toe_height_min = std::min(toe_height_min, toe.y);
+    if (frames == 0) continue;
+    const float moved = horizontal_distance(toe, previous.joints[static_cast<size_t>(toes[side])]);
+    const double speed_cm = 100.0 * moved / dt;
+    if (r.contact[side] && previous.contact[side]) skate.push_back(speed_cm);
+    if (standing) stand_foot.add(speed_cm);
+    measure_pivot(r, side, moved / dt);
+  }
+  if (standing && frames > 0) {
+    stand_root.add(100.0 * horizontal_distance(r.root_position, previous.root_position) / dt);
+  }
+}
+
+// The foot-to-toe vector's yaw rate while the toe is low and slow now and on the previous frame.
+void EvaluationAccumulator::State::measure_pivot(const EvaluationFrame& r, int side,
+                                                 float toe_speed) {
+  const int foot = side == 0 ? roles.left_foot : roles.right_foot;
+  const int toe = side == 0 ? roles.left_toe : roles.right_toe;
+  if (foot < 0 || toe < 0) return;
+  const glm::vec3& toe_position = r.joints[static_cast<size_t>(toe)];
+  const float yaw =
+      direction_yaw(toe_position - r.joints[static_cast<size_t>(foot)], pivot_yaw[side]);
+  const bool ok = toe_position.y < kPivotToeHeight && toe_speed < kPivotToeSpeed;
+  if (ok && pivot_ok[side]) pivot.add(yaw_error_deg(yaw, pivot_yaw[side]) / dt);
+  pivot_ok[side] = ok;
+  pivot_yaw[side] = yaw;
+}
+
+// The hips' yaw and its rate this frame (deg/s; 0 on the first frame or without hips).
+float EvaluationAccumulator::State::measure_hips(const EvaluationFrame& r) {
+  if (!has_hips()) return 0.0f;
+  const float yaw = pair_yaw(r.joints[static_cast<size_t>(roles.left_upper_leg)],
+                             r.joints[static_cast<size_t>(roles.right_upper_leg)], hips_yaw);
+  float rate = 0.0f;
+  if (frames > 0) {
+    rate = static_cast<float>(yaw_error_deg(yaw, hips_yaw) / dt);
+    hips_rates.push_back(rate);
+  }
+  hips_yaw = yaw;
+  return rate;
+}
+
+// Turning on the spot: start, follow and close events (see the header).
+void EvaluationAccumulator::State::measure_stand_turn(const EvaluationFrame& r, float hips_rate) {
+  const size_t ring = desired_speed_history.size();
+  const size_t now = static_cast<size_t>(frames) % ring;
+  const float speed = glm::length(r.desired_velocity);
+  desired_speed_history[now] = speed;
+  desired_yaw_history[now] = r.desired_yaw;
+  if (!has_hips()) return;
+  bool condition = false;
+  if (frames >= lookback_frames) {
+    const size_t then = static_cast<size_t>(frames - lookback_frames) % ring;
+    condition = speed < kStandTurnSpeed && desired_speed_history[then] < kStandTurnSpeed &&
+                yaw_error_deg(r.desired_yaw, desired_yaw_history[then]) >= kStandTurnAngleDegrees;
+  }
+  const bool starts = condition && !stand_turn_condition;
+  stand_turn_condition = condition;
+  if (starts || speed >= kStandTurnSpeed) {
+    stand_turn_sums.close(stand_turn, dt);
+    stand_turn = StandTurn{};
+    stand_turn.open = starts;
+  }
+  if (!stand_turn.open) return;
+  const double error = yaw_error_deg(hips_yaw, r.desired_yaw);
+  if (stand_turn.settle_frame < 0 && error <= kSettleAngleDegrees) {
+    stand_turn.settle_frame = stand_turn.length;
+  }
+  ++stand_turn.length;
+  stand_turn.last_error_deg = error;
+  stand_turn_sums.peak_rate_deg_s = std::max<double>(stand_turn_sums.peak_rate_deg_s, hips_rate);
+}
+
+// The chest's yaw error while strafing, the head's speed while idle.
+void EvaluationAccumulator::State::measure_chest_and_head(const EvaluationFrame& r) {
+  if (has_chest()) {
+    chest_yaw = pair_yaw(r.joints[static_cast<size_t>(roles.left_upper_arm)],
+                         r.joints[static_cast<size_t>(roles.right_upper_arm)], chest_yaw);
+    const float speed = glm::length(r.desired_velocity);
+    const bool strafing = speed >= kStrafeMinSpeed &&
+                          yaw_error_deg(direction_yaw(r.desired_velocity, r.desired_yaw),
+                                        r.desired_yaw) >= kStrafeMinAngleDegrees &&
+                          facing_held.frames >= strafe_settle_frames &&
+                          velocity_held.frames >= strafe_settle_frames;
+    if (strafing) strafe_chest.add(yaw_error_deg(chest_yaw, r.desired_yaw));
+  }
+  if (roles.head >= 0 && frames > 0 && standing_frames >= idle_settle_frames) {
+    const size_t head = static_cast<size_t>(roles.head);
+    idle_head.add(100.0 * glm::length(r.joints[head] - previous.joints[head]) / dt);
+  }
+}
+
+// Joint acceleration at the previous frame (it needs this one), counted once for every
+// transition among the 10 frames up to it.
+void EvaluationAccumulator::State::measure_transition_accel(const EvaluationFrame& r) {
+  if (frames >= 2) {
+    const int count = std::popcount(transition_bits & 0x3ffu);
+    for (int i = 0; i < count; ++i) {
+      joint_accelerations(positions[0], positions[1], r.joints, dt, accelerations);
+    }
+  }
+  transition_bits = (transition_bits << 1) | (r.transition ? 1u : 0u);
+}
+
+// This frame becomes the previous one: its scalars and a copy of its joints.
+void EvaluationAccumulator::State::remember(const EvaluationFrame& r) {
+  std::swap(positions[0], positions[1]);
+  std::copy(r.joints.begin(), r.joints.end(), positions[1].begin());
+  previous = r;
+  previous.joints = positions[1];
+  ++frames;
+}
+
+EvaluationMetrics EvaluationAccumulator::metrics() const {
+  const State& s = *state_;
+  EvaluationMetrics m;
+  m.frames = s.frames;
+  m.seconds = static_cast<double>(s.frames) * s.dt;
+  std::vector<double> skate = s.skate, accelerations = s.accelerations, rates = s.hips_rates;
+  m.foot_skate_cm_s_mean =
+      RunningMean{std::accumulate(skate.begin(), skate.end(), 0.0), static_cast<int>(skate.size())}
+          .value();
+  m.foot_skate_cm_s_p95 = percentile(skate, 95.0);
+  m.root_sim_distance_cm_mean = s.distance.value();
+  m.root_sim_distance_cm_max = s.distance_max;
+  m.facing_error_deg_mean = s.facing.value();
+  m.speed_events = s.speed_events + (s.speed_event.start >= 0 ? 1 : 0);
+  m.heading_events = s.heading_events + (s.heading_event.start >= 0 ? 1 : 0);
+  m.speed_events_reached = s.speed_times.count;
+  m.heading_events_reached = s.heading_times.count;
+  m.speed_response_s = s.speed_times.value();
+  m.heading_response_s = s.heading_times.value();
+  m.stand_root_speed_cm_s_mean = s.stand_root.value();
+  m.stand_foot_speed_cm_s_mean = s.stand_foot.value();
+  m.stand_frames = s.stand_root.count;
+  m.transitions_per_s = m.seconds > 0.0 ? s.transitions / m.seconds : 0.0;
+  m.search_us_mean = s.searches.value();
+  m.update_us_mean = s.updates.value();
+  m.transition_accel_p99 = percentile(accelerations, 99.0);
+
+  m.body_turn_rate_deg_s_max = rates.empty() ? 0.0 : *std::max_element(rates.begin(), rates.end());
+  m.body_turn_rate_deg_s_p99 = percentile(rates, 99.0);
+  m.foot_pivot_deg_s_mean = s.pivot.value();
+  m.foot_pivot_frames = s.pivot.count;
+  StandTurnSums turns = s.stand_turn_sums;
+  turns.close(s.stand_turn, s.dt);
+  m.stand_turns = turns.events;
+  m.stand_turn_unsettled = turns.unsettled;
+  m.stand_turn_response_s = turns.events > 0 ? turns.response_s / turns.events : 0.0;
+  m.stand_turn_final_error_deg_mean = turns.events > 0 ? turns.final_error_deg / turns.events : 0.0;
+  m.stand_turn_peak_rate_deg_s_max = turns.peak_rate_deg_s;
+  m.strafe_chest_error_deg_mean = s.strafe_chest.value();
+  m.strafe_chest_frames = s.strafe_chest.count;
+  m.idle_head_speed_cm_s_mean = s.idle_head.value();
+  m.idle_head_frames = s.idle_head.count;
+  m.toe_height_min_cm = std::isfinite(s.toe_height_min) ? 100.0 * s.toe_height_min : 0.0;
+  return m;
+}
+
+namespace {
 
 std::string csv_header(const Database& db) {
   std::string h =
@@ -120,7 +449,7 @@ std::string csv_header(const Database& db) {
   return h;
 }
 
-std::string csv_row(const FrameRecord& r, const glm::vec3* joints, size_t joint_count) {
+std::string csv_row(const EvaluationFrame& r) {
   char buffer[256];
   std::snprintf(buffer, sizeof buffer, "%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%d,%d,%d",
                 r.t, r.sim_position.x, r.sim_position.z, glm::degrees(r.sim_yaw), r.root_position.x,
@@ -128,11 +457,52 @@ std::string csv_row(const FrameRecord& r, const glm::vec3* joints, size_t joint_
                 r.desired_velocity.z, glm::degrees(r.desired_yaw), r.transition ? 1 : 0,
                 r.contact[0] ? 1 : 0, r.contact[1] ? 1 : 0);
   std::string row = buffer;
-  for (size_t j = 0; j < joint_count; ++j) {
-    std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", joints[j].x, joints[j].y, joints[j].z);
+  for (const glm::vec3& p : r.joints) {
+    std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", p.x, p.y, p.z);
     row += buffer;
   }
   return row;
+}
+
+// The record of the update just made; `positions` receives the joints it views.
+EvaluationFrame frame_record(const Controller& controller, float t, double update_seconds,
+                             std::vector<glm::vec3>& positions) {
+  const ControllerDebug& d = controller.debug();
+  EvaluationFrame r;
+  r.t = t;
+  r.sim_position = d.simulation_position;
+  r.sim_yaw = quat_yaw(d.simulation_rotation);
+  r.root_position = controller.root_transform().translation;
+  r.root_yaw = quat_yaw(controller.root_transform().rotation);
+  r.desired_velocity = d.desired_velocity;
+  r.desired_yaw = quat_yaw(d.desired_rotation);
+  r.transition = d.transitioned;
+  r.contact[0] = d.contact[0];
+  r.contact[1] = d.contact[1];
+  r.update_seconds = update_seconds;
+  r.searched = d.searched;
+  r.search_seconds = d.search_seconds;
+  const std::span<const Transform> globals = controller.global_transforms();
+  for (size_t j = 0; j < positions.size(); ++j) positions[j] = globals[j].translation;
+  r.joints = positions;
+  return r;
+}
+
+// The transition figures against the database's own acceleration at the same dt.
+void compare_with_database(const ControllerDatabase& database, const EvaluationOptions& options,
+                           EvaluationMetrics& m) {
+  const Database& db = database.database();
+  const uint64_t excluded = database.action_tags() | database.idle_tags();
+  m.database_accel_p99 = database_acceleration_p99(db, options.dt, excluded);
+  m.transition_accel_ratio =
+      m.database_accel_p99 > 0.0 ? m.transition_accel_p99 / m.database_accel_p99 : 0.0;
+  m.database_accel_p99_same_sampling =
+      options.settings.cubic_playback ? database_acceleration_p99(db, options.dt, excluded, true)
+                                      : m.database_accel_p99;
+  m.transition_accel_ratio_same_sampling =
+      m.database_accel_p99_same_sampling > 0.0
+          ? m.transition_accel_p99 / m.database_accel_p99_same_sampling
+          : 0.0;
 }
 
 }  // namespace
@@ -162,8 +532,10 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
         positions[static_cast<size_t>(s) * joints + j] = global[j].translation;
       }
     }
-    for (int s = 1; s + 1 < steps; ++s) {
-      joint_accelerations(positions, joints, static_cast<size_t>(s), dt, accelerations);
+    const std::span<const glm::vec3> all = positions;
+    for (size_t s = 1; s + 1 < static_cast<size_t>(steps); ++s) {
+      joint_accelerations(all.subspan((s - 1) * joints, joints), all.subspan(s * joints, joints),
+                          all.subspan((s + 1) * joints, joints), dt, accelerations);
     }
   }
   return percentile(accelerations, 99.0);
@@ -188,8 +560,11 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   const size_t frame_count = static_cast<size_t>(std::ceil(seconds / dt));
   const size_t joints = static_cast<size_t>(db.joint_count());
 
-  std::vector<FrameRecord> frames(frame_count);
-  std::vector<glm::vec3> positions(frame_count * joints);
+  EvaluationResult result;
+  result.csv_header = csv_header(db);
+  if (options.keep_frames) result.csv_rows.reserve(frame_count);
+  EvaluationAccumulator accumulator(db.roles, joints, dt, frame_count);
+  std::vector<glm::vec3> positions(joints);
   using Clock = std::chrono::steady_clock;
   for (size_t f = 0; f < frame_count; ++f) {
     const float t = static_cast<float>(f + 1) * dt;
@@ -197,99 +572,12 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     const Clock::time_point start = Clock::now();
     controller.update(dt, input);
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const ControllerDebug& d = controller.debug();
-    FrameRecord& r = frames[f];
-    r.t = t;
-    r.sim_position = d.simulation_position;
-    r.sim_yaw = quat_yaw(d.simulation_rotation);
-    r.root_position = controller.root_transform().translation;
-    r.root_yaw = quat_yaw(controller.root_transform().rotation);
-    r.desired_velocity = d.desired_velocity;
-    r.desired_yaw = quat_yaw(d.desired_rotation);
-    r.transition = d.transitioned;
-    r.contact[0] = d.contact[0];
-    r.contact[1] = d.contact[1];
-    r.update_seconds = elapsed;
-    r.searched = d.searched;
-    r.search_seconds = d.search_seconds;
-    const std::span<const Transform> globals = controller.global_transforms();
-    for (size_t j = 0; j < joints; ++j) positions[f * joints + j] = globals[j].translation;
+    const EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
+    accumulator.add(frame);
+    if (options.keep_frames) result.csv_rows.push_back(csv_row(frame));
   }
-
-  EvaluationResult result;
-  EvaluationMetrics& m = result.metrics;
-  m.frames = static_cast<int>(frame_count);
-  m.seconds = static_cast<double>(frame_count) * dt;
-  const int toes[2] = {db.roles.left_toe >= 0 ? db.roles.left_toe : db.roles.left_foot,
-                       db.roles.right_toe >= 0 ? db.roles.right_toe : db.roles.right_foot};
-  std::vector<double> skate, distance, facing, stand_root, stand_foot, updates, searches;
-  float stand_time = 0.0f;
-  int transitions = 0;
-  for (size_t f = 0; f < frame_count; ++f) {
-    const FrameRecord& r = frames[f];
-    distance.push_back(100.0 * horizontal_distance(r.root_position, r.sim_position));
-    facing.push_back(std::abs(glm::degrees(wrap_angle(r.root_yaw - r.sim_yaw))));
-    updates.push_back(r.update_seconds * 1e6);
-    if (r.searched) searches.push_back(r.search_seconds * 1e6);
-    transitions += r.transition ? 1 : 0;
-    stand_time = glm::length(r.desired_velocity) == 0.0f ? stand_time + dt : 0.0f;
-    if (f == 0) continue;
-    for (int side = 0; side < 2; ++side) {
-      const size_t toe = static_cast<size_t>(toes[side]);
-      const double speed =
-          100.0 *
-          horizontal_distance(positions[f * joints + toe], positions[(f - 1) * joints + toe]) / dt;
-      if (r.contact[side] && frames[f - 1].contact[side]) skate.push_back(speed);
-      if (stand_time >= kStandSettleSeconds) stand_foot.push_back(speed);
-    }
-    if (stand_time >= kStandSettleSeconds) {
-      stand_root.push_back(100.0 *
-                           horizontal_distance(r.root_position, frames[f - 1].root_position) / dt);
-    }
-  }
-  m.foot_skate_cm_s_mean = mean(skate);
-  m.foot_skate_cm_s_p95 = percentile(skate, 95.0);
-  m.root_sim_distance_cm_mean = mean(distance);
-  m.root_sim_distance_cm_max =
-      distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end());
-  m.facing_error_deg_mean = mean(facing);
-  m.stand_root_speed_cm_s_mean = mean(stand_root);
-  m.stand_foot_speed_cm_s_mean = mean(stand_foot);
-  m.stand_frames = static_cast<int>(stand_root.size());
-  m.transitions_per_s = transitions / m.seconds;
-  m.search_us_mean = mean(searches);
-  m.update_us_mean = mean(updates);
-  measure_responses(frames, dt, m);
-
-  // Joint acceleration over the 10 frames from each transition, against the database's own.
-  std::vector<double> accelerations;
-  for (size_t f = 0; f < frame_count; ++f) {
-    if (!frames[f].transition) continue;
-    for (size_t g = std::max<size_t>(f, 1); g < std::min(f + 10, frame_count - 1); ++g) {
-      joint_accelerations(positions, joints, g, dt, accelerations);
-    }
-  }
-  m.transition_accel_p99 = percentile(accelerations, 99.0);
-  m.database_accel_p99 =
-      database_acceleration_p99(db, dt, database->action_tags() | database->idle_tags());
-  m.transition_accel_ratio =
-      m.database_accel_p99 > 0.0 ? m.transition_accel_p99 / m.database_accel_p99 : 0.0;
-  m.database_accel_p99_same_sampling =
-      options.settings.cubic_playback
-          ? database_acceleration_p99(db, dt, database->action_tags() | database->idle_tags(), true)
-          : m.database_accel_p99;
-  m.transition_accel_ratio_same_sampling =
-      m.database_accel_p99_same_sampling > 0.0
-          ? m.transition_accel_p99 / m.database_accel_p99_same_sampling
-          : 0.0;
-
-  result.csv_header = csv_header(db);
-  if (options.keep_frames) {
-    result.csv_rows.reserve(frame_count);
-    for (size_t f = 0; f < frame_count; ++f) {
-      result.csv_rows.push_back(csv_row(frames[f], positions.data() + f * joints, joints));
-    }
-  }
+  result.metrics = accumulator.metrics();
+  compare_with_database(*database, options, result.metrics);
   return result;
 }
 

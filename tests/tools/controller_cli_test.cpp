@@ -86,11 +86,29 @@ TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
   const CommandRun run = run_mm(eval_arguments(script, "--json '" + json_path.string() + "'"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
-  for (const char* key :
-       {"foot_skate_cm_s_mean", "foot_skate_cm_s_p95", "root_sim_distance_cm_mean",
-        "root_sim_distance_cm_max", "facing_error_deg_mean", "speed_response_s",
-        "heading_response_s", "stand_root_speed_cm_s_mean", "stand_foot_speed_cm_s_mean",
-        "transitions_per_s", "transition_accel_ratio", "search_us_mean", "update_us_mean"}) {
+  for (const char* key : {"foot_skate_cm_s_mean",
+                          "foot_skate_cm_s_p95",
+                          "root_sim_distance_cm_mean",
+                          "root_sim_distance_cm_max",
+                          "facing_error_deg_mean",
+                          "speed_response_s",
+                          "heading_response_s",
+                          "stand_root_speed_cm_s_mean",
+                          "stand_foot_speed_cm_s_mean",
+                          "transitions_per_s",
+                          "transition_accel_ratio",
+                          "search_us_mean",
+                          "update_us_mean",
+                          "body_turn_rate_deg_s_p99",
+                          "body_turn_rate_deg_s_max",
+                          "foot_pivot_deg_s_mean",
+                          "stand_turns",
+                          "stand_turn_unsettled",
+                          "stand_turn_response_s",
+                          "stand_turn_final_error_deg_mean",
+                          "stand_turn_peak_rate_deg_s_max",
+                          "strafe_chest_error_deg_mean",
+                          "idle_head_speed_cm_s_mean"}) {
     ASSERT_TRUE(json.contains(key)) << key;
     EXPECT_TRUE(json[key].is_number()) << key;
     EXPECT_GE(json[key].get<double>(), 0.0) << key;
@@ -106,6 +124,15 @@ TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
   EXPECT_EQ(json["frames"].get<int>(), 480);
   EXPECT_GT(json["stand_frames"].get<int>(), 60);
   EXPECT_GT(json["transitions_per_s"].get<double>(), 0.0);
+  // The lowest toe may be below the ground (a sinking foot), so only its presence is checked.
+  ASSERT_TRUE(json.contains("toe_height_min_cm"));
+  EXPECT_TRUE(json["toe_height_min_cm"].is_number());
+  EXPECT_NE(run.output.find("toe_height_min_cm"), std::string::npos);
+  EXPECT_LE(json["body_turn_rate_deg_s_p99"].get<double>(),
+            json["body_turn_rate_deg_s_max"].get<double>() + 1e-9);
+  // The script walks, turns and runs, and stands its last 2 s.
+  EXPECT_GT(json["body_turn_rate_deg_s_max"].get<double>(), 0.0);
+  EXPECT_GT(json["idle_head_frames"].get<int>(), 0);
 }
 
 TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {

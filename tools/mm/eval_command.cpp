@@ -5,6 +5,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -81,6 +82,20 @@ nlohmann::json to_json(const EvaluationMetrics& m) {
           {"database_accel_p99_same_sampling_m_s2", m.database_accel_p99_same_sampling},
           {"search_us_mean", m.search_us_mean},
           {"update_us_mean", m.update_us_mean},
+          {"body_turn_rate_deg_s_p99", m.body_turn_rate_deg_s_p99},
+          {"body_turn_rate_deg_s_max", m.body_turn_rate_deg_s_max},
+          {"foot_pivot_deg_s_mean", m.foot_pivot_deg_s_mean},
+          {"foot_pivot_frames", m.foot_pivot_frames},
+          {"stand_turns", m.stand_turns},
+          {"stand_turn_unsettled", m.stand_turn_unsettled},
+          {"stand_turn_response_s", m.stand_turn_response_s},
+          {"stand_turn_final_error_deg_mean", m.stand_turn_final_error_deg_mean},
+          {"stand_turn_peak_rate_deg_s_max", m.stand_turn_peak_rate_deg_s_max},
+          {"strafe_chest_error_deg_mean", m.strafe_chest_error_deg_mean},
+          {"strafe_chest_frames", m.strafe_chest_frames},
+          {"idle_head_speed_cm_s_mean", m.idle_head_speed_cm_s_mean},
+          {"idle_head_frames", m.idle_head_frames},
+          {"toe_height_min_cm", m.toe_height_min_cm},
           {"frames", m.frames},
           {"seconds", m.seconds}};
 }
@@ -104,6 +119,40 @@ void print_table_row(const std::string& name, const EvaluationMetrics& m) {
       m.update_us_mean);
 }
 
+// The body metrics of issue 17, a second table: the first has no room left.
+void print_body_table_header() {
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "turn99", "turnmax",
+              "pivot", "sturns", "unsettl", "sturn_s", "sturn_e", "sturn_r", "strafe", "idlehd",
+              "toemin");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "deg/s", "deg/s", "deg/s",
+              "", "", "s", "deg", "deg/s", "deg", "cm/s", "cm");
+}
+
+void print_body_table_row(const std::string& name, const EvaluationMetrics& m) {
+  std::printf("%-22s %7.1f %7.1f %7.2f %7d %7d %7.3f %7.2f %7.1f %7.2f %7.3f %7.2f\n", name.c_str(),
+              m.body_turn_rate_deg_s_p99, m.body_turn_rate_deg_s_max, m.foot_pivot_deg_s_mean,
+              m.stand_turns, m.stand_turn_unsettled, m.stand_turn_response_s,
+              m.stand_turn_final_error_deg_mean, m.stand_turn_peak_rate_deg_s_max,
+              m.strafe_chest_error_deg_mean, m.idle_head_speed_cm_s_mean, m.toe_height_min_cm);
+}
+
+void print_body_metrics(const EvaluationMetrics& m) {
+  std::printf("body_turn_rate_deg_s_p99    %10.3f\n", m.body_turn_rate_deg_s_p99);
+  std::printf("body_turn_rate_deg_s_max    %10.3f\n", m.body_turn_rate_deg_s_max);
+  std::printf("foot_pivot_deg_s_mean       %10.3f   (%d toe frames)\n", m.foot_pivot_deg_s_mean,
+              m.foot_pivot_frames);
+  std::printf("stand_turns                 %10d\n", m.stand_turns);
+  std::printf("stand_turn_unsettled        %10d\n", m.stand_turn_unsettled);
+  std::printf("stand_turn_response_s       %10.3f\n", m.stand_turn_response_s);
+  std::printf("stand_turn_final_error_deg_mean %6.3f\n", m.stand_turn_final_error_deg_mean);
+  std::printf("stand_turn_peak_rate_deg_s_max %7.3f\n", m.stand_turn_peak_rate_deg_s_max);
+  std::printf("strafe_chest_error_deg_mean %10.3f   (%d strafing frames)\n",
+              m.strafe_chest_error_deg_mean, m.strafe_chest_frames);
+  std::printf("idle_head_speed_cm_s_mean   %10.3f   (%d idle frames)\n",
+              m.idle_head_speed_cm_s_mean, m.idle_head_frames);
+  std::printf("toe_height_min_cm           %10.3f\n", m.toe_height_min_cm);
+}
+
 void print_metrics(const EvaluationMetrics& m) {
   std::printf("foot_skate_cm_s_mean        %10.3f\n", m.foot_skate_cm_s_mean);
   std::printf("foot_skate_cm_s_p95         %10.3f\n", m.foot_skate_cm_s_p95);
@@ -125,6 +174,7 @@ void print_metrics(const EvaluationMetrics& m) {
       m.transition_accel_ratio_same_sampling, m.database_accel_p99_same_sampling);
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
+  print_body_metrics(m);
 }
 
 int run_eval(const std::vector<std::string>& args) {
@@ -141,6 +191,7 @@ int run_eval(const std::vector<std::string>& args) {
   const bool table = arguments.scripts.size() > 1;
   if (table) print_table_header();
   nlohmann::json runs = nlohmann::json::array();
+  std::vector<std::pair<std::string, EvaluationMetrics>> rows;
   nlohmann::json single;
   for (const std::string& path : arguments.scripts) {
     Result<InputScript> script = load_input_script(path);
@@ -160,6 +211,7 @@ int run_eval(const std::vector<std::string>& args) {
     json["ik"] = arguments.options.settings.ik_enabled;
     if (table) {
       print_table_row(name, result->metrics);
+      rows.emplace_back(name, result->metrics);
       runs.push_back(json);
     } else {
       std::printf("script %s, dt %.5f s, IK %s, %d frames (%.1f s)\n", path.c_str(),
@@ -177,6 +229,11 @@ int run_eval(const std::vector<std::string>& args) {
         return 1;
       }
     }
+  }
+  if (table) {
+    std::printf("\n");
+    print_body_table_header();
+    for (const auto& [name, metrics] : rows) print_body_table_row(name, metrics);
   }
   if (!arguments.json_path.empty()) {
     std::ofstream file(arguments.json_path);

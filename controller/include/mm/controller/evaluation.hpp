@@ -1,10 +1,18 @@
 #pragma once
 // Scripted evaluation (`mm eval`): one controller runs a script at a fixed dt, headless, and
 // the run is measured. Every metric is defined here once; `mm eval` prints and writes them.
+// The metrics are computed frame by frame from per-frame records (EvaluationFrame) by an
+// EvaluationAccumulator, so they can be fed synthetic frames and never need the whole run.
 //
-// Metrics (speeds are horizontal, from positions one frame apart):
+// Conventions: speeds are horizontal, from positions one frame apart, unless said 3-D; a value
+// that needs the previous frame starts at the second frame; a mean over no values is 0 and the
+// count beside it (frames or events) says so; yaws are about +Y, atan2(x, z), and yaw errors
+// and rates are absolute and wrapped to [0, 180] degrees per frame.
+//
+// Metrics:
 // - foot_skate_cm_s_mean / _p95: the toe's speed on frames where that foot is in contact (the
-//   contact the controller holds: the playing database frame's), over both feet;
+//   contact the controller holds: the playing database frame's) on this and the previous frame,
+//   over both feet;
 // - root_sim_distance_cm_mean / _max: distance between the character's root and the simulation
 //   object; facing_error_deg_mean: the angle between their facings;
 // - speed_response_s: after the desired speed changes by at least kSpeedEventChange, the time
@@ -13,7 +21,9 @@
 // - heading_response_s: after the desired facing turns by at least kHeadingEventAngle in one
 //   step, the time until the root's facing is within 10 degrees of it (mean, likewise);
 // - stand_root_speed_cm_s_mean / stand_foot_speed_cm_s_mean: root and toe speed on frames where
-//   the desired speed has been zero for at least kStandSettleSeconds;
+//   the desired speed has been zero for at least kStandSettleSeconds and the desired facing has
+//   not changed for kStandSettleSeconds either (a turn on the spot steps its feet);
+//   stand_frames counts them;
 // - transitions_per_s: jumps to a new database frame per second of script;
 // - transition_accel_ratio: the 99th percentile of joint acceleration (second differences of
 //   global joint positions, every joint but the simulation root) over the 10 frames from each
@@ -25,14 +35,56 @@
 //   (transition_accel_ratio_same_sampling);
 // - search_us_mean: wall time per search; update_us_mean: wall time per update() (the only
 //   figures that vary from run to run).
+//
+// The body metrics (issue 17). Body yaw: the yaw of the horizontal vector (L - R) x up, where L
+// and R are the global positions of a left/right joint pair found by joint role: the hips'
+// from the upper legs, the chest's from the upper arms. A frame where the pair has no
+// horizontal separation keeps the previous frame's yaw. A missing pair leaves its metrics at 0
+// (with their counts 0).
+// - body_turn_rate_deg_s_p99 / _max: the hips' yaw rate, frame to frame, over the run (nearest
+//   rank percentile);
+// - foot_pivot_deg_s_mean: the yaw rate of the horizontal foot-to-toe vector on frames where
+//   that toe is below kPivotToeHeight and its horizontal speed below kPivotToeSpeed on this and
+//   the previous frame (so it starts at the third frame), over both feet; foot_pivot_frames
+//   counts the samples (a side without a foot and a toe role gives none);
+// - turning on the spot: an event starts on a frame where the desired speed is below
+//   kStandTurnSpeed now and kStandTurnLookback earlier and the desired facing differs by at
+//   least kStandTurnAngle from kStandTurnLookback earlier, when that did not hold on the
+//   previous frame (a facing step satisfies it for the whole look-back; that is one event).
+//   "Earlier" is the frame nearest kStandTurnLookback back, at least one. The event lasts until
+//   the next event starts or the desired speed reaches kStandTurnSpeed (the stick moves), or
+//   the run ends. stand_turns counts the events; stand_turn_unsettled those whose hips' yaw
+//   never came within kSettleAngle of the desired facing (followed as it changes);
+//   stand_turn_response_s: mean over events of the time from the event's first frame to the
+//   first frame within kSettleAngle, an unsettled event counting its whole length (frames
+//   times dt); stand_turn_final_error_deg_mean: mean of the hips' yaw error to the desired
+//   facing on each event's last frame; stand_turn_peak_rate_deg_s_max: the largest hips' yaw
+//   rate on any frame inside an event. With no events, all five are 0;
+// - strafe_chest_error_deg_mean: the chest's yaw error to the desired facing on frames where
+//   the desired velocity is at least kStrafeMinSpeed, points at least kStrafeMinAngle away from
+//   the desired facing, and neither has changed for kStrafeSettleSeconds; strafe_chest_frames
+//   counts them;
+// - idle_head_speed_cm_s_mean: the head's 3-D speed on frames where the desired speed has been
+//   zero for at least kIdleSettleSeconds (a held-frame idle gives 0); idle_head_frames counts
+//   them;
+// - toe_height_min_cm: the lowest height either toe joint reaches over the run (the foot joint
+//   where a side has no toe role, as for foot skating), every frame; 0 for no frames.
+// "Has not changed for S seconds": the value has stayed within a tolerance (kFacingTolerance
+// for the desired facing, kVelocityTolerance as a vector for the desired velocity) of the value
+// it was last held at for at least S seconds, counting this frame's dt (as the stand time
+// does), so a slow drift also counts as a change once it adds up.
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "mm/controller/controller.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/database/joint_roles.hpp"
 #include "mm/runtime/result.hpp"
 
 namespace mm {
@@ -41,8 +93,30 @@ namespace mm {
 inline constexpr float kSpeedEventChange = 0.5f;
 // A desired facing turn at least this large (radians) in one frame starts a heading measurement.
 inline constexpr float kHeadingEventAngle = 0.5f;
-// Standing metrics count frames whose desired speed has been zero this long (s).
+// Standing metrics count frames whose desired speed has been zero and whose desired facing has
+// not changed for this long (s).
 inline constexpr float kStandSettleSeconds = 1.0f;
+// Within this many degrees of the desired facing a turn counts as done.
+inline constexpr float kSettleAngleDegrees = 10.0f;
+// "Has not changed": a smaller change of the desired facing (degrees) or of the desired
+// velocity (m/s, as a vector) is noise, not a new request.
+inline constexpr float kFacingToleranceDegrees = 1.0f;
+inline constexpr float kVelocityTolerance = 0.01f;
+// A pivoting toe: below this height (m) and slower than this (m/s).
+inline constexpr float kPivotToeHeight = 0.06f;
+inline constexpr float kPivotToeSpeed = 0.35f;
+// Turning on the spot: the desired speed below this (m/s) now and kStandTurnLookback (s)
+// earlier, and the desired facing at least kStandTurnAngleDegrees away from then.
+inline constexpr float kStandTurnSpeed = 0.01f;
+inline constexpr float kStandTurnLookback = 0.1f;
+inline constexpr float kStandTurnAngleDegrees = 45.0f;
+// Strafing: desired speed at least this (m/s), at least this far (degrees) from the facing,
+// both held this long (s).
+inline constexpr float kStrafeMinSpeed = 0.3f;
+inline constexpr float kStrafeMinAngleDegrees = 45.0f;
+inline constexpr float kStrafeSettleSeconds = 0.5f;
+// Idle: the desired speed zero for this long (s).
+inline constexpr float kIdleSettleSeconds = 2.0f;
 
 struct EvaluationMetrics {
   double foot_skate_cm_s_mean = 0.0;
@@ -67,8 +141,64 @@ struct EvaluationMetrics {
   double transition_accel_ratio_same_sampling = 0.0;
   double search_us_mean = 0.0;
   double update_us_mean = 0.0;
+  // The body metrics (definitions at the top of this file).
+  double body_turn_rate_deg_s_p99 = 0.0;
+  double body_turn_rate_deg_s_max = 0.0;
+  double foot_pivot_deg_s_mean = 0.0;
+  int foot_pivot_frames = 0;
+  int stand_turns = 0;
+  int stand_turn_unsettled = 0;
+  double stand_turn_response_s = 0.0;
+  double stand_turn_final_error_deg_mean = 0.0;
+  double stand_turn_peak_rate_deg_s_max = 0.0;
+  double strafe_chest_error_deg_mean = 0.0;
+  int strafe_chest_frames = 0;
+  double idle_head_speed_cm_s_mean = 0.0;
+  int idle_head_frames = 0;
+  double toe_height_min_cm = 0.0;
   int frames = 0;
   double seconds = 0.0;
+};
+
+// What one frame of a run leaves behind for the metrics. Yaws in radians, positions in metres.
+struct EvaluationFrame {
+  float t = 0.0f;
+  glm::vec3 sim_position{0.0f};
+  float sim_yaw = 0.0f;
+  glm::vec3 root_position{0.0f};
+  float root_yaw = 0.0f;
+  glm::vec3 desired_velocity{0.0f};
+  float desired_yaw = 0.0f;
+  bool transition = false;
+  bool contact[2] = {false, false};  // left, right
+  double update_seconds = 0.0;
+  bool searched = false;
+  double search_seconds = 0.0;
+  // Every joint's global position, indexed like the skeleton; read during add() only.
+  std::span<const glm::vec3> joints;
+};
+
+// The metrics of a run, fed one frame at a time. Holds the previous frames it needs and the
+// values that go into percentiles, never the whole run. Not copyable (one run each).
+class EvaluationAccumulator {
+ public:
+  // `roles` picks the joints; every frame carries `joint_count` joints; `dt` is the frame time;
+  // `expected_frames` only reserves room for the percentile samples.
+  EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count, float dt,
+                        size_t expected_frames = 0);
+  ~EvaluationAccumulator();
+  EvaluationAccumulator(const EvaluationAccumulator&) = delete;
+  EvaluationAccumulator& operator=(const EvaluationAccumulator&) = delete;
+
+  // The next frame (asserts it carries joint_count joints).
+  void add(const EvaluationFrame& frame);
+  // The metrics of the frames so far, events still open closed at the last frame. The database
+  // figures (database_accel_p99*, the ratios) are left 0: evaluate_script fills them.
+  EvaluationMetrics metrics() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 struct EvaluationOptions {
