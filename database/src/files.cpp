@@ -58,6 +58,24 @@ Result<FileContents> read_whole_file(const std::filesystem::path& path, std::str
   return contents;
 }
 
+Status write_whole_file(const std::filesystem::path& path, std::string_view bytes,
+                        std::string_view what) {
+  const std::string name = path.string();
+  const std::string failed = name + ": cannot write the " + std::string(what) + " (";
+  std::error_code ignored;
+  // Worded as read_whole_file words it, rather than the system's "Is a directory".
+  if (std::filesystem::is_directory(path, ignored)) return Error{failed + "it is a folder)"};
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(name.c_str(), "wb"),
+                                                       &std::fclose);
+  if (!file) return Error{failed + system_error_text() + ")"};
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size()) {
+    return Error{failed + system_error_text() + ")"};
+  }
+  // Buffered bytes reach the disk at fclose: a full disk is only reported there.
+  if (std::fclose(file.release()) != 0) return Error{failed + system_error_text() + ")"};
+  return Status::success();
+}
+
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

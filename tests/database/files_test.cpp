@@ -1,5 +1,5 @@
-// The shared file services: whole-file reads (contents and every failure by its message), file
-// types by extension, byte sizes for people, and the huge-page hint's safety.
+// The shared file services: whole-file reads and writes (contents and every failure by its
+// message), file types by extension, byte sizes for people, and the huge-page hint's safety.
 
 #include "mm/database/files.hpp"
 
@@ -63,6 +63,29 @@ TEST(ReadWholeFile, AFolderIsRefusedByName) {
   ASSERT_FALSE(contents);
   EXPECT_EQ(contents.message(),
             scratch_dir().string() + ": cannot read the tag manifest (it is a folder)");
+}
+
+TEST(WriteWholeFile, ReplacesTheFileWithEveryByte) {
+  std::string bytes = "MOTION\n";
+  bytes.push_back('\0');
+  bytes += "after the nul";
+  const auto path = write_file("files_test_written.bin", "an older, longer content to replace");
+  ASSERT_TRUE(write_whole_file(path, bytes));
+  auto contents = read_whole_file(path);
+  ASSERT_TRUE(contents) << contents.message();
+  EXPECT_EQ(std::string(contents->text()), bytes);
+}
+
+TEST(WriteWholeFile, FailuresNameTheFileItsRoleAndTheReason) {
+  const auto missing = scratch_dir() / "no_such_folder" / "out.bvh";
+  Status status = write_whole_file(missing, "x", "BVH file");
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.message(),
+            missing.string() + ": cannot write the BVH file (No such file or directory)");
+  status = write_whole_file(scratch_dir(), "x", "BVH file");
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.message(),
+            scratch_dir().string() + ": cannot write the BVH file (it is a folder)");
 }
 
 TEST(Extensions, AreComparedWithoutCase) {

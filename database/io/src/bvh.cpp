@@ -14,6 +14,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <glm/gtx/euler_angles.hpp>
+
 #include "mm/database/files.hpp"
 
 namespace mm {
@@ -742,6 +744,209 @@ Result<Clip> load_bvh(const std::filesystem::path& path, const BvhOptions& optio
     return read_and_parse(path, name, options);
   } catch (const std::exception& exception) {
     return Error{name + ": cannot import (" + exception.what() + ")"};
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Export.
+
+namespace {
+
+// The channels every exported joint gets; store_frame composes "Zrotation Xrotation Yrotation"
+// as R = Rz * Rx * Ry, the order glm::extractEulerAngleZXY decomposes.
+constexpr const char* kExportChannels =
+    "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation";
+
+// The shortest fixed-notation decimal that reads back as the same float: exact round trips
+// without the 9 digits "%.9g" always prints, and no exponent, which some BVH readers refuse.
+void append_number(std::string& out, float value) {
+  // "-0" (from atan2 of a negative zero, or a negated zero offset) reads back the same but
+  // looks like a sign error to whoever reads the file.
+  if (value == 0.0f) value = 0.0f;
+  char digits[64];  // the longest float in fixed notation (a subnormal) needs 48 bytes
+  const auto [end, ec] =
+      std::to_chars(digits, digits + sizeof digits, value, std::chars_format::fixed);
+  out.append(digits, ec == std::errc() ? end : digits);
+}
+
+void append_vector(std::string& out, const glm::vec3& v, float units_per_metre) {
+  for (int axis = 0; axis < 3; ++axis) {
+    out += ' ';
+    append_number(out, v[axis] * units_per_metre);
+  }
+}
+
+// Degrees (Z, X, Y) with Rz(z) * Rx(x) * Ry(y) = the rotation. glm::extractEulerAngleZXY is
+// the decomposition for exactly this order (glm::eulerAngles is for another) and stays exact at
+// gimbal lock (X at +-90 degrees, where only Z + Y or Z - Y is defined): it takes Y from the
+// matrix with Z's rotation undone rather than from entries that vanish there, and atan2 of two
+// zeros is still finite. Double only keeps its rounding well below that of the float angles
+// written; float measures about the same in the round-trip tests.
+glm::dvec3 zxy_degrees(const glm::quat& rotation) {
+  const glm::dmat4 m = glm::mat4_cast(glm::normalize(glm::dquat(rotation)));
+  double z = 0.0, x = 0.0, y = 0.0;
+  glm::extractEulerAngleZXY(m, z, x, y);
+  return glm::degrees(glm::dvec3(z, x, y));
+}
+
+void append_indent(std::string& out, size_t depth) {
+  out.append(depth, '\t');
+}
+
+void append_end_site(std::string& out, size_t depth, const glm::vec3& offset,
+                     float units_per_metre) {
+  append_indent(out, depth);
+  out += "End Site\n";
+  append_indent(out, depth);
+  out += "{\n";
+  append_indent(out, depth + 1);
+  out += "OFFSET";
+  append_vector(out, offset, units_per_metre);
+  out += '\n';
+  append_indent(out, depth);
+  out += "}\n";
+}
+
+// Writes the HIERARCHY section and returns the joints in the order it lists them (which the
+// frame lines follow). Iterative, as the importer is: a deep chain needs no deep call stack.
+std::vector<int> append_hierarchy(std::string& out, const Clip& clip, float units_per_metre) {
+  const Skeleton& skeleton = clip.skeleton;
+  const int joint_count = skeleton.joint_count();
+  std::vector<std::vector<int>> children(static_cast<size_t>(joint_count));
+  for (int j = 0; j < joint_count; ++j) {
+    if (skeleton.parent(j) >= 0) children[static_cast<size_t>(skeleton.parent(j))].push_back(j);
+  }
+  const auto end_site = [&](int joint) {
+    return clip.end_sites.empty() ? glm::vec3(0.0f) : clip.end_sites[static_cast<size_t>(joint)];
+  };
+  std::vector<int> order;
+  order.reserve(static_cast<size_t>(joint_count));
+  struct Open {
+    int joint;
+    size_t next_child;
+  };
+  std::vector<Open> open;
+  // Writes a joint's head and opens it at the depth the stack gives.
+  const auto open_joint = [&](int joint) {
+    const size_t depth = open.size();
+    append_indent(out, depth);
+    out += depth == 0 ? "ROOT " : "JOINT ";
+    out += skeleton.name(joint);
+    out += '\n';
+    append_indent(out, depth);
+    out += "{\n";
+    append_indent(out, depth + 1);
+    out += "OFFSET";
+    append_vector(out, skeleton.rest(joint).translation, units_per_metre);
+    out += '\n';
+    append_indent(out, depth + 1);
+    out += kExportChannels;
+    out += '\n';
+    order.push_back(joint);
+    open.push_back({joint, 0});
+  };
+
+  out += "HIERARCHY\n";
+  for (int root = 0; root < joint_count; ++root) {
+    if (skeleton.parent(root) >= 0) continue;
+    open_joint(root);
+    while (!open.empty()) {
+      const int joint = open.back().joint;
+      const std::vector<int>& kids = children[static_cast<size_t>(joint)];
+      if (open.back().next_child < kids.size()) {
+        open_joint(kids[open.back().next_child++]);
+        continue;
+      }
+      // The importer keeps an End Site wherever it is; a leaf always gets one, as BVH readers
+      // take the bone's direction and length from it.
+      const size_t depth = open.size();
+      if (kids.empty() || end_site(joint) != glm::vec3(0.0f)) {
+        append_end_site(out, depth, end_site(joint), units_per_metre);
+      }
+      append_indent(out, depth - 1);
+      out += "}\n";
+      open.pop_back();
+    }
+  }
+  return order;
+}
+
+// Everything format_bvh needs beyond Clip::validate(), so that what it writes reads back.
+Status check_exportable(const Clip& clip, float units_per_metre) {
+  if (!std::isfinite(units_per_metre) || !(units_per_metre > 0.0f)) {
+    return Error{"expected units_per_metre to be finite and > 0, found " +
+                 std::to_string(units_per_metre)};
+  }
+  if (Status valid = clip.validate(); !valid) return valid;
+  const Skeleton& skeleton = clip.skeleton;
+  for (const std::string& name : skeleton.names()) {
+    // Names are whitespace-separated tokens in BVH, and a lone brace reads as structure.
+    const bool has_space = std::any_of(name.begin(), name.end(), is_space);
+    if (has_space || name == "{" || name == "}") {
+      return Error{"joint '" + name +
+                   "' cannot be written as BVH (names must be one token without whitespace and "
+                   "not a brace)"};
+    }
+  }
+  // Validated values are finite in metres but may overflow a float in file units.
+  const auto fits = [units_per_metre](const glm::vec3& v) {
+    const glm::vec3 scaled = v * units_per_metre;
+    return std::isfinite(scaled.x) && std::isfinite(scaled.y) && std::isfinite(scaled.z);
+  };
+  for (int j = 0; j < skeleton.joint_count(); ++j) {
+    if (!fits(skeleton.rest(j).translation) ||
+        (!clip.end_sites.empty() && !fits(clip.end_sites[static_cast<size_t>(j)]))) {
+      return Error{"joint '" + skeleton.name(j) +
+                   "': its rest offset or End Site is not finite in file units"};
+    }
+  }
+  for (size_t i = 0; i < clip.local.size(); ++i) {
+    if (!fits(clip.local[i].translation)) {
+      return Error{"frame " + std::to_string(i / static_cast<size_t>(clip.joint_count())) +
+                   ", joint '" +
+                   skeleton.name(static_cast<int>(i % static_cast<size_t>(clip.joint_count()))) +
+                   "': the translation is not finite in file units"};
+    }
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+std::string format_bvh(const Clip& clip, float units_per_metre) {
+  std::string out;
+  const std::vector<int> order = append_hierarchy(out, clip, units_per_metre);
+  out += "MOTION\nFrames: " + std::to_string(clip.frame_count) + "\nFrame Time: ";
+  append_number(out, clip.frame_time);
+  out += '\n';
+  for (int frame = 0; frame < clip.frame_count; ++frame) {
+    const std::span<const Transform> pose = clip.pose(frame);
+    bool first = true;
+    for (const int joint : order) {
+      const Transform& t = pose[static_cast<size_t>(joint)];
+      const glm::dvec3 zxy = zxy_degrees(t.rotation);
+      const float values[6] = {t.translation.x * units_per_metre, t.translation.y * units_per_metre,
+                               t.translation.z * units_per_metre, static_cast<float>(zxy[0]),
+                               static_cast<float>(zxy[1]),        static_cast<float>(zxy[2])};
+      for (const float value : values) {
+        if (!first) out += ' ';
+        first = false;
+        append_number(out, value);
+      }
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+Status save_bvh(const Clip& clip, const std::filesystem::path& out, float units_per_metre) {
+  if (Status s = check_exportable(clip, units_per_metre); !s) {
+    return Error{out.string() + ": " + s.message()};
+  }
+  try {
+    return write_whole_file(out, format_bvh(clip, units_per_metre), "BVH file");
+  } catch (const std::exception& exception) {
+    return Error{out.string() + ": cannot export (" + exception.what() + ")"};
   }
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The small system services the importers, the database file and the command line share:
-// reading a whole file, naming file types by extension, printing byte sizes, and hinting the
-// kernel about large arrays. Cold paths only.
+// reading and writing a whole file, naming file types by extension, printing byte sizes, and
+// hinting the kernel about large arrays. Cold paths only.
 
 #include <cstddef>
 #include <cstdint>
@@ -28,6 +28,11 @@ struct FileContents {
 // file's role in messages ("input script").
 Result<FileContents> read_whole_file(const std::filesystem::path& path,
                                      std::string_view what = "file");
+
+// Replaces `path` with `bytes` in one go. Errors name the file and say why, as read_whole_file's
+// do: "<path>: cannot write the <what> (Permission denied)", "... (it is a folder)".
+Status write_whole_file(const std::filesystem::path& path, std::string_view bytes,
+                        std::string_view what = "file");
 
 // The extension in lower case, with its dot (".bvh"), or "" when there is none.
 std::string lower_extension(const std::filesystem::path& path);
