@@ -2,19 +2,27 @@
 # The measurements: the controller on every shipped input script (mm eval: a table of the
 # feet, tracking, responses, standing and transitions, then a second of the body metrics: hips
 # turn rate, foot pivot, turns on the spot, strafing chest, idle head, lowest toe), the crowd
-# benchmark, every search method, on the database of ../shared/mocap/bandai-normal (or
-# $MM_DATA). Builds Release first; writes JSON of each to out/.
+# benchmark, every search method, on the database of ../shared/mocap/bandai-normal and
+# ../shared/mocap/reactidle/genuine (or $MM_DATA). Builds Release first; writes JSON of each to out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-data=${MM_DATA:-$root/../shared/mocap/bandai-normal}
+# The default data: the Bandai normal clips, plus the ReActIdle genuine idles where they exist
+# (another skeleton: retargeted by mm build, and played when the character stands).
+if [ -n "${MM_DATA:-}" ]; then
+  inputs=("$MM_DATA")
+else
+  inputs=("$root/../shared/mocap/bandai-normal")
+  [ -d "$root/../shared/mocap/reactidle/genuine" ] && inputs+=("$root/../shared/mocap/reactidle/genuine")
+fi
+data=${inputs[0]}
 
 scripts/setup.sh release
 mm=build/release/tools/mm
 mkdir -p out
 
-printf '\n=== 1/4 Building the motion database from %s ===\n' "$data"
-"$mm" build "$data" -o out/database.mmdb
+printf '\n=== 1/4 Building the motion database from %s ===\n' "${inputs[*]}"
+"$mm" build "${inputs[@]}" -o out/database.mmdb
 
 printf '\n=== 2/4 Scripted controller runs (mm eval, every script in scripts/input, dt 1/60, IK on; two tables) ===\n'
 scripts=()

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job: the motion-matching demo on the motion capture in ../shared/mocap/bandai-normal
-# (or $MM_DATA). Installs missing Debian packages, builds Release, builds the motion database,
-# then:
+# with the ReActIdle idles of ../shared/mocap/reactidle/genuine (or $MM_DATA). Installs missing
+# Debian packages, builds Release, builds the motion database, then:
 # - with a display: opens mm-viewer (gamepad or keyboard; its --help lists the controls);
 # - without one: runs the viewer headless on scripts/input/showcase.txt (walk, turn, run, stop
 #   and stand, walk back, strafe), writing a screenshot every 1.5 s, the last frame and a
@@ -11,7 +11,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 
-data=${MM_DATA:-$root/../shared/mocap/bandai-normal}
+# The default data: the Bandai normal clips, plus the ReActIdle genuine idles where they exist
+# (another skeleton: retargeted by mm build, and played when the character stands).
+if [ -n "${MM_DATA:-}" ]; then
+  inputs=("$MM_DATA")
+else
+  inputs=("$root/../shared/mocap/bandai-normal")
+  [ -d "$root/../shared/mocap/reactidle/genuine" ] && inputs+=("$root/../shared/mocap/reactidle/genuine")
+fi
+data=${inputs[0]}
 if [ ! -d "$data" ] || [ -z "$(find "$data" -maxdepth 1 \( -name '*.bvh' -o -name '*.glb' -o -name '*.gltf' \) -print -quit)" ]; then
   cat >&2 <<MSG
 run: no motion capture found in '$data'.
@@ -28,8 +36,8 @@ mm=build/release/tools/mm
 viewer=build/release/viewer/mm-viewer
 mkdir -p out/viewer
 
-printf '\n=== Building the motion database from %s ===\n' "$data"
-"$mm" build "$data" -o out/database.mmdb
+printf '\n=== Building the motion database from %s ===\n' "${inputs[*]}"
+"$mm" build "${inputs[@]}" -o out/database.mmdb
 
 if [ -z "${MM_HEADLESS:-}" ] && { [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; }; then
   printf '\n=== mm-viewer (close the window or press Esc to quit; F1 hides the panel) ===\n'

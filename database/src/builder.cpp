@@ -360,6 +360,38 @@ Result<size_t> choose_reference_input(BuildState& state) {
   return reference_index;
 }
 
+// Phase 2a, after retargeting: idle takes of the data become their calm segments (idle.hpp).
+void split_idle_clips(BuildState& state) {
+  int takes = 0;
+  size_t segments = 0;
+  double kept = 0.0, total = 0.0;
+  for (InputResult& result : state.results) {
+    std::vector<Clip> clips;
+    for (Clip& clip : result.clips) {
+      const std::vector<std::string> tags = tags_from_name(clip.name);
+      if (std::find(tags.begin(), tags.end(), kIdleTag) == tags.end()) {
+        clips.push_back(std::move(clip));
+        continue;
+      }
+      ++takes;
+      total += clip.frame_count * static_cast<double>(clip.frame_time);
+      for (Clip& segment : calm_idle_segments(clip, result.roles)) {
+        kept += segment.frame_count * static_cast<double>(segment.frame_time);
+        ++segments;
+        clips.push_back(std::move(segment));
+      }
+    }
+    result.clips = std::move(clips);
+  }
+  if (takes == 0) return;
+  char line[160];
+  std::snprintf(line, sizeof line,
+                "%d idle takes: %zu calm segments kept (%.0f s of %.0f s; feet planted, facing "
+                "steady)",
+                takes, segments, kept, total);
+  state.rep.idle_summary = line;
+}
+
 // Phase 2b: the database skeleton (simulation root + the reference's joints), its roles, the
 // feature channels' joints and the mirror map.
 Status start_database(BuildState& state, size_t reference_index) {
@@ -621,6 +653,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
 
   const Result<size_t> reference = choose_reference_input(state);
   if (!reference) return Error{reference.message()};
+  split_idle_clips(state);
   if (Status s = start_database(state, *reference); !s) return Error{s.message()};
   if (Status s = lay_out_clips(state, *idle_frames); !s) return Error{s.message()};
   allocate_arrays(state);

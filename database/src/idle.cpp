@@ -204,4 +204,83 @@ void fill_idle_clip(Database& db, const ClipRange& range, int source_frame) {
   }
 }
 
+namespace {
+
+// Per frame: whether both feet are planted, and the body's yaw across the upper legs.
+struct FrameCalm {
+  bool planted = false;
+  float yaw = 0.0f;
+};
+
+std::vector<FrameCalm> frame_calm(const Clip& clip, const JointRoleIndices& roles,
+                                  const CalmIdleCriteria& criteria) {
+  const size_t frames = static_cast<size_t>(clip.frame_count);
+  std::vector<glm::vec3> feet(2 * frames);
+  std::vector<FrameCalm> out(frames);
+  std::vector<Transform> global(static_cast<size_t>(clip.joint_count()));
+  for (size_t f = 0; f < frames; ++f) {
+    forward_kinematics(clip.skeleton.parents(), clip.pose(static_cast<int>(f)), global);
+    feet[2 * f] = global[static_cast<size_t>(roles.left_foot)].translation;
+    feet[2 * f + 1] = global[static_cast<size_t>(roles.right_foot)].translation;
+    const glm::vec3 across = global[static_cast<size_t>(roles.left_upper_leg)].translation -
+                             global[static_cast<size_t>(roles.right_upper_leg)].translation;
+    // Forward is across x up: (-across.z, 0, across.x).
+    out[f].yaw = std::atan2(-across.z, across.x);
+  }
+  const float limit = criteria.max_foot_speed * clip.frame_time;
+  for (size_t f = 0; f < frames; ++f) {
+    const size_t a = f > 0 ? f - 1 : f, b = f + 1 < frames ? f + 1 : f;
+    bool planted = true;
+    for (size_t side = 0; side < 2; ++side) {
+      glm::vec3 d = feet[2 * b + side] - feet[2 * a + side];
+      d.y = 0.0f;
+      planted = planted && glm::length(d) <= limit * static_cast<float>(b - a);
+    }
+    out[f].planted = planted;
+  }
+  return out;
+}
+
+float angle_between(float a, float b) {
+  return std::abs(std::remainder(a - b, 2.0f * glm::pi<float>()));
+}
+
+Clip segment_of(const Clip& clip, int first, int end) {
+  Clip out;
+  out.name = clip.name + "_at" + std::to_string(static_cast<int>(first * clip.frame_time)) + "s";
+  out.source_path = clip.source_path;
+  out.skeleton = clip.skeleton;
+  out.end_sites = clip.end_sites;
+  out.frame_time = clip.frame_time;
+  out.frame_count = end - first;
+  const size_t joints = static_cast<size_t>(clip.joint_count());
+  out.local.assign(clip.local.begin() + static_cast<std::ptrdiff_t>(first * joints),
+                   clip.local.begin() + static_cast<std::ptrdiff_t>(end * joints));
+  return out;
+}
+
+}  // namespace
+
+std::vector<Clip> calm_idle_segments(const Clip& clip, const JointRoleIndices& roles,
+                                     const CalmIdleCriteria& criteria) {
+  const std::vector<FrameCalm> calm = frame_calm(clip, roles, criteria);
+  const int min_frames = static_cast<int>(std::ceil(criteria.min_seconds / clip.frame_time));
+  std::vector<Clip> out;
+  int f = 0;
+  while (f < clip.frame_count) {
+    if (!calm[static_cast<size_t>(f)].planted) {
+      ++f;
+      continue;
+    }
+    const int first = f;
+    while (f < clip.frame_count && calm[static_cast<size_t>(f)].planted &&
+           angle_between(calm[static_cast<size_t>(f)].yaw, calm[static_cast<size_t>(first)].yaw) <=
+               criteria.max_turn) {
+      ++f;
+    }
+    if (f - first >= min_frames) out.push_back(segment_of(clip, first, f));
+  }
+  return out;
+}
+
 }  // namespace mm

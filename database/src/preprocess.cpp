@@ -796,15 +796,17 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
 
   if (options.root.fixed) hold_at_mean(scratch.positions, scratch.directions);
   // Joint 0 positions (smoothed or not) go straight into the output.
-  smooth_gaussian_linear(scratch.positions, options.root.position_smoothing / dt, scratch.smoothed,
-                         scratch.weights);
+  // A held root is already as smooth as it gets (and smoothing would round it differently at
+  // the clip's ends).
+  const float position_sigma = options.root.fixed ? 0.0f : options.root.position_smoothing / dt;
+  const float facing_sigma = options.root.fixed ? 0.0f : options.root.facing_smoothing / dt;
+  smooth_gaussian_linear(scratch.positions, position_sigma, scratch.smoothed, scratch.weights);
   for (int f = 0; f < frames; ++f) {
     glm::vec3 p = scratch.smoothed[f];
     p.y = 0.0f;
     out.local_positions[static_cast<size_t>(f) * out_joints] = p;
   }
-  smooth_gaussian_linear(scratch.directions, options.root.facing_smoothing / dt, scratch.smoothed,
-                         scratch.weights);
+  smooth_gaussian_linear(scratch.directions, facing_sigma, scratch.smoothed, scratch.weights);
 
   for (int f = 0; f < frames; ++f) {
     glm::vec3 d = scratch.smoothed[f];

@@ -109,7 +109,8 @@ Result<std::vector<TagRule>> load_tag_manifest(const std::filesystem::path& path
 
 std::vector<std::string> tags_from_name(std::string_view clip_name) {
   const std::vector<std::string_view> parts = split(clip_name, '_');
-  if (parts.size() == 2 && !parts[0].empty() && all_digits(parts[0]) &&
+  // A take ("003_genuine") or one of its segments ("003_genuine_at68s").
+  if (parts.size() >= 2 && parts.size() <= 3 && !parts[0].empty() && all_digits(parts[0]) &&
       (parts[1] == "genuine" || parts[1] == "acted")) {
     return {"idle", "reactidle", std::string(parts[1])};  // sorted
   }

@@ -18,6 +18,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/database/feature_extraction.hpp"
 #include "mm/database/idle.hpp"
+#include "mm/database/preprocess.hpp"
 #include "mm/runtime/pose.hpp"
 #include "test_support.hpp"
 
@@ -565,6 +566,77 @@ TEST(IdleBuild, SurvivesTheDatabaseFile) {
   EXPECT_EQ(find_idle_clip(*loaded), 2);
   // Searching the loaded database skips the idle clip and finds the same source again.
   EXPECT_EQ(find_calmest_standing_frame(*loaded), reported_source_frame(db, built().report));
+}
+
+// ---- Calm segments of idle takes --------------------------------------------------------------
+
+// A standing figure at 30 Hz for `seconds`: hips, two legs of upper leg, lower leg and foot; the
+// left foot and the body's facing follow the given functions of time.
+template <class FootFn, class YawFn>
+Clip standing_take(float seconds, const FootFn& left_foot_offset, const YawFn& yaw) {
+  Clip clip;
+  clip.name = "003_genuine";
+  clip.skeleton = Skeleton::create({"Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "RightUpLeg",
+                                    "RightLeg", "RightFoot"},
+                                   {-1, 0, 1, 2, 0, 4, 5}, std::vector<Transform>(7))
+                      .value();
+  clip.frame_time = 1.0f / 30.0f;
+  clip.frame_count = static_cast<int>(seconds * 30.0f) + 1;
+  for (int f = 0; f < clip.frame_count; ++f) {
+    const float t = f * clip.frame_time;
+    Transform hips, up_l, leg_l, foot_l, up_r, leg_r, foot_r;
+    hips.translation = {0.0f, 0.9f, 0.0f};
+    hips.rotation = glm::angleAxis(yaw(t), glm::vec3(0.0f, 1.0f, 0.0f));
+    up_l.translation = {0.1f, 0.0f, 0.0f};
+    up_r.translation = {-0.1f, 0.0f, 0.0f};
+    leg_l.translation = leg_r.translation = {0.0f, -0.4f, 0.0f};
+    foot_l.translation = glm::vec3(0.0f, -0.4f, 0.0f) + left_foot_offset(t);
+    foot_r.translation = {0.0f, -0.4f, 0.0f};
+    clip.local.insert(clip.local.end(), {hips, up_l, leg_l, foot_l, up_r, leg_r, foot_r});
+  }
+  return clip;
+}
+
+JointRoleIndices standing_roles(const Clip& clip) {
+  Result<JointRoleIndices> roles = find_joint_roles(clip.skeleton, JointRoles{});
+  EXPECT_TRUE(roles) << roles.message();
+  return *roles;
+}
+
+TEST(CalmIdleSegments, AStepSplitsTheTakeAndShortPiecesAreDropped) {
+  // 20 s standing; from 8 to 8.5 s the left foot steps 0.3 m forward (0.6 m/s), and from 18 to
+  // 18.5 s back: calm 0-8 s, 8.5-18 s, and 18.5-20 s (too short).
+  const Clip take = standing_take(
+      20.0f,
+      [](float t) {
+        const float out = std::clamp((t - 8.0f) / 0.5f, 0.0f, 1.0f);
+        const float back = std::clamp((t - 18.0f) / 0.5f, 0.0f, 1.0f);
+        return glm::vec3(0.0f, 0.0f, 0.3f * (out - back));
+      },
+      [](float) { return 0.0f; });
+  const std::vector<Clip> segments = calm_idle_segments(take, standing_roles(take));
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_EQ(segments[0].name, "003_genuine_at0s");
+  EXPECT_NEAR(segments[0].frame_count / 30.0f, 8.0f, 0.1f);
+  EXPECT_EQ(segments[1].name, "003_genuine_at8s");
+  EXPECT_NEAR(segments[1].frame_count / 30.0f, 9.5f, 0.1f);
+  // A segment holds the take's own frames.
+  const int first = static_cast<int>(std::lround(8.5f * 30.0f)) + 1;
+  EXPECT_EQ(segments[1].pose(0)[3].translation, take.pose(first)[3].translation);
+  ASSERT_TRUE(segments[1].validate());
+}
+
+TEST(CalmIdleSegments, ATurnEndsASegment) {
+  // The body turns slowly (3 degrees a second, feet planted): a segment ends once it has turned
+  // the criteria's 15 degrees, after 5 s, and the next one starts there.
+  const Clip take = standing_take(
+      12.0f, [](float) { return glm::vec3(0.0f); }, [](float t) { return glm::radians(3.0f) * t; });
+  CalmIdleCriteria criteria;
+  criteria.max_turn = glm::radians(15.0f);
+  const std::vector<Clip> segments = calm_idle_segments(take, standing_roles(take), criteria);
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_NEAR(segments[0].frame_count / 30.0f, 5.0f, 0.1f);
+  EXPECT_NEAR(segments[1].frame_count / 30.0f, 5.0f, 0.1f);
 }
 
 }  // namespace

@@ -187,6 +187,7 @@ std::optional<Database> build_and_save(Arguments& arguments, BuildReport& report
 
 void print_warnings(const BuildReport& report) {
   for (const std::string& line : report.retargeted) std::printf("retargeted:  %s\n", line.c_str());
+  if (!report.idle_summary.empty()) std::printf("idle:        %s\n", report.idle_summary.c_str());
   for (const std::string& w : report.warnings)
     std::fprintf(stderr, "mm build: warning: %s\n", w.c_str());
   if (!report.refused.empty()) {

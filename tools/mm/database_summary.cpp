@@ -61,7 +61,21 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
     if (!idle_source.empty()) std::fprintf(out, ", holding %s", idle_source.c_str());
     std::fprintf(out, "\n");
   } else {
-    std::fprintf(out, "idle:        none\n");
+    // Idle clips of the data (e.g. ReActIdle's), when the builder synthesized none.
+    const uint64_t idle_tag = db.tag_mask(std::vector<std::string>{kIdleTag});
+    int clips = 0;
+    long long frames = 0;
+    for (const ClipRange& c : db.clips) {
+      if (!(c.tags & idle_tag)) continue;
+      ++clips;
+      frames += c.frame_count();
+    }
+    if (clips == 0) {
+      std::fprintf(out, "idle:        none\n");
+    } else {
+      std::fprintf(out, "idle:        %d clips of the data tagged idle, %lld frames (%.1f s)\n",
+                   clips, frames, frames * static_cast<double>(db.frame_time));
+    }
   }
   std::fprintf(out, "joints:      %d (joint 0 '%s')\n", db.joint_count(),
                db.joint_count() ? db.skeleton.name(0).c_str() : "-");

@@ -112,6 +112,8 @@ struct BuildReport {
   // One line per source skeleton retargeted onto the database's: its first input, clips,
   // joints matched, scale and the database joints left at rest.
   std::vector<std::string> retargeted;
+  // How the idle takes of the data were cut into calm segments; empty without idle takes.
+  std::string idle_summary;
   std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)
 };
 

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "mm/database/clip.hpp"
 #include "mm/database/database.hpp"
 
 namespace mm {
@@ -97,5 +98,25 @@ std::string idle_search_failure(const IdleSourceSearch& search, const IdleCriter
 // angular velocity zero, both contacts 1. The source frame must lie outside `range`. Features,
 // searchable flags and frame_clip are the caller's (extract_range_features).
 void fill_idle_clip(Database& db, const ClipRange& range, int source_frame);
+
+// ---- Idle clips of the data -------------------------------------------------------------
+
+// Where real idle motion (a person standing, e.g. ReActIdle's) is calm enough to play while
+// the character stands: both feet planted and the body facing one way. Steps and turns inside a
+// long take would otherwise slide or turn a character that should stand.
+struct CalmIdleCriteria {
+  // Metres / second: the horizontal speed of each foot (the foot roles) on a calm frame.
+  float max_foot_speed = 0.1f;
+  // Radians: how far the body's facing (across the upper legs) may turn from a segment's start.
+  float max_turn = 0.26f;
+  // Seconds: segments shorter than this are dropped (the features look 1 s ahead and the
+  // controller never jumps into the last second of a clip).
+  float min_seconds = 4.0f;
+};
+
+// The calm segments of an idle clip, each a clip of its own named "<name>_at<start>s" (start in
+// whole seconds into the take), in time order. `roles` are indices in the clip's skeleton.
+std::vector<Clip> calm_idle_segments(const Clip& clip, const JointRoleIndices& roles,
+                                     const CalmIdleCriteria& criteria = {});
 
 }  // namespace mm

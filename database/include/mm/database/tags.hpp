@@ -9,7 +9,8 @@
 //                                    (e.g. "walk-back" -> "locomotion", "walk")
 //   "action"                         for every other content (the standing wave-* and
 //                                    raise-up-* gestures)
-// A ReActIdle name "{person}_{genuine|acted}" (e.g. "003_genuine") gives "idle", "reactidle"
+// A ReActIdle name "{person}_{genuine|acted}" (e.g. "003_genuine", or a segment of it such as
+// "003_genuine_at68s") gives "idle", "reactidle"
 // and "genuine" or "acted": real standing motion, which the controller plays when the stick is
 // released (the builder then synthesizes no held-frame idle clip).
 // Other names give no tags from the name.
