@@ -360,7 +360,7 @@ bool Controller::should_search() const {
   // simulation settles, and a jump every interval would make every transition chain into the
   // next before its offsets have decayed.
   if (search_timer_ >= settings_.search_interval &&
-      since_transition_ >= settings_.transition_cooldown) {
+      since_transition_ >= settings_.transition_cooldown && !playing_idle_through()) {
     return true;
   }
   if (tag_bits_ != tag_bits_at_search_ || stopping_ != stopping_at_search_) return true;
@@ -373,6 +373,16 @@ bool Controller::should_search() const {
     return true;
   }
   return clip_duration() - clip_time_ < settings_.clip_end_lookahead;
+}
+
+bool Controller::on_idle_clip() const {
+  return stopping_ && clip_ >= 0 &&
+         (db_->clips[static_cast<size_t>(clip_)].tags & shared_->idle_tags()) != 0;
+}
+
+// Standing on an idle clip whose next frame may still be matched: nothing to search for.
+bool Controller::playing_idle_through() const {
+  return on_idle_clip() && shared_->candidates()[static_cast<size_t>(playback_point().frame1)] != 0;
 }
 
 // The query: the playing frame's own pose features (interpolated between its two frames), with
@@ -424,8 +434,8 @@ SearchResult Controller::search_candidates() const {
   const Database& db = *db_;
   SearchConstraints constraints;
   constraints.current_frame = playback_point().frame0;
-  constraints.window_frames =
-      static_cast<int>(std::lround(settings_.ignore_window / db.frame_time));
+  const float window = on_idle_clip() ? settings_.idle_ignore_window : settings_.ignore_window;
+  constraints.window_frames = static_cast<int>(std::lround(window / db.frame_time));
   constraints.transition_cost = settings_.transition_cost;
   if (tag_bits_ == 0) {
     if (stopping_) {

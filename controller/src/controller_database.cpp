@@ -106,8 +106,9 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   const int excluded = static_cast<int>(std::lround(options.clip_end_exclusion / db.frame_time));
   out->candidates_.assign(db.searchable.begin(), db.searchable.end());
   for (const ClipRange& clip : db.clips) {
-    // The idle clip is one held pose: its end is as good as its start.
-    if (clip.tags & out->idle_tags_) continue;
+    // The synthesized idle clip is one held pose: its end is as good as its start. Idle clips
+    // of the data end like any take: jumping to their last frames would hold the last pose.
+    if (is_idle_clip(db, clip)) continue;
     for (int f = std::max(clip.start, clip.end - excluded); f < clip.end; ++f) {
       out->candidates_[static_cast<size_t>(f)] = 0;
     }

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <cmath>
 #include <limits>
 
@@ -386,6 +388,58 @@ TEST(ControllerTest, DifferentFrameRatesTrackTheSameTrajectory) {
   }
   EXPECT_LT(glm::length(ends[0] - ends[1]), 0.35f);
   EXPECT_LT(glm::length(ends[2] - ends[1]), 0.35f);
+}
+
+// A database with real idle takes (ReActIdle, retargeted): a long stand plays them through,
+// breathing and swaying, and moves on at their ends instead of replaying their last moments.
+TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
+  const std::filesystem::path inputs[] = {
+      test::clip_path("dataset-2_walk_normal_001"), test::clip_path("dataset-2_walk_normal_002"),
+      test::mocap_dir() / "reactidle" / "genuine" / "008_genuine.bvh",
+      test::mocap_dir() / "reactidle" / "genuine" / "012_genuine.bvh"};
+  BuildOptions options;
+  options.bvh.scale = 0.0f;  // centimetres and metres
+  Result<Database> db = build_database(inputs, options);
+  ASSERT_TRUE(db) << db.message();
+  Result<std::shared_ptr<const ControllerDatabase>> shared =
+      ControllerDatabase::create(std::make_shared<const Database>(std::move(db).value()));
+  ASSERT_TRUE(shared) << shared.message();
+  Result<Controller> made = Controller::create(*shared, ControllerSettings{});
+  ASSERT_TRUE(made) << made.message();
+  Controller& c = *made;
+  for (int i = 0; i < 120; ++i) c.update(kDt, push_toward(0.0f));
+  const Database& base = c.controller_database().database();
+  const uint64_t idle = base.tag_mask(std::vector<std::string>{"idle"});
+  ControllerInput released;
+  const int head = base.roles.head;
+  ASSERT_GE(head, 0);
+  std::set<int> frames;
+  int jumps = 0, last_frame = -1;
+  double head_path = 0.0;
+  glm::vec3 previous{0.0f};
+  // 3 s to come to rest, then a minute: longer than any calm segment of these two takes.
+  const int settle = 180, stand = 3600;
+  for (int i = 0; i < settle + stand; ++i) {
+    c.update(kDt, released);
+    const glm::vec3 h = c.global_transforms()[static_cast<size_t>(head)].translation;
+    if (i > settle) {
+      ASSERT_NE(base.clips[static_cast<size_t>(c.debug().clip)].tags & idle, 0u) << i;
+      head_path += glm::distance(h, previous);
+      frames.insert(c.debug().frame);
+      const int step = c.debug().frame - last_frame;
+      jumps += step < 0 || step > 2 ? 1 : 0;
+    }
+    last_frame = c.debug().frame;
+    previous = h;
+  }
+  const double head_speed_cm_s = 100.0 * head_path / (stand * kDt);
+  EXPECT_GT(head_speed_cm_s, 0.5);
+  EXPECT_LT(head_speed_cm_s, 5.0);
+  // Played through at 30 Hz, a minute visits about 1800 frames; a loop of a segment's last
+  // moments, a few.
+  EXPECT_GT(frames.size(), 1200u);
+  // Jumps only where a calm segment ends (or a better one starts), not every search interval.
+  EXPECT_LT(jumps, 12);
 }
 
 }  // namespace

@@ -141,6 +141,10 @@ struct ControllerSettings {
   float transition_cost = 1.0f;
   // Frames within this time of the playing frame are not jumped to (s).
   float ignore_window = 0.2f;
+  // The same while standing on an idle clip of the data (s). Such a clip plays through without
+  // periodic searches; once its last candidate frame has passed, the next idle frame is at
+  // least this far away, so a long stand moves on instead of replaying its last moments.
+  float idle_ignore_window = 4.0f;
   // A change of the desired velocity (m/s) or facing (radians) since the last search this large
   // searches at once.
   float replan_velocity_change = 0.5f;
@@ -300,6 +304,8 @@ class Controller {
   void build_query();
   void search();
   SearchResult search_candidates() const;
+  bool on_idle_clip() const;
+  bool playing_idle_through() const;
   void record_search(const SearchResult& best);
   void transition_to(int frame);
   float clip_duration() const;
