@@ -186,8 +186,6 @@ std::optional<Database> build_and_save(Arguments& arguments, BuildReport& report
 }
 
 void print_warnings(const BuildReport& report) {
-  for (const std::string& line : report.retargeted) std::printf("retargeted:  %s\n", line.c_str());
-  if (!report.idle_summary.empty()) std::printf("idle:        %s\n", report.idle_summary.c_str());
   for (const std::string& w : report.warnings)
     std::fprintf(stderr, "mm build: warning: %s\n", w.c_str());
   if (!report.refused.empty()) {
@@ -204,6 +202,8 @@ void print_summary(const std::string& output, const Database& db, const BuildRep
   std::error_code ec;
   const uintmax_t size = std::filesystem::file_size(output, ec);
   std::printf("wrote %s\n", output.c_str());
+  for (const std::string& line : report.retargeted) std::printf("retargeted:  %s\n", line.c_str());
+  if (!report.idle_summary.empty()) std::printf("idle takes:  %s\n", report.idle_summary.c_str());
   std::printf("input:       %d files, %s read, %d refused\n", report.inputs,
               format_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
   const std::string idle_source =
