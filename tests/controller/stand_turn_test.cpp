@@ -39,8 +39,9 @@ struct StandTurn {
 
 // Stands for a second facing +Z, then asks for the facing `degrees` away (positive: toward +X)
 // and holds it for `seconds`.
-StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f) {
-  Result<Controller> made = Controller::create(normal_controller_database());
+StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
+                           const ControllerSettings& settings = {}) {
+  Result<Controller> made = Controller::create(normal_controller_database(), settings);
   EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.message());
   Controller c = std::move(made).value();
   const Database& db = c.controller_database().database();
@@ -109,6 +110,29 @@ TEST(StandTurnTest, HalfTurnsBothWays) {
 TEST(StandTurnTest, FrameRateDoesNotChangeTheTurn) {
   expect_natural_turn(179.0f, 1.0f / 30.0f, 1.4f);
   expect_natural_turn(-90.0f, 1.0f / 144.0f, 1.0f);
+}
+
+TEST(StandTurnTest, SettingsAreValidatedAndSetByName) {
+  ControllerSettings s;
+  EXPECT_TRUE(set_controller_setting(s, "stand_turn_max_rate", "4").ok());
+  EXPECT_FLOAT_EQ(s.stand_turn_max_rate, 4.0f);
+  EXPECT_TRUE(set_controller_setting(s, "stand_turn_acceleration", "12.5").ok());
+  EXPECT_FLOAT_EQ(s.stand_turn_acceleration, 12.5f);
+  EXPECT_TRUE(s.validate().ok());
+  s.stand_turn_acceleration = 0.0f;
+  EXPECT_NE(s.validate().message().find("stand_turn_acceleration"), std::string::npos);
+  s = {};
+  s.stand_turn_max_rate = std::nanf("");
+  EXPECT_NE(s.validate().message().find("stand_turn_max_rate"), std::string::npos);
+}
+
+// The limit is what keeps the hips natural: without it the same turn is too fast, so the test
+// above can tell.
+TEST(StandTurnTest, AnUnboundedTurnIsTooFast) {
+  ControllerSettings fast;
+  fast.stand_turn_max_rate = 100.0f;
+  fast.stand_turn_acceleration = 1000.0f;
+  EXPECT_GT(turn_on_the_spot(90.0f, 1.0f / 60.0f, 3.0f, fast).peak_rate_degrees, 400.0f);
 }
 
 }  // namespace
