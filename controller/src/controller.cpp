@@ -586,9 +586,34 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
 void Controller::simulate(float dt) {
   spring_character_update(sim_position_, sim_velocity_, sim_acceleration_, desired_velocity_,
                           settings_.simulation_velocity_halflife, dt);
-  critical_spring_update(sim_rotation_, sim_angular_velocity_, desired_rotation_,
-                         settings_.simulation_rotation_halflife, dt);
+  if (stopping_) {
+    stand_turn(dt);
+  } else {
+    critical_spring_update(sim_rotation_, sim_angular_velocity_, desired_rotation_,
+                           settings_.simulation_rotation_halflife, dt);
+  }
   sim_position_.y = 0.0f;
+}
+
+// Standing, the facing turns the way a person turns on the spot: the rotation spring alone
+// would swing a still body round faster than any step could follow. The turn rate moves toward
+// the fastest rate from which the turn can still stop on the desired facing at the set
+// deceleration, bounded by the maximum rate, and changes by at most the set acceleration: it
+// eases in, cruises and eases out. A turn that would pass the facing this update lands on it.
+void Controller::stand_turn(float dt) {
+  const float error = wrap_angle(quat_yaw(desired_rotation_) - quat_yaw(sim_rotation_));
+  const float acceleration = settings_.stand_turn_acceleration;
+  const float stoppable = std::sqrt(2.0f * acceleration * std::abs(error));
+  const float goal = std::copysign(std::min(settings_.stand_turn_max_rate, stoppable), error);
+  float rate = sim_angular_velocity_.y;
+  rate += std::clamp(goal - rate, -acceleration * dt, acceleration * dt);
+  float step = rate * dt;
+  if (step * error > 0.0f && std::abs(step) >= std::abs(error)) {
+    step = error;
+    rate = 0.0f;
+  }
+  sim_rotation_ = glm::normalize(yaw_rotation(step) * sim_rotation_);
+  sim_angular_velocity_ = glm::vec3(0.0f, rate, 0.0f);
 }
 
 void Controller::predict() {
@@ -646,7 +671,14 @@ void Controller::synchronize(float dt) {
 
   const float root_yaw = quat_yaw(root.rotation);
   float angle = wrap_angle(quat_yaw(sim_rotation_) - root_yaw) * fraction;
-  const float max_angle = settings_.adjustment_max_angular_velocity_ratio * turn_rate * dt;
+  float max_angle = settings_.adjustment_max_angular_velocity_ratio * turn_rate * dt;
+  if (stopping_) {
+    // The idle pose does not turn by itself, so a standing character turns with the
+    // simulation's own (bounded, eased) turning, and catches up on what remains no faster:
+    // the ratio to its own turning would hold it, and the clamp drag it, short of the facing.
+    angle += sim_angular_velocity_.y * dt;
+    max_angle = std::max(max_angle, settings_.stand_turn_max_rate * dt);
+  }
   angle = std::clamp(angle, -max_angle, max_angle);
   float yaw = root_yaw + angle;
 
@@ -741,13 +773,17 @@ void Controller::foot_lock(float dt) {
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
+    const bool was_locked = feet_[side].locked;
     const glm::vec3 target = foot_target(side, animated, settling, dt);
+    hold_heading(side, was_locked, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
     debug_.ik_target[side] = target;
     // A stepping foot is in the air, whatever the playing frame says.
     debug_.contact[side] = debug_.contact[side] && !feet_[side].stepping;
-    if (glm::length(target - animated) >= 1e-5f) reach(side, animated, target);
+    if (glm::length(target - animated) >= 1e-5f || std::abs(feet_[side].heading_offset) > 1e-5f) {
+      reach(side, animated, target);
+    }
   }
 }
 
@@ -805,15 +841,49 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   return target;
 }
 
-// Two-bone IK of one leg toward a toe target, then the bone lengths restored.
+// A planted foot does not swivel on the ground: while locked it keeps the heading it landed
+// with, whatever the body above it does (the leg twists instead), and once released it eases
+// back onto the animation's heading. A lock begins with the heading shown at that moment, so
+// the foot never jumps. Legs without a toe have no heading to hold.
+void Controller::hold_heading(int side, bool was_locked, float dt) {
+  FootLock& f = feet_[side];
+  if (leg_joints_[side][3] < 0) {
+    f.heading_offset = f.heading_offset_velocity = 0.0f;
+    return;
+  }
+  const float animated = foot_heading(side);
+  if (f.locked) {
+    if (!was_locked) f.heading = wrap_angle(animated + f.heading_offset);
+    f.heading_offset = wrap_angle(f.heading - animated);
+    f.heading_offset_velocity = 0.0f;
+    return;
+  }
+  critical_spring_update(f.heading_offset, f.heading_offset_velocity, 0.0f,
+                         settings_.foot_lock_release_halflife, dt);
+}
+
+// The animated foot's heading: the yaw of its foot-to-toe line (radians).
+float Controller::foot_heading(int side) const {
+  const std::vector<int>& leg = leg_joints_[side];
+  const glm::vec3 along = globals_[static_cast<size_t>(leg[3])].translation -
+                          globals_[static_cast<size_t>(leg[2])].translation;
+  return std::atan2(along.x, along.z);
+}
+
+// Two-bone IK of one leg toward a toe target, the foot turned to its held heading, then the
+// bone lengths restored.
 void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& target) {
   const std::span<const int> parents = db_->skeleton.parents();
   const std::vector<int>& leg = leg_joints_[side];
   const int hip = leg[0], knee = leg[1], foot = leg[2];
-  // Reach: the ankle goes where the animated foot rotation puts it above the target toe.
-  const glm::quat foot_rotation = globals_[static_cast<size_t>(foot)].rotation;
+  // Reach: the ankle goes where the foot's rotation (animated, turned to the held heading)
+  // puts it above the target toe.
+  const glm::quat swivel = yaw_rotation(feet_[side].heading_offset);
+  const glm::quat foot_rotation =
+      glm::normalize(swivel * globals_[static_cast<size_t>(foot)].rotation);
   const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
-  glm::vec3 ankle_target = target - (animated - globals_[static_cast<size_t>(foot)].translation);
+  glm::vec3 ankle_target =
+      target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
   ankle_target = hip_position + soft_reach(ankle_target - hip_position, leg_length(side));
   // The knee bends toward where it points now; a nearly straight leg has no such direction
   // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),

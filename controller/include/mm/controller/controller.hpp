@@ -177,6 +177,14 @@ struct ControllerSettings {
   float clamp_max_distance = 0.4f;
   float clamp_max_angle = 0.6f;
 
+  // ---- Turning on the spot. The data has no turns in place: while standing (stick released,
+  // simulation slower than stop_speed) the simulation's facing turns toward the desired facing
+  // no faster than stand_turn_max_rate, speeding up and slowing down at stand_turn_acceleration
+  // (so it eases in and out and stops on the facing), the character's root turns with it, and
+  // the feet step after the turning idle pose.
+  float stand_turn_max_rate = 5.2f;       // rad/s (about 300 degrees per second)
+  float stand_turn_acceleration = 10.0f;  // rad/s^2
+
   // ---- Foot locking and IK.
   bool ik_enabled = true;         // false: the animation's feet as they are
   bool foot_lock_enabled = true;  // hold a foot's toe where it landed while in contact
@@ -299,6 +307,7 @@ class Controller {
   void start_standing();
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
+  void stand_turn(float dt);
   void predict();
   bool should_search() const;
   void build_query();
@@ -325,6 +334,8 @@ class Controller {
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
+  void hold_heading(int side, bool was_locked, float dt);
+  float foot_heading(int side) const;
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
   void refresh_subtree(int joint);
@@ -406,6 +417,11 @@ class Controller {
     bool stepping = false;  // released during a contact: stepping, in the air until it lands
     float lift = 0.0f;      // the step's height above the target (m), and its rate
     float lift_velocity = 0.0f;
+    // The foot's heading (yaw of its foot-to-toe line, radians): held while locked, and the
+    // displayed heading minus the animated one, decaying after a release, with its rate.
+    float heading = 0.0f;
+    float heading_offset = 0.0f;
+    float heading_offset_velocity = 0.0f;
   };
   FootLock feet_[2];
 
