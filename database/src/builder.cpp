@@ -298,11 +298,12 @@ std::string retarget_summary(const std::string& input, size_t clips, const Retar
   return r.left_at_rest.empty() ? line + " none" : line;
 }
 
-// The name of the database skeleton's input in messages: the target clip's file, or the
-// reference input's.
+// The target clip in messages: its file, or its name when it was made in memory.
 std::string target_name(const Clip& target) {
   return "target " + (target.source_path.empty() ? "'" + target.name + "'" : target.source_path);
 }
+
+// The input of the database skeleton in messages: the target, or the reference input.
 std::string skeleton_input_name(const BuildState& state, size_t reference_index) {
   return state.target ? target_name(state.target->clips[0]) : state.input_names[reference_index];
 }
