@@ -235,7 +235,10 @@ struct BuildState {
   std::vector<ClipJob> jobs;
   std::vector<std::vector<std::string>> clip_tag_lists;  // per database clip
   size_t total_frames = 0;
-  // The skeleton other skeletons are retargeted onto (the reference input's), once needed.
+  // BuildOptions::target with its roles, when given: the database skeleton's input.
+  std::optional<InputResult> target;
+  // The skeleton other skeletons are retargeted onto (the target's or the reference input's),
+  // once needed.
   std::optional<RetargetSkeleton> retarget_target;
   // Per retargeted source skeleton: its line in rep.retargeted and its clip count.
   std::map<std::string, std::pair<size_t, size_t>> retargeted;
@@ -295,14 +298,51 @@ std::string retarget_summary(const std::string& input, size_t clips, const Retar
   return r.left_at_rest.empty() ? line + " none" : line;
 }
 
-// Phase 2a for an input on another skeleton than the reference's: its clips become clips of the
-// reference skeleton (retarget.hpp).
+// The target clip in messages: its file, or its name when it was made in memory.
+std::string target_name(const Clip& target) {
+  return "target " + (target.source_path.empty() ? "'" + target.name + "'" : target.source_path);
+}
+
+// The input of the database skeleton in messages: the target, or the reference input.
+std::string skeleton_input_name(const BuildState& state, size_t reference_index) {
+  return state.target ? target_name(state.target->clips[0]) : state.input_names[reference_index];
+}
+
+// The input whose skeleton, roles and rest pose the database takes.
+const InputResult& skeleton_input(const BuildState& state, size_t reference_index) {
+  return state.target ? *state.target : state.results[reference_index];
+}
+
+// Phase 2a, before the inputs: the target's roles (BuildOptions::target), when there is one.
+Status prepare_target(BuildState& state) {
+  const std::optional<Clip>& target = state.options.target;
+  if (!target) return Status::success();
+  InputResult result;
+  result.clips.assign(1, *target);
+  const std::string name = target_name(*target);
+  if (Status s = result.clips[0].validate(); !s) return Error{name + ": " + s.message()};
+  if (Status s = check_joint_map(target->skeleton, state.options.target_role_map); !s) {
+    return Error{name + ": " + s.message()};
+  }
+  JointRoles names = state.options.roles;
+  apply_joint_map(names, state.options.target_role_map);
+  Result<JointRoleIndices> roles = find_joint_roles(target->skeleton, names);
+  if (!roles) return Error{name + ": " + roles.message()};
+  result.roles = *roles;
+  state.target = std::move(result);
+  return Status::success();
+}
+
+// Phase 2a for an input on another skeleton than the database's: its clips become clips of the
+// database skeleton (retarget.hpp).
 Status retarget_input(BuildState& state, size_t reference_index, size_t i) {
-  const InputResult& reference = state.results[reference_index];
+  const InputResult& reference = skeleton_input(state, reference_index);
   InputResult& result = state.results[i];
   if (!state.retarget_target) {
     Result<RetargetSkeleton> target = describe_for_retargeting(reference.clips[0], reference.roles);
-    if (!target) return Error{state.input_names[reference_index] + ": " + target.message()};
+    if (!target) {
+      return Error{skeleton_input_name(state, reference_index) + ": " + target.message()};
+    }
     state.retarget_target = std::move(target).value();
   }
   Result<RetargetSkeleton> source = describe_for_retargeting(result.clips[0], result.roles);
@@ -327,11 +367,12 @@ Status retarget_input(BuildState& state, size_t reference_index, size_t i) {
 }
 
 // Phase 2a, in input order: refuses what failed and retargets inputs of other skeletons onto
-// the first one's; returns the index of the first usable input, whose skeleton the database
-// takes.
+// the target's, or without a target the first usable input's; returns the index of the first
+// usable input (whose skeleton the database takes when there is no target).
 Result<size_t> choose_reference_input(BuildState& state) {
-  const InputResult* reference = nullptr;
-  size_t reference_index = 0;
+  if (Status s = prepare_target(state); !s) return Error{s.message()};
+  const InputResult* reference = state.target ? &*state.target : nullptr;
+  std::optional<size_t> reference_index;
   for (size_t i = 0; i < state.results.size(); ++i) {
     InputResult& result = state.results[i];
     if (!result.processed) continue;
@@ -339,7 +380,7 @@ Result<size_t> choose_reference_input(BuildState& state) {
     Status status = result.status;
     if (status && reference &&
         !reference->clips[0].skeleton.same_topology(result.clips[0].skeleton)) {
-      status = retarget_input(state, reference_index, i);
+      status = retarget_input(state, reference_index.value_or(0), i);
     }
     if (!status) {
       if (!state.options.skip_bad) return Error{status.message()};
@@ -348,16 +389,16 @@ Result<size_t> choose_reference_input(BuildState& state) {
       result.processed = false;
       continue;
     }
-    if (!reference) {
-      reference = &result;
+    if (!reference_index) {
       reference_index = i;
+      if (!reference) reference = &result;
     }
   }
-  if (!reference) {
+  if (!reference_index) {
     return Error{"build: no usable input: all " + std::to_string(state.results.size()) +
                  " were refused (the first: " + state.rep.refused.front().message + ")"};
   }
-  return reference_index;
+  return *reference_index;
 }
 
 // Phase 2a, after retargeting: idle takes of the data become their calm segments (idle.hpp).
@@ -395,13 +436,15 @@ void split_idle_clips(BuildState& state) {
 // Phase 2b: the database skeleton (simulation root + the reference's joints), its roles, the
 // feature channels' joints and the mirror map.
 Status start_database(BuildState& state, size_t reference_index) {
-  const InputResult& reference = state.results[reference_index];
+  const InputResult& reference = skeleton_input(state, reference_index);
   const Skeleton& source_skeleton = reference.clips[0].skeleton;
   Database& db = state.db;
   db.frame_time = 1.0f / state.options.rate;
   db.schema = state.options.schema;
   Result<Skeleton> skeleton = add_simulation_root(source_skeleton);
-  if (!skeleton) return Error{state.input_names[reference_index] + ": " + skeleton.message()};
+  if (!skeleton) {
+    return Error{skeleton_input_name(state, reference_index) + ": " + skeleton.message()};
+  }
   db.skeleton = std::move(skeleton).value();
   for (const JointRoleInfo& role : kJointRoles) {
     const int j = reference.roles.*role.index;

@@ -410,6 +410,38 @@ TEST(BuilderMixedSkeletons, AnotherSkeletonIsRetargetedOntoTheFirst) {
   EXPECT_NE(db.message().find("required role 'left_upper_leg'"), std::string::npos) << db.message();
 }
 
+// BuildOptions::target: the database takes its skeleton (not the first input's) and its roles,
+// every input is retargeted onto it, and its own frames stay out of the database.
+TEST(BuilderMixedSkeletons, ATargetSkeletonIsTheDatabasesAndTakesItsRoles) {
+  Result<Clip> target =
+      load_bvh(test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh", BvhOptions{0.0f});
+  ASSERT_TRUE(target) << target.message();
+  const fs::path inputs[] = {test::clip_path(kClips[0])};
+  BuildOptions options;
+  options.idle_seconds = 0.0f;
+  options.target = *target;
+  BuildReport report;
+  Result<Database> db = build_database(inputs, options, &report);
+  ASSERT_TRUE(db) << db.message();
+  ASSERT_EQ(db->clips.size(), 1u);
+  EXPECT_EQ(db->clips[0].name, kClips[0]);
+  ASSERT_EQ(db->joint_count(), target->joint_count() + 1);
+  for (int j = 0; j < target->joint_count(); ++j) {
+    EXPECT_EQ(db->skeleton.name(j + 1), target->skeleton.name(j));
+    EXPECT_EQ(db->skeleton.rest(j + 1).translation, target->skeleton.rest(j).translation);
+  }
+  EXPECT_EQ(db->roles.hips, 1);  // "pelvis", behind the simulation root
+  ASSERT_EQ(report.retargeted.size(), 1u);
+
+  // The target's map is checked against the target's skeleton, and its errors name the target.
+  options.target_role_map = {{"head", "Skull", 2, "rig.map"}};
+  db = build_database(inputs, options, &report);
+  ASSERT_FALSE(db);
+  EXPECT_NE(db.message().find("target "), std::string::npos) << db.message();
+  EXPECT_NE(db.message().find("rig.map:2: head=Skull: no joint named 'Skull'"), std::string::npos)
+      << db.message();
+}
+
 // Real idle clips (ReActIdle, on another skeleton) are retargeted, cut into calm segments,
 // tagged idle, stand still at joint 0 and replace the synthesized held-frame idle clip.
 TEST(BuilderMixedSkeletons, ReActIdleClipsBecomeStillStandingIdleClips) {

@@ -49,7 +49,7 @@ fs::path folder_with_real_clips(const fs::path& dir) {
 TEST(Cli, HelpListsEveryCommandAndEachCommandHasHelp) {
   const CommandRun help = run_mm("--help");
   EXPECT_EQ(help.exit_code, 0);
-  for (const char* command : {"build", "info", "export", "search-bench"}) {
+  for (const char* command : {"build", "info", "export", "retarget", "search-bench"}) {
     EXPECT_NE(help.output.find(command), std::string::npos) << command;
     const CommandRun sub = run_mm(std::string(command) + " --help");
     EXPECT_EQ(sub.exit_code, 0) << command;
@@ -336,9 +336,11 @@ TEST(Cli, EveryCommandsHelpListsItsOptions) {
       {"build",
        {"-o,--output", "--rate", "--mirror", "--idle", "--tags", "--skip-bad", "--threads",
         "--scale", "--role", "--mirror-pair", "--forward-axis", "--contact-height",
-        "--contact-toe-height", "--contact-speed", "--quiet"}},
+        "--contact-toe-height", "--contact-speed", "--quiet", "--target", "--target-map"}},
       {"info", {"--clips"}},
       {"export", {"-o,--output", "--clip", "--scale", "--body", "--weights", "--voxel"}},
+      {"retarget",
+       {"--to", "-o,--output", "--map", "--target-map", "--rest-frame", "--rate", "--clip"}},
       {"eval", {"--db", "--script", "--dt", "--ik", "--set", "--json", "--dump"}},
       {"crowd-bench", {"--db", "--characters", "--seconds", "--threads", "--set", "--json"}},
       {"search-bench", {"--db", "--queries"}},

@@ -17,6 +17,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "motion_files.hpp"
 #include "number_parsing.hpp"
 #include "progress_bar.hpp"
 #include "shared_options.hpp"
@@ -28,6 +29,8 @@ struct Arguments {
   std::vector<std::string> inputs;
   std::string output;
   std::string map_file;
+  std::string target_file;
+  std::string target_map_file;
   BuildOptions options;
   bool quiet = false;
 };
@@ -85,6 +88,17 @@ void add_skeleton_options(CLI::App& app, Arguments& out) {
                  "joint map: lines \"role=Joint\" naming the joint of a role ('#' starts a "
                  "comment); roles: " +
                      joint_role_names())
+      ->type_name("FILE");
+  CLI::Option* target =
+      app.add_option(
+             "--target", out.target_file,
+             "the database skeleton: a .bvh, .gltf or .glb file whose joints, hierarchy and "
+             "rest offsets the database takes instead of the first input's (its frames are "
+             "not added); inputs of another skeleton are retargeted onto it")
+          ->type_name("FILE");
+  app.add_option("--target-map", out.target_map_file,
+                 "joint map of the --target skeleton (lines \"role=Joint\")")
+      ->needs(target)
       ->type_name("FILE");
   app.add_option_function<std::vector<std::string>>(
          "--role",
@@ -218,18 +232,37 @@ void print_summary(const std::string& output, const Database& db, const BuildRep
       report.finish_seconds, seconds - report.total_seconds);
 }
 
+// Reads the map files and the target into the build options.
+Status read_skeleton_files(Arguments& arguments) {
+  BuildOptions& options = arguments.options;
+  if (!arguments.map_file.empty()) {
+    Result<std::vector<JointRoleAssignment>> map = load_joint_map(arguments.map_file);
+    if (!map) return Error{map.message()};
+    // The map file first: --role on the command line overrides its lines.
+    map->insert(map->end(), options.role_map.begin(), options.role_map.end());
+    options.role_map = std::move(map).value();
+  }
+  if (!arguments.target_map_file.empty()) {
+    Result<std::vector<JointRoleAssignment>> map = load_joint_map(arguments.target_map_file);
+    if (!map) return Error{map.message()};
+    options.target_role_map = std::move(map).value();
+  }
+  if (!arguments.target_file.empty()) {
+    MotionFileOptions read;
+    read.bvh_scale = options.bvh.scale;
+    Result<MotionFile> target = read_motion_file(arguments.target_file, read);
+    if (!target) return Error{target.message()};
+    options.target = std::move(target->clip);
+  }
+  return Status::success();
+}
+
 int run_build(const std::vector<std::string>& args) {
   Arguments arguments;
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
-  if (!arguments.map_file.empty()) {
-    Result<std::vector<JointRoleAssignment>> map = load_joint_map(arguments.map_file);
-    if (!map) {
-      std::fprintf(stderr, "mm build: %s\n", map.message().c_str());
-      return 1;
-    }
-    // The map file first: --role on the command line overrides its lines.
-    map->insert(map->end(), arguments.options.role_map.begin(), arguments.options.role_map.end());
-    arguments.options.role_map = std::move(map).value();
+  if (Status s = read_skeleton_files(arguments); !s) {
+    std::fprintf(stderr, "mm build: %s\n", s.message().c_str());
+    return 1;
   }
   const auto start = std::chrono::steady_clock::now();
   BuildReport report;

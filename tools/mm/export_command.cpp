@@ -13,7 +13,7 @@
 #include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
-#include "number_parsing.hpp"
+#include "motion_files.hpp"
 #include "shared_options.hpp"
 
 namespace mm::cli {
@@ -78,27 +78,6 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
 std::string clip_description(const std::string& name, int frames, int joints) {
   return "'" + name + "', " + std::to_string(frames) + " frames, " + std::to_string(joints) +
          " joints";
-}
-
-// The index of the clip `selector` names among `names` (an index or an exact name), or an error
-// listing what exists.
-Result<size_t> select_clip(const std::string& selector, const std::vector<std::string>& names,
-                           const std::string& file) {
-  if (names.empty()) return Error{file + ": has no clips"};
-  if (selector.empty()) return size_t{0};
-  if (std::optional<long long> index = parse_count(selector)) {
-    if (*index < static_cast<long long>(names.size())) return static_cast<size_t>(*index);
-    return Error{file + ": clip index " + selector + " is out of range (the file has " +
-                 std::to_string(names.size()) + " clips, 0 to " + std::to_string(names.size() - 1) +
-                 ")"};
-  }
-  for (size_t i = 0; i < names.size(); ++i) {
-    if (names[i] == selector) return i;
-  }
-  std::string some;
-  for (size_t i = 0; i < names.size() && i < 8; ++i) some += (i ? ", " : "") + names[i];
-  if (names.size() > 8) some += ", ...";
-  return Error{file + ": no clip named '" + selector + "' (clips: " + some + ")"};
 }
 
 // A database clip as a pose sequence: the stored local positions and rotations, unit scale.

@@ -4,10 +4,10 @@
 // Four phases. 1, parallel over inputs (workers pull input indices from a shared counter):
 // import (BVH or glTF), validate, resample to the database rate, find the joint roles. 2, in
 // input order: refuse failed inputs, retarget the clips of skeletons other than the first
-// input's onto it (retarget.hpp; one line per source skeleton in the report), lay out the
-// clip ranges (a mirrored copy right after its original), their tags and the database arrays.
-// 3, parallel over clips, each worker with its own reusable buffers: preprocess (simulation
-// root, velocities, contacts; see preprocess.hpp) and extract the raw features
+// input's (or BuildOptions::target's) onto it (retarget.hpp; one line per source skeleton in the
+// report), lay out the clip ranges (a mirrored copy right after its original), their tags and the
+// database arrays. 3, parallel over clips, each worker with its own reusable buffers: preprocess
+// (simulation root, velocities, contacts; see preprocess.hpp) and extract the raw features
 // (feature_extraction.hpp) straight into the database arrays at the clip's frames. 4:
 // normalize the features over the searchable frames of the whole database and validate the
 // result. Every per-clip step is independent of the others and the statistics are summed in
@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -83,6 +84,13 @@ struct BuildOptions {
   std::function<void(size_t done, size_t total)> progress;
   // Settings of the BVH importer (its scale turns file units into metres).
   BvhOptions bvh;
+  // The database skeleton, when set: this clip's skeleton (joint names, hierarchy, rest
+  // offsets) instead of the first input's, with its roles (found with `roles` and
+  // target_role_map) and its rest pose and ground for retargeting; every input of another
+  // skeleton is retargeted onto it. Its frames are not added to the database.
+  std::optional<Clip> target;
+  // Roles named for the target's skeleton, as role_map does for the inputs'.
+  std::vector<JointRoleAssignment> target_role_map;
 };
 
 // An input the builder refused, and why.
