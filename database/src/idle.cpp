@@ -102,6 +102,11 @@ float horizontal_feet_distance(const Database& db, int frame) {
 std::vector<int> arm_end_joints(const Skeleton& skeleton, const JointRoleIndices& roles) {
   const int joints = skeleton.joint_count();
   std::vector<int> ends;
+  // The map knows the arms: the hands, or the wrist ends of the lower arms (a skeleton without
+  // hands). Leaves elsewhere (ReActIdle's pelvis stubs) are not arms.
+  const int left = roles.left_hand >= 0 ? roles.left_hand : roles.left_lower_arm;
+  const int right = roles.right_hand >= 0 ? roles.right_hand : roles.right_lower_arm;
+  if (left >= 0 && right >= 0 && left < joints && right < joints) return {left, right};
   if (roles.head < 0 || roles.hips < 0 || roles.head >= joints || roles.hips >= joints) {
     return ends;
   }

@@ -132,6 +132,21 @@ TEST(IdleHandMade, FeetDistanceAndArmEnds) {
   EXPECT_EQ(highest_arm_end_over_hips(headless, 4), -std::numeric_limits<float>::infinity());
 }
 
+TEST(IdleHandMade, ArmEndsComeFromTheArmRolesWhenTheMapHasThem) {
+  // Leaves that are not arms (ReActIdle's pelvis stubs) are left out once the roles name arms.
+  const Skeleton sk =
+      Skeleton::create({"Hips", "Stub", "Chest", "Head", "ArmL", "ForeL", "ArmR", "ForeR"},
+                       {-1, 0, 0, 2, 2, 4, 2, 6}, std::vector<Transform>(8))
+          .value();
+  JointRoleIndices roles;
+  roles.hips = 0;
+  roles.head = 3;
+  EXPECT_EQ(arm_end_joints(sk, roles), (std::vector<int>{1, 5, 7}));  // the leaves
+  roles.left_lower_arm = 5;
+  roles.right_lower_arm = 7;
+  EXPECT_EQ(arm_end_joints(sk, roles), (std::vector<int>{5, 7}));
+}
+
 TEST(IdleHandMade, EachCriterionRemovesItsFrameAndTheCalmestLowestFrameWins) {
   const Database db = hand_made_database();
   const IdleSourceSearch s = search_idle_source(db);

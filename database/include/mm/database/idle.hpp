@@ -16,7 +16,7 @@
 //   - the two feet (the left_foot and right_foot roles) are closer than
 //     IdleCriteria::max_feet_distance horizontally, by forward kinematics of the frame (side
 //     by side, not the double support of a stride);
-//   - the arms hang: every arm end (arm_end_joints: the hands, or the finger tips) is lower
+//   - the arms hang: every arm end (arm_end_joints: the hands, or the lower arms) is lower
 //     than the hips plus IdleCriteria::max_arm_end_over_hips. Without this the calmest frame
 //     of a gesture take can be a hand held still above the head at the top of the gesture.
 // The candidate with the least motion energy wins, the lowest frame on a tie:
@@ -70,10 +70,11 @@ double idle_motion_energy(const Database& db, int frame);
 // on one frame; infinity when the database lacks either role.
 float horizontal_feet_distance(const Database& db, int frame);
 
-// The joints the arm check looks at: the leaves of the skeleton (joints without children)
-// that lie neither in the head role's subtree nor in a foot role's: the hands, or the finger
-// tips of a skeleton that has fingers. Empty when the head or hips role is missing (the head
-// itself would then pass for a raised hand), which leaves the check out.
+// The joints the arm check looks at: the two hand roles (or, without hands, the lower arms,
+// whose ends are the wrists) when the joint map has both sides; otherwise the leaves of the
+// skeleton (joints without children) that lie neither in the head role's subtree nor in a foot
+// role's. Empty, without arm roles, when the head or hips role is missing (the head itself
+// would then pass for a raised hand), which leaves the check out.
 std::vector<int> arm_end_joints(const Skeleton& skeleton, const JointRoleIndices& roles);
 
 // How far in metres the highest arm end of one frame is above the hips (negative: below);
