@@ -7,15 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
-# The default data: the Bandai normal clips, plus the ReActIdle genuine idles where they exist
-# (another skeleton: retargeted by mm build, and played when the character stands).
-if [ -n "${MM_DATA:-}" ]; then
-  inputs=("$MM_DATA")
-else
-  inputs=("$root/../shared/mocap/bandai-normal")
-  [ -d "$root/../shared/mocap/reactidle/genuine" ] && inputs+=("$root/../shared/mocap/reactidle/genuine")
-fi
-data=${inputs[0]}
+source scripts/default_data.sh
 
 scripts/setup.sh release
 mm=build/release/tools/mm

@@ -11,14 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 
-# The default data: the Bandai normal clips, plus the ReActIdle genuine idles where they exist
-# (another skeleton: retargeted by mm build, and played when the character stands).
-if [ -n "${MM_DATA:-}" ]; then
-  inputs=("$MM_DATA")
-else
-  inputs=("$root/../shared/mocap/bandai-normal")
-  [ -d "$root/../shared/mocap/reactidle/genuine" ] && inputs+=("$root/../shared/mocap/reactidle/genuine")
-fi
+source scripts/default_data.sh
 data=${inputs[0]}
 if [ ! -d "$data" ] || [ -z "$(find "$data" -maxdepth 1 \( -name '*.bvh' -o -name '*.glb' -o -name '*.gltf' \) -print -quit)" ]; then
   cat >&2 <<MSG
