@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace mm::test {
@@ -28,6 +29,12 @@ inline CommandRun run_mm(const std::string& arguments) {
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
+}
+
+// A path in single quotes, for a command line (the test paths hold no quotes).
+inline std::string quoted(const std::filesystem::path& p) {
+  std::string q = "'";
+  return q.append(p.string()).append("'");
 }
 
 }  // namespace mm::test

@@ -24,12 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::CommandRun;
+using test::quoted;
 using test::run_mm;
-
-std::string quoted(const fs::path& p) {
-  std::string q = "'";
-  return q.append(p.string()).append("'");
-}
 
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

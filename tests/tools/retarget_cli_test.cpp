@@ -23,12 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 
 using test::CommandRun;
+using test::quoted;
 using test::run_mm;
-
-std::string quoted(const fs::path& p) {
-  std::string q = "'";
-  return q.append(p.string()).append("'");
-}
 
 fs::path bandai_walk() {
   return test::clip_path("dataset-2_walk_normal_001");
