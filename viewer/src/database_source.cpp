@@ -58,6 +58,7 @@ Result<std::shared_ptr<const Database>> build_folder(const fs::path& folder) {
   std::fflush(stdout);
   cli::ProgressBar progress("mm-viewer: build", true);
   BuildOptions options;
+  options.bvh.scale = 0.0f;  // units from each skeleton's size, as `mm build` without --scale
   options.progress = [&](size_t done, size_t total) { progress.update(done, total); };
   Result<Database> db = build_database(*files, options);
   if (!db) return db.error();
