@@ -761,8 +761,7 @@ void Controller::finish_pose() {
 void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
-  const bool settling =
-      stopping_ && (db_->clips[static_cast<size_t>(clip_)].tags & shared_->idle_tags()) != 0;
+  const bool settling = on_idle_clip();
   for (int side = 0; side < 2; ++side) {
     const std::vector<int>& leg = leg_joints_[side];
     const int effector = leg[3] >= 0 ? leg[3] : leg[2];
