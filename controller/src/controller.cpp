@@ -23,6 +23,12 @@ const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
 constexpr float kRelockOffset = 0.01f;
 // Standing, a held toe farther than this (m) from where the idle pose puts it steps there.
 constexpr float kSettleDistance = 0.08f;
+// Standing, a held foot turned farther than this (radians) from the idle pose's heading steps
+// round to it: a turn on the spot leaves the planted feet behind and twists the legs.
+constexpr float kSettleHeading = 0.25f;
+// A step lands once its heading too has come this close (radians) to the animation's, so a
+// foot never plants with the twist it stepped to undo.
+constexpr float kRelockHeading = 0.05f;
 // A step lifts the toe by this share of the distance it still has to go, at most kStepHeight
 // (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 0.5f;
@@ -69,17 +75,22 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 
 // Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
 // target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
-// kSoftReach of the leg's length are kept, longer ones approach the full length exponentially.
+// kSoftReach of the leg's length, or up to the animation's own hip-to-ankle distance when its leg
+// is straighter than that, are kept; longer ones approach the full length exponentially, over
+// at least kMinSoftSpan of it. Keeping the animation's own extension matters for a standing
+// pose with locked knees: softening it would bend both knees forward by centimetres.
 constexpr float kSoftReach = 0.96f;
+constexpr float kMinSoftSpan = 0.01f;
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
-glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float length) {
+
+glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, float length) {
   const float d = glm::length(hip_to_ankle);
-  const float soft = kSoftReach * length;
-  if (d <= soft || d < 1e-6f) return hip_to_ankle;
-  const float span = length - soft;
-  const float reached = soft + span * (1.0f - std::exp(-(d - soft) / span));
+  const float kept = std::max(kSoftReach * length, std::min(animated_distance, length));
+  if (d <= kept || d < 1e-6f) return hip_to_ankle;
+  const float span = std::max(length - kept, kMinSoftSpan * length);
+  const float reached = kept + span * (1.0f - std::exp(-(d - kept) / span));
   return hip_to_ankle * (reached / d);
 }
 
@@ -806,7 +817,8 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
     const bool settle =
-        settling && !feet_[1 - side].stepping && glm::length(drag) > kSettleDistance;
+        settling && !feet_[1 - side].stepping &&
+        (glm::length(drag) > kSettleDistance || std::abs(f.heading_offset) > kSettleHeading);
     // Beyond the leg's reach (softened, see soft_reach) the held toe would be dragged along the
     // ground anyway.
     const std::vector<int>& leg = leg_joints_[side];
@@ -828,13 +840,16 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
                          settings_.foot_lock_release_halflife, dt);
   glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
   f.target = target;
-  // A stepping foot rises with the distance it still has to go and lands as it arrives; the
-  // lift itself follows that height on a spring, so the foot leaves the ground smoothly.
-  const float lift_goal =
-      f.stepping ? std::min(kStepHeight, kStepLift * std::hypot(f.offset.x, f.offset.z)) : 0.0f;
+  // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
+  // turning round its toe still has its heel's arc to go); the lift itself follows that height
+  // on a spring, so the foot leaves the ground smoothly.
+  const float to_go =
+      std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
+  const float lift_goal = f.stepping ? std::min(kStepHeight, kStepLift * to_go) : 0.0f;
   critical_spring_update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
   target.y += f.lift;
-  if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset) {
+  if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset &&
+      std::abs(f.heading_offset) < kRelockHeading) {
     f.stepping = false;
   }
   return target;
@@ -883,7 +898,10 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
   glm::vec3 ankle_target =
       target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
-  ankle_target = hip_position + soft_reach(ankle_target - hip_position, leg_length(side));
+  const float animated_reach =
+      glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
+  ankle_target =
+      hip_position + soft_reach(ankle_target - hip_position, animated_reach, leg_length(side));
   // The knee bends toward where it points now; a nearly straight leg has no such direction
   // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
   // so the character's forward breaks the tie.
@@ -933,6 +951,12 @@ void Controller::restore_leg_lengths(int side) {
     locals_[joint].rotation = glm::normalize(glm::conjugate(parent_rotation) * global);
     refresh_subtree(leg[i]);
   }
+}
+
+// The foot's length, ankle to toe, in the pose being played (0 without a toe).
+float Controller::foot_length(int side) const {
+  const int toe = leg_joints_[side][3];
+  return toe >= 0 ? glm::length(locals_[static_cast<size_t>(toe)].translation) : 0.0f;
 }
 
 // The leg's length in the pose being played (actors' legs differ between takes).

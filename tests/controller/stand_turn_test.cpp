@@ -35,7 +35,20 @@ struct StandTurn {
   float peak_rate_degrees = 0.0f;  // the hips' largest yaw rate, frame to frame
   float lift[2] = {0.0f, 0.0f};    // each toe's highest rise above where it stood (m)
   int stepping_frames = 0;         // frames with a foot out of contact
+  // How far each foot ends up turned against the hips, beyond how it stood before the turn
+  // (degrees): a foot left planted at its old heading twists the leg above it.
+  float foot_twist_degrees[2] = {0.0f, 0.0f};
+  // Each leg's hip-to-ankle distance over its length on the last frame: 1 is straight.
+  float extension[2] = {0.0f, 0.0f};
 };
+
+// The yaw of a foot's foot-to-toe line relative to the hips' yaw.
+float foot_yaw_to_hips(const Controller& c, int foot, int toe) {
+  const std::span<const Transform> g = c.global_transforms();
+  const glm::vec3 along =
+      g[static_cast<size_t>(toe)].translation - g[static_cast<size_t>(foot)].translation;
+  return wrap_angle(std::atan2(along.x, along.z) - hips_yaw(c));
+}
 
 // Stands for a second facing +Z, then asks for the facing `degrees` away (positive: toward +X)
 // and holds it for `seconds`.
@@ -46,6 +59,7 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
   Controller c = std::move(made).value();
   const Database& db = c.controller_database().database();
   const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
   const int settle_frames = static_cast<int>(std::lround(1.0f / dt));
   for (int i = 0; i < settle_frames; ++i) c.update(dt, ControllerInput{});
 
@@ -55,8 +69,10 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
   const float goal = glm::radians(degrees);
   StandTurn turn;
   float planted[2];
+  float stance[2];
   for (int side = 0; side < 2; ++side) {
     planted[side] = c.global_transforms()[static_cast<size_t>(toes[side])].translation.y;
+    stance[side] = foot_yaw_to_hips(c, feet[side], toes[side]);
   }
   float previous_yaw = hips_yaw(c);
   const int frames = static_cast<int>(std::lround(seconds / dt));
@@ -79,6 +95,17 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
       if (!c.debug().contact[side]) ++turn.stepping_frames;
     }
   }
+  for (int side = 0; side < 2; ++side) {
+    turn.foot_twist_degrees[side] =
+        yaw_error_degrees(foot_yaw_to_hips(c, feet[side], toes[side]), stance[side]);
+    const std::span<const Transform> g = c.global_transforms();
+    const int knee = db.skeleton.parents()[static_cast<size_t>(feet[side])];
+    const int hip = db.skeleton.parents()[static_cast<size_t>(knee)];
+    const glm::vec3 h = g[static_cast<size_t>(hip)].translation;
+    const glm::vec3 k = g[static_cast<size_t>(knee)].translation;
+    const glm::vec3 a = g[static_cast<size_t>(feet[side])].translation;
+    turn.extension[side] = glm::length(a - h) / (glm::length(k - h) + glm::length(a - k));
+  }
   return turn;
 }
 
@@ -93,6 +120,11 @@ void expect_natural_turn(float degrees, float dt, float settle_limit) {
   EXPECT_GT(turn.lift[0], 0.02f);
   EXPECT_GT(turn.lift[1], 0.02f);
   EXPECT_GT(turn.stepping_frames, 0);
+  printf("twist %.1f %.1f lift %.3f %.3f\n", turn.foot_twist_degrees[0], turn.foot_twist_degrees[1],
+         turn.lift[0], turn.lift[1]);
+  // And they come round with the body: no leg is left twisted (crossed shins) once it stands.
+  EXPECT_LT(turn.foot_twist_degrees[0], 20.0f);
+  EXPECT_LT(turn.foot_twist_degrees[1], 20.0f);
 }
 
 // A quarter turn in about 0.8 s and a half turn in about 1.2 s, both ways (a half turn of
@@ -124,6 +156,23 @@ TEST(StandTurnTest, SettingsAreValidatedAndSetByName) {
   s = {};
   s.stand_turn_max_rate = std::nanf("");
   EXPECT_NE(s.validate().message().find("stand_turn_max_rate"), std::string::npos);
+}
+
+// Standing after the turn, the feet are planted where the idle pose puts them (within a step's
+// threshold), so the legs keep the pose's own extension: foot IK must not bend knees the data
+// holds straight (both knees bent forward read as crossed shins).
+TEST(StandTurnTest, StandingLegsKeepThePosesExtension) {
+  ControllerSettings no_ik;
+  no_ik.ik_enabled = false;
+  const float dt = 1.0f / 60.0f;
+  for (const float degrees : {179.0f, -90.0f}) {
+    const StandTurn with_ik = turn_on_the_spot(degrees, dt);
+    const StandTurn animated = turn_on_the_spot(degrees, dt, 3.0f, no_ik);
+    for (int side = 0; side < 2; ++side) {
+      SCOPED_TRACE(testing::Message() << degrees << " degrees, side " << side);
+      EXPECT_NEAR(with_ik.extension[side], animated.extension[side], 0.002f);
+    }
+  }
 }
 
 // The limit is what keeps the hips natural: without it the same turn is too fast, so the test

@@ -339,8 +339,9 @@ class Controller {
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
   void refresh_subtree(int joint);
-  float leg_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of a
-                                     // joint and its descendants from the locals
+  float leg_length(int side) const;
+  float foot_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of
+                                      // a joint and its descendants from the locals
   void finish_pose();
   void refresh_outputs(float dt);
   uint64_t resolve_tag(std::string_view tag) const;
