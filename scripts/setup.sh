@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project needs (only those missing), then configures and
-# builds one configuration. Usage: scripts/setup.sh [release|asan|fuzz]   (default: release)
+# builds one configuration. Usage: scripts/setup.sh [release|asan|tsan|fuzz]   (default: release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,6 +26,7 @@ fi
 
 config=${1:-release}
 jobs=$(nproc)
+targets=()  # empty: every target
 case "$config" in
   release)
     cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DMM_WERROR=ON >/dev/null ;;
@@ -34,10 +35,17 @@ case "$config" in
     cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON -DMM_WERROR=ON \
       "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
       -DMM_BUILD_BENCH=OFF >/dev/null ;;
+  tsan)
+    # ThreadSanitizer, optimized like asan, over the thread tests only (the target
+    # mm_thread_tests of tests/CMakeLists.txt): the rest runs on one thread, and the tools and the
+    # viewer are not built.
+    cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE_THREAD=ON \
+      -DMM_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" -DMM_BUILD_BENCH=OFF >/dev/null
+    targets=(--target mm_thread_tests) ;;
   fuzz)
     CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_BUILD_FUZZ=ON \
       -DMM_BUILD_TESTS=OFF -DMM_BUILD_BENCH=OFF >/dev/null ;;
-  *) echo "setup: unknown configuration '$config' (release, asan or fuzz)" >&2; exit 2 ;;
+  *) echo "setup: unknown configuration '$config' (release, asan, tsan or fuzz)" >&2; exit 2 ;;
 esac
 echo "setup: building build/$config with $jobs jobs"
-cmake --build "build/$config" -j "$jobs"
+cmake --build "build/$config" -j "$jobs" "${targets[@]}"

@@ -20,6 +20,16 @@ float unit(std::mt19937& rng) {
   return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
 }
 
+// The mean of every character's update times (microseconds) over frames [first, last).
+double mean_update_us(const std::vector<float>& update_us, size_t characters, size_t frames,
+                      size_t first, size_t last) {
+  double sum = 0.0;
+  for (size_t i = 0; i < characters; ++i) {
+    for (size_t f = first; f < last; ++f) sum += update_us[i * frames + f];
+  }
+  return sum / static_cast<double>(characters * (last - first));
+}
+
 }  // namespace
 
 InputScript varied_input_script(uint32_t seed, float seconds) {
@@ -119,6 +129,12 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   }
   result.update_us_mean = total_update * 1e6 / static_cast<double>(update_us.size());
   result.search_share = total_update > 0.0 ? total_search / total_update : 0.0;
+  const size_t all_frames = static_cast<size_t>(frames);
+  const size_t window = std::clamp<size_t>(
+      static_cast<size_t>(std::lround(kCrowdWindowSeconds / options.dt)), 1, all_frames);
+  result.update_us_first_window = mean_update_us(update_us, n, all_frames, 0, window);
+  result.update_us_last_window =
+      mean_update_us(update_us, n, all_frames, all_frames - window, all_frames);
   const size_t rank =
       std::min(update_us.size() - 1, static_cast<size_t>(std::ceil(0.99 * update_us.size())) - 1);
   std::nth_element(update_us.begin(), update_us.begin() + static_cast<std::ptrdiff_t>(rank),

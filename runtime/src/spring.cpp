@@ -10,8 +10,20 @@ namespace mm {
 
 namespace {
 
-// Beyond this many time constants exp(-w*t) is below 1e-43: the spring has arrived.
-constexpr double kArrivedExponent = 100.0;
+// Beyond this many time constants exp(-w*t) is below 1e-26: the spring has arrived (any state
+// below 1e14 would decay under kSpringNegligible), and the float coefficients of a shorter step
+// stay clear of the subnormal range.
+constexpr double kArrivedExponent = 60.0;
+
+// A state component smaller than kSpringNegligible is exactly zero (spring.hpp).
+double settled(double value) {
+  return std::abs(value) < static_cast<double>(kSpringNegligible) ? 0.0 : value;
+}
+
+glm::vec3 settled(const glm::vec3& v) {
+  auto component = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
+  return {component(v.x), component(v.y), component(v.z)};
+}
 
 bool finite(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -80,8 +92,8 @@ glm::vec3 scaled(double s, const glm::vec3& v) {
 void apply_spring(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, const SpringCoefficients& c) {
   const glm::vec3 j0 = x - goal;
   const glm::vec3 v0 = v;
-  x = goal + scaled(c.xx, j0) + scaled(c.xv, v0);
-  v = scaled(c.vx, j0) + scaled(c.vv, v0);
+  x = goal + settled(scaled(c.xx, j0) + scaled(c.xv, v0));
+  v = settled(scaled(c.vx, j0) + scaled(c.vv, v0));
 }
 
 void apply_character(glm::vec3& x, glm::vec3& v, glm::vec3& a, const glm::vec3& desired,
@@ -89,8 +101,8 @@ void apply_character(glm::vec3& x, glm::vec3& v, glm::vec3& a, const glm::vec3& 
   const glm::vec3 j0 = v - desired;
   const glm::vec3 j1 = a + scaled(c.w, j0);
   x = x + scaled(c.t, desired) + scaled(c.x_j0, j0) + scaled(c.x_j1, j1);
-  v = desired + scaled(c.e, j0) + scaled(c.e * c.t, j1);
-  a = scaled(c.e, a) - scaled(c.e * c.w * c.t, j1);
+  v = desired + settled(scaled(c.e, j0) + scaled(c.e * c.t, j1));
+  a = settled(scaled(c.e, a) - scaled(c.e * c.w * c.t, j1));
 }
 
 bool usable(float halflife, float dt) {
@@ -130,8 +142,8 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
   const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
   const double j0 = static_cast<double>(x) - goal;
   const double v0 = v;
-  x = static_cast<float>(goal + c.xx * j0 + c.xv * v0);
-  v = static_cast<float>(c.vx * j0 + c.vv * v0);
+  x = static_cast<float>(goal + settled(c.xx * j0 + c.xv * v0));
+  v = static_cast<float>(settled(c.vx * j0 + c.vv * v0));
 }
 
 void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
@@ -156,8 +168,8 @@ void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
   if (!step.moves || !finite(goal)) return;
   const glm::vec3 j0 = x - goal;
   const glm::vec3 v0 = v;
-  x = goal + step.xx * j0 + step.xv * v0;
-  v = step.vx * j0 + step.vv * v0;
+  x = goal + settled(step.xx * j0 + step.xv * v0);
+  v = settled(step.vx * j0 + step.vv * v0);
 }
 
 void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,

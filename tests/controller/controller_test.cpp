@@ -442,5 +442,40 @@ TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
   EXPECT_LT(jumps, 12);
 }
 
+bool subnormal(float value) {
+  return std::fpclassify(value) == FP_SUBNORMAL;
+}
+
+bool any_subnormal(const glm::vec3& v) {
+  return subnormal(v.x) || subnormal(v.y) || subnormal(v.z);
+}
+
+bool any_subnormal(const glm::quat& q) {
+  return subnormal(q.w) || subnormal(q.x) || subnormal(q.y) || subnormal(q.z);
+}
+
+// Two minutes standing after a walk: the stopping simulation's velocity and acceleration end
+// exactly zero, and no state the controller shows (the simulation, the pose) is ever a
+// subnormal float, whose slow arithmetic would make a long-standing crowd cost more and more.
+TEST(ControllerTest, ALongStandLeavesNoSubnormalState) {
+  Controller c = make();
+  for (int i = 0; i < 120; ++i) c.update(kDt, push_toward(30.0f));
+  const ControllerInput released;
+  for (int i = 0; i < 120 * 60; ++i) {
+    c.update(kDt, released);
+    const ControllerDebug& d = c.debug();
+    ASSERT_FALSE(any_subnormal(d.simulation_position) || any_subnormal(d.simulation_velocity) ||
+                 any_subnormal(d.simulation_acceleration) || any_subnormal(d.simulation_rotation) ||
+                 any_subnormal(d.simulation_angular_velocity))
+        << "frame " << i;
+    for (const Transform& t : c.local_transforms()) {
+      ASSERT_FALSE(any_subnormal(t.translation) || any_subnormal(t.rotation)) << "frame " << i;
+    }
+    for (int side = 0; side < 2; ++side) ASSERT_FALSE(any_subnormal(d.ik_target[side])) << i;
+  }
+  EXPECT_EQ(c.debug().simulation_velocity, glm::vec3(0.0f));
+  EXPECT_EQ(c.debug().simulation_acceleration, glm::vec3(0.0f));
+}
+
 }  // namespace
 }  // namespace mm

@@ -305,7 +305,7 @@ TEST(BuilderRealClips, MirroredBuildDoublesTheClipsAndMirrorsTheFeatures) {
   }
 }
 
-TEST(BuilderRealClips, OutputDoesNotDependOnTheThreadCount) {
+TEST(BuilderThreads, OutputDoesNotDependOnTheThreadCount) {
   // With mirrored copies and the idle clip, whose source frame is searched for after the
   // parallel phase and whose features are normalized with the rest.
   std::vector<Database> dbs;

@@ -252,7 +252,7 @@ TEST(DatabaseFile, HeaderReaderReportsSizes) {
   EXPECT_FLOAT_EQ(info->frame_time, 1.0f / 60.0f);
 }
 
-TEST(DatabaseFile, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
+TEST(DatabaseFileThreads, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
   // 70k frames make a file over 8 MiB, which takes the two-thread path.
   const Database db = make_database(70000, 11);
   std::vector<std::byte> bytes = serialize_database(db);
@@ -706,7 +706,7 @@ TEST(DatabaseValidate, CatchesEachInconsistency) {
   }
 }
 
-TEST(DatabaseValidate, LargeArraysReportTheFirstBadValue) {
+TEST(DatabaseValidateThreads, LargeArraysReportTheFirstBadValue) {
   // Over a million values the scans split across two threads; the first bad index must win
   // whichever half it is in.
   Database db = make_database(300000, 3);

@@ -256,6 +256,50 @@ TEST(Inertialization, OffsetsDecayBelowOnePercentAfterFiveHalflives) {
   }
 }
 
+// After a long time the offsets are exactly zero (the output is exactly the incoming
+// animation), and on the way they follow the spring's exact decay and never become subnormal
+// floats, whose arithmetic would slow every later update.
+TEST(Inertialization, OffsetsComeToRestExactlyWithoutSubnormals) {
+  Animation outgoing = Animation::random();
+  Animation incoming = Animation::different_from(outgoing);
+  InertializationOffsets offsets;
+  offsets.resize(kJoints);
+  inertialize_transition(offsets, outgoing.at(0.0f), incoming.at(0.0f));
+  const InertializationOffsets initial = offsets;
+  // spring.hpp's closed form for an offset decaying toward zero, in double.
+  const double w = 1.6783469900166608 / kHalflife;
+  auto exact = [&](float x0, float v0, double t) {
+    return std::exp(-w * t) * (x0 + (v0 + w * x0) * t);
+  };
+  std::array<Transform, kJoints> out;
+  const float dt = 1.0f / 60.0f;
+  for (int frame = 1; frame <= 120 * 60; ++frame) {  // two minutes at 60 Hz
+    const double t = frame * static_cast<double>(dt);
+    inertialize_update(offsets, incoming.at(static_cast<float>(t)), kHalflife, dt, out, {}, {});
+    for (int j = 0; j < kJoints; ++j) {
+      ASSERT_TRUE(
+          test::no_subnormal(offsets.positions[j]) && test::no_subnormal(offsets.velocities[j]) &&
+          test::no_subnormal(offsets.rotations[j]) && test::no_subnormal(offsets.rotation_rates[j]))
+          << "frame " << frame << ", joint " << j;
+      for (int axis = 0; axis < 3; ++axis) {
+        ASSERT_NEAR(offsets.positions[j][axis],
+                    exact(initial.positions[j][axis], initial.velocities[j][axis], t), 1e-6)
+            << "frame " << frame << ", joint " << j;
+        ASSERT_NEAR(offsets.rotations[j][axis],
+                    exact(initial.rotations[j][axis], initial.rotation_rates[j][axis], t), 1e-6)
+            << "frame " << frame << ", joint " << j;
+      }
+    }
+  }
+  for (int j = 0; j < kJoints; ++j) {
+    EXPECT_EQ(offsets.positions[j], glm::vec3(0.0f)) << j;
+    EXPECT_EQ(offsets.velocities[j], glm::vec3(0.0f)) << j;
+    EXPECT_EQ(offsets.rotations[j], glm::vec3(0.0f)) << j;
+    EXPECT_EQ(offsets.rotation_rates[j], glm::vec3(0.0f)) << j;
+    EXPECT_EQ(out[j].translation, incoming.local[j].translation) << j;
+  }
+}
+
 TEST(Inertialization, FromRestDecayFollowsTheSpringHalflife) {
   // Static poses: the offset from rest halves in one halflife (spring.hpp's definition).
   std::array<Transform, 1> from{}, to{}, out{};

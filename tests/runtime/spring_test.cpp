@@ -402,5 +402,102 @@ TEST(CriticalSpring, PrecomputedStepEqualsTheUpdate) {
   EXPECT_EQ(x, glm::vec3(1.0f));
 }
 
+// ---- coming to rest
+// -------------------------------------------------------------------------------
+
+// The exact critically damped offset from the goal after t seconds (spring.hpp's closed form),
+// in double.
+double exact_offset(double x0, double v0, float halflife, double t) {
+  const double w = 1.6783469900166608 / halflife;
+  return std::exp(-w * t) * (x0 + (v0 + w * x0) * t);
+}
+
+bool subnormal(float value) {
+  return std::fpclassify(value) == FP_SUBNORMAL;
+}
+
+// Two minutes at 60 Hz: long past the point where an offset of a metre would have decayed
+// through the whole float range.
+constexpr int kLongRunFrames = 120 * 60;
+constexpr float kFrame = 1.0f / 60.0f;
+
+// The decay follows the exact curve (to float rounding, and relatively far into the tail) and
+// never passes through a subnormal float. Toward zero it ends on exactly zero offset and
+// velocity; toward 2.5 within the float spacing there, nearly still.
+TEST(CriticalSpring, DecayComesToRestExactlyWithoutSubnormals) {
+  const float halflife = 0.1f;
+  for (const float goal : {0.0f, 2.5f}) {
+    float x = goal + 1.0f, v = -3.0f;                        // a scalar spring
+    glm::vec3 x3(0.4f, -1.0f, 1e-3f), v3(2.0f, 0.5f, 0.0f);  // and a 3D one, in steps
+    const glm::vec3 x3_0 = x3, v3_0 = v3, goal3(goal);
+    const CriticalSpringStep step = critical_spring_step(halflife, kFrame);
+    int rest_frame = -1;
+    for (int f = 1; f <= kLongRunFrames; ++f) {
+      critical_spring_update(x, v, goal, halflife, kFrame);
+      critical_spring_apply(x3, v3, goal3, step);
+      const double expected = exact_offset(1.0, -3.0, halflife, f * static_cast<double>(kFrame));
+      ASSERT_NEAR(x - goal, expected, 3e-7 * (1.0 + goal)) << "frame " << f << ", goal " << goal;
+      if (goal == 0.0f && std::abs(expected) > 1e-9) {
+        ASSERT_NEAR(x, expected, 1e-3 * std::abs(expected)) << "frame " << f;
+      }
+      for (int axis = 0; axis < 3; ++axis) {
+        const double e = exact_offset(x3_0[axis] - goal, v3_0[axis], halflife, f * kFrame);
+        ASSERT_NEAR(x3[axis] - goal, e, 3e-7 * (1.0 + goal)) << "frame " << f << ", axis " << axis;
+      }
+      ASSERT_FALSE(subnormal(x) || subnormal(v)) << "frame " << f << ", goal " << goal;
+      ASSERT_TRUE(test::no_subnormal(x3) && test::no_subnormal(v3)) << "frame " << f;
+      if (rest_frame < 0 && x == goal && v == 0.0f && x3 == goal3 && v3 == glm::vec3(0.0f)) {
+        rest_frame = f;
+      }
+    }
+    if (goal == 0.0f) {
+      // At rest within a few seconds (a metre decays below kSpringNegligible in about 20
+      // halflives), and for good.
+      EXPECT_GT(rest_frame, 0);
+      EXPECT_LT(rest_frame, 5 * 60);
+      EXPECT_EQ(x, goal);
+      EXPECT_EQ(v, 0.0f);
+      EXPECT_EQ(x3, goal3);
+      EXPECT_EQ(v3, glm::vec3(0.0f));
+    } else {
+      const float spacing = std::nextafter(goal, 10.0f) - goal;
+      EXPECT_LE(std::abs(x - goal), spacing);
+      EXPECT_LT(std::abs(v), 1e-5f);
+      EXPECT_TRUE(near_vec3(x3, goal3, 2.0f * spacing));  // one spacing per axis
+      EXPECT_TRUE(near_vec3(v3, glm::vec3(0.0f), 1e-5f));
+    }
+  }
+}
+
+TEST(SpringCharacter, VelocityAndAccelerationComeToRestExactlyWithoutSubnormals) {
+  glm::vec3 x(0.0f), v(1.5f, 0.0f, -2.0f), a(4.0f, 0.0f, 1.0f);
+  const glm::vec3 stop(0.0f);
+  for (int f = 1; f <= kLongRunFrames; ++f) {
+    spring_character_update(x, v, a, stop, 0.3f, kFrame);
+    ASSERT_TRUE(test::no_subnormal(x) && test::no_subnormal(v) && test::no_subnormal(a))
+        << "frame " << f;
+  }
+  EXPECT_EQ(v, glm::vec3(0.0f));
+  EXPECT_EQ(a, glm::vec3(0.0f));
+  // Where it stopped: x0 + the integral of the velocity, (v0 + (v0 w + a0) / w) / w per axis.
+  const double w = 1.6783469900166608 / 0.3;
+  EXPECT_NEAR(x.x, (1.5 + (1.5 * w + 4.0) / w) / w, 1e-5);
+  EXPECT_NEAR(x.z, (-2.0 + (-2.0 * w + 1.0) / w) / w, 1e-5);
+}
+
+TEST(RotationSpring, AngularVelocitySettlesWithoutSubnormals) {
+  const glm::quat goal = glm::angleAxis(0.3f, kUp);
+  glm::quat q = glm::angleAxis(-1.0f, kUp);
+  glm::vec3 rate(0.0f, 2.0f, 0.0f);
+  for (int f = 1; f <= kLongRunFrames; ++f) {
+    critical_spring_update(q, rate, goal, 0.15f, kFrame);
+    ASSERT_TRUE(test::no_subnormal(rate)) << "frame " << f;
+    ASSERT_FALSE(subnormal(q.w) || subnormal(q.x) || subnormal(q.y) || subnormal(q.z)) << f;
+  }
+  // The error measured from quaternions stops at their rounding: nearly still, on the goal.
+  EXPECT_TRUE(near_vec3(rate, glm::vec3(0.0f), 1e-5f));
+  EXPECT_TRUE(same_rotation(q, goal, 1e-6f));
+}
+
 }  // namespace
 }  // namespace mm

@@ -83,4 +83,10 @@ inline bool finite_vec3(const glm::vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
+// Whether no component is a subnormal float (whose arithmetic is slow on x86).
+inline bool no_subnormal(const glm::vec3& v) {
+  return std::fpclassify(v.x) != FP_SUBNORMAL && std::fpclassify(v.y) != FP_SUBNORMAL &&
+         std::fpclassify(v.z) != FP_SUBNORMAL;
+}
+
 }  // namespace mm::test

@@ -682,7 +682,27 @@ TEST(SyntheticApprox, KdtreeEpsStaysWithinItsBound) {
   }
 }
 
-TEST(SearchBatch, BatchedResultsEqualSingleSearches) {
+// The trees' groups built on four threads answer exactly as when built on one.
+TEST(SearchThreads, KdtreeBuiltOnFourThreadsAnswersAsOnOne) {
+  const SyntheticSearchData data = small_synthetic();
+  BaselineSearchOptions one_thread, four_threads;
+  one_thread.build_threads = 1;
+  four_threads.build_threads = 4;
+  for (const char* method : {"kdtree", "kdtree-eps"}) {
+    auto serial = make(method, data.input(), one_thread);
+    auto parallel = make(method, data.input(), four_threads);
+    ASSERT_NE(serial, nullptr);
+    ASSERT_NE(parallel, nullptr);
+    for (const Query& q : constrained_queries(data, 2, 7)) {
+      const SearchResult a = serial->search(q.features, q.constraints);
+      const SearchResult b = parallel->search(q.features, q.constraints);
+      ASSERT_EQ(a.frame, b.frame) << method;
+      ASSERT_EQ(a.cost, b.cost) << method;
+    }
+  }
+}
+
+TEST(SearchBatchThreads, BatchedResultsEqualSingleSearches) {
   const SyntheticSearchData data = small_synthetic();
   auto kdtree = make("kdtree", data.input());
   ASSERT_NE(kdtree, nullptr);

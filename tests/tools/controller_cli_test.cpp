@@ -212,13 +212,20 @@ TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("final positions identical"), std::string::npos) << run.output;
   const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
-  for (const char* key : {"update_us_mean", "update_us_p99", "search_share",
-                          "max_characters_60hz_1_thread", "max_characters_60hz_2_threads"}) {
+  for (const char* key :
+       {"update_us_mean", "update_us_p99", "search_share", "update_us_first_window",
+        "update_us_last_window", "max_characters_60hz_1_thread", "max_characters_60hz_2_threads"}) {
     ASSERT_TRUE(json.contains(key)) << key;
     EXPECT_GT(json[key].get<double>(), 0.0) << key;
   }
   EXPECT_LE(json["search_share"].get<double>(), 1.0);
   EXPECT_TRUE(json["same_result_every_thread_count"].get<bool>());
+  // One second is shorter than a window: both windows are the whole run.
+  EXPECT_EQ(json["update_us_first_window"], json["update_us_last_window"]);
+  EXPECT_NEAR(json["update_us_first_window"].get<double>(), json["update_us_mean"].get<double>(),
+              1e-6 * json["update_us_mean"].get<double>());
+  EXPECT_NE(run.output.find("first 5 s us"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("last/first"), std::string::npos) << run.output;
 
   const CommandRun bad = run_mm("crowd-bench --db '" + small_database().string() + "' --seconds 1");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;

@@ -34,7 +34,9 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       "time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera "
       "turns), and prints the update cost per character per frame (mean, p99, the share spent in "
       "search) and the largest crowd a 1/60 s frame holds at that cost, on 1 and on 2 threads "
-      "(and on --threads T when it is another count). Every run ends with the same character "
+      "(and on --threads T when it is another count), with the mean cost over the first and the "
+      "last 5 s of game time and their ratio, which a cost creeping up over a long run raises. "
+      "Every run ends with the same character "
       "positions whatever the thread count; the tool checks that.",
       "mm crowd-bench");
   set_up_app(app);
@@ -61,13 +63,18 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
 
 // The JSON of one run, and its figures printed as a table row.
 nlohmann::json report_run(const CrowdResult& run) {
-  std::printf("%8d %14.2f %14.2f %12.1f%% %14.3f %16d\n", run.threads, run.update_us_mean,
-              run.update_us_p99, 100.0 * run.search_share, run.frame_ms_mean,
-              run.max_characters_60hz);
+  const double ratio = run.update_us_last_window / run.update_us_first_window;
+  std::printf("%8d %14.2f %14.2f %12.1f%% %14.3f %16d %12.2f %12.2f %10.2f\n", run.threads,
+              run.update_us_mean, run.update_us_p99, 100.0 * run.search_share, run.frame_ms_mean,
+              run.max_characters_60hz, run.update_us_first_window, run.update_us_last_window,
+              ratio);
   std::fflush(stdout);
   return {{"threads", run.threads},
           {"update_us_mean", run.update_us_mean},
           {"update_us_p99", run.update_us_p99},
+          {"update_us_first_window", run.update_us_first_window},
+          {"update_us_last_window", run.update_us_last_window},
+          {"update_us_window_ratio", ratio},
           {"search_share", run.search_share},
           {"frame_ms_mean", run.frame_ms_mean},
           {"max_characters_60hz", run.max_characters_60hz}};
@@ -82,8 +89,17 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   if (arguments.extra_threads > 0) thread_counts.insert(arguments.extra_threads);
   std::printf("%d characters, %.1f s at 60 Hz (%d frames each)\n", options.characters,
               options.seconds, static_cast<int>(std::ceil(options.seconds * 60.0f)));
-  std::printf("%8s %14s %14s %13s %14s %16s\n", "threads", "update us mean", "update us p99",
-              "search share", "frame ms mean", "max chars 60 Hz");
+  // The update cost over the first and the last window of game time, and their ratio: a cost
+  // that grows over a long run shows there.
+  auto window_label = [](const char* which) {
+    std::string label = which;  // appended: see the -Wrestrict note below
+    return label.append(std::to_string(std::lround(kCrowdWindowSeconds))).append(" s us");
+  };
+  const std::string first = window_label("first ");
+  const std::string last = window_label("last ");
+  std::printf("%8s %14s %14s %13s %14s %16s %12s %12s %10s\n", "threads", "update us mean",
+              "update us p99", "search share", "frame ms mean", "max chars 60 Hz", first.c_str(),
+              last.c_str(), "last/first");
   std::vector<glm::vec3> reference;
   bool same = true;
   for (int threads : thread_counts) {
@@ -107,6 +123,9 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
       json["update_us_mean"] = run->update_us_mean;
       json["update_us_p99"] = run->update_us_p99;
       json["search_share"] = run->search_share;
+      json["update_us_first_window"] = run->update_us_first_window;
+      json["update_us_last_window"] = run->update_us_last_window;
+      json["update_us_window_ratio"] = run->update_us_last_window / run->update_us_first_window;
     }
   }
   return same;

@@ -20,6 +20,12 @@ namespace mm {
 // camera turned). The same seed always gives the same script, on every platform.
 InputScript varied_input_script(uint32_t seed, float seconds);
 
+// The length (s of game time) of the windows at the start and at the end of a run whose update
+// costs CrowdResult compares: a controller's cost must not creep up over a long run (its
+// decaying state shrinking into slow subnormal floats did once). Shorter runs have one window,
+// the whole run.
+inline constexpr float kCrowdWindowSeconds = 5.0f;
+
 struct CrowdOptions {
   int characters = 100;
   float seconds = 10.0f;  // of game time
@@ -34,8 +40,10 @@ struct CrowdResult {
   double wall_seconds = 0.0;    // the whole run, all threads
   double update_us_mean = 0.0;  // per character per frame (each update timed)
   double update_us_p99 = 0.0;
-  double search_share = 0.0;   // time in search / time in update
-  double frame_ms_mean = 0.0;  // wall time per frame for the whole crowd
+  double update_us_first_window = 0.0;  // the mean over the first kCrowdWindowSeconds
+  double update_us_last_window = 0.0;   // the mean over the last kCrowdWindowSeconds
+  double search_share = 0.0;            // time in search / time in update
+  double frame_ms_mean = 0.0;           // wall time per frame for the whole crowd
   // Characters one frame of 1/60 s could update at this run's rate per character and thread
   // count: characters * (1/60 s) / frame time.
   int max_characters_60hz = 0;

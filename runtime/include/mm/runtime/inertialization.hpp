@@ -7,7 +7,8 @@
 //   position: out = incoming + offset,   rotation: out = exp(offset) * incoming,
 // with the rotation offset kept as a rotation vector e (angle * axis, parent frame). So the
 // output and its velocity are continuous at the switch, also when a switch happens while the
-// previous one is still decaying.
+// previous one is still decaying. Offsets come to rest at exactly zero (spring.hpp's
+// kSpringNegligible), never lingering as slow subnormal floats.
 //
 // Angular velocities everywhere here are in the joint's parent frame (rad/s, axis times rate):
 // dq/dt = 0.5 * (0, w) * q. Converting between d(e)/dt and the angular velocity of exp(e) uses

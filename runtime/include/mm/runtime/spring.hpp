@@ -19,6 +19,15 @@
 //   NaN from input cannot poison the state;
 // - halflife is clamped below at kMinSpringHalflife (so 0 means "arrive at once");
 // - a very long dt converges exactly to the goal with zero velocity;
+// - each component of a spring's offset from the goal, of its velocity and (spring character)
+//   of its acceleration is set to exactly 0 once smaller in magnitude than kSpringNegligible.
+//   Left alone, an offset decaying toward a goal of zero (an inertialization offset, a
+//   stopping character's velocity) would shrink into the subnormal floats (below about
+//   1e-38), whose arithmetic is many times slower on x86, so a character standing for minutes
+//   would cost more every frame; zero costs nothing. Toward a goal away from zero the offset
+//   can only shrink to the float spacing at the goal (and a rotation's error to the rounding
+//   of its quaternions), where it may stay: normal floats, with a velocity far below
+//   anything visible;
 // - predictions at a negative or non-finite time give the current state, and predictions
 //   with a non-finite goal or halflife give the current state at every time.
 // Nothing here allocates.
@@ -35,6 +44,12 @@ inline constexpr float kHalflifeFrequencyFactor = 1.6783469900166608f;
 
 // The shortest halflife used (seconds); shorter ones, including 0, are clamped to it.
 inline constexpr float kMinSpringHalflife = 1e-5f;
+
+// Below this magnitude a spring's state is exactly zero (see above), in the state's own units:
+// metres or radians for an offset from the goal, m/s or rad/s for its velocity (m/s^2 for the
+// spring character's acceleration, whose "offset" is a velocity). A picometre, far below
+// anything visible, and far above the subnormal range.
+inline constexpr float kSpringNegligible = 1e-12f;
 
 // The natural angular frequency w (1/s) of a critically damped spring with this halflife (s).
 float halflife_to_angular_frequency(float halflife);
