@@ -77,8 +77,9 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 // target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
 // kSoftReach of the leg's length, or up to the animation's own hip-to-ankle distance when its leg
 // is straighter than that, are kept; longer ones approach the full length exponentially, over
-// at least kMinSoftSpan of it. Keeping the animation's own extension matters for a standing
-// pose with locked knees: softening it would bend both knees forward by centimetres.
+// at least kMinSoftSpan of it. The animation's own extension is kept only standing, where poses
+// lock their knees and softening them would bend both knees forward by centimetres; in motion
+// the shorter span it leaves makes knees snap straight at the transitions.
 constexpr float kSoftReach = 0.96f;
 constexpr float kMinSoftSpan = 0.01f;
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
@@ -899,7 +900,8 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   glm::vec3 ankle_target =
       target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
   const float animated_reach =
-      glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
+      on_idle_clip() ? glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position)
+                     : 0.0f;
   ankle_target =
       hip_position + soft_reach(ankle_target - hip_position, animated_reach, leg_length(side));
   // The knee bends toward where it points now; a nearly straight leg has no such direction
