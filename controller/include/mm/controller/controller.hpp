@@ -295,7 +295,8 @@ class Controller {
 
   // Global (model = world) transforms of every database joint after the last update, in float:
   // exact near the world origin, rounded to float's steps far from it (at 100 km, 8 mm). Far
-  // away, use origin() and origin_transforms().
+  // away, use origin() and origin_transforms(). Ask again after each update: once the origin
+  // leaves zero the span views another buffer.
   std::span<const Transform> global_transforms() const {
     return origin_ == glm::dvec3(0.0) ? std::span<const Transform>(globals_) : world_globals_;
   }
@@ -310,7 +311,7 @@ class Controller {
   // The inverse bind matrices of skinning_matrices(): a game far away computes its own skinning
   // matrices relative to origin() from origin_transforms() (runtime/skinning.hpp).
   std::span<const glm::mat4> inverse_bind_matrices() const { return inverse_bind_; }
-  // Local transforms after inertialization and IK.
+  // Local transforms after inertialization and IK; the root's (joint 0) is relative to origin().
   std::span<const Transform> local_transforms() const { return locals_; }
   // global * inverse(bind global), with the database skeleton's rest pose as the bind pose
   // (from global_transforms(), so in world space).
