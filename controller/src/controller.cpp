@@ -205,7 +205,7 @@ void Controller::size_buffers() {
   const Database& db = *db_;
   const size_t n = static_cast<size_t>(db.joint_count());
   offsets_.resize(db.joint_count());
-  for (auto* v : {&sampled_, &other_, &locals_, &globals_}) v->resize(n);
+  for (auto* v : {&sampled_, &other_, &locals_, &globals_, &world_globals_}) v->resize(n);
   for (auto* v : {&sampled_velocities_, &sampled_angular_velocities_, &other_velocities_,
                   &other_angular_velocities_}) {
     v->assign(n, glm::vec3(0.0f));
@@ -260,7 +260,8 @@ Status Controller::set_settings(const ControllerSettings& settings) {
   return Status::success();
 }
 
-void Controller::teleport(const glm::vec3& position, float yaw) {
+// teleport() relative to the origin (teleport_world() picks the origin first).
+void Controller::place(const glm::vec3& position, float yaw) {
   const glm::vec3 ground(position.x, 0.0f, position.z);
   const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
   sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
@@ -288,6 +289,7 @@ void Controller::teleport(const glm::vec3& position, float yaw) {
 void Controller::update(float dt, const ControllerInput& input) {
   if (!(dt > 0.0f) || !std::isfinite(dt)) return;
   dt = std::min(dt, settings_.max_dt);
+  follow_character();
   debug_.searched = debug_.transitioned = false;
   debug_.search_seconds = 0.0f;
 
@@ -316,7 +318,10 @@ void Controller::update(float dt, const ControllerInput& input) {
 void Controller::refresh_outputs(float dt) {
   finish_pose();
   foot_lock(dt);
-  if (settings_.compute_skinning) mm::skinning_matrices(globals_, inverse_bind_, skinning_);
+  publish_world_transforms();
+  if (settings_.compute_skinning) {
+    mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
+  }
 }
 
 // The stick, relative to the camera, becomes a desired velocity (with separate forward,
@@ -713,7 +718,8 @@ void Controller::synchronize(float dt) {
   move_root(position, glm::normalize(delta * root.rotation));
 }
 
-void Controller::adjust_root(const glm::vec3& position, const glm::quat& rotation) {
+// adjust_root() relative to the origin.
+void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& rotation) {
   if (!finite(position) || !finite(rotation) || clip_ < 0) return;
   move_root(position, glm::normalize(rotation));
   // The feet go with the body: held toes would otherwise pull the legs back.

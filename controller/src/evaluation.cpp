@@ -169,6 +169,7 @@ struct EvaluationAccumulator::State {
   bool has_hips() const { return has_pair(roles.left_upper_leg, roles.right_upper_leg); }
   bool has_chest() const { return has_pair(roles.left_upper_arm, roles.right_upper_arm); }
 
+  void follow_origin(const EvaluationFrame& r);
   void measure_plain(const EvaluationFrame& r);
   void measure_responses(const EvaluationFrame& r);
   void update_held(const EvaluationFrame& r);
@@ -206,6 +207,7 @@ EvaluationAccumulator::~EvaluationAccumulator() = default;
 void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   State& s = *state_;
   assert(frame.joints.size() == s.joint_count);
+  s.follow_origin(frame);
   s.measure_plain(frame);
   s.update_held(frame);
   s.measure_feet(frame);
@@ -214,6 +216,19 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   s.measure_chest_and_head(frame);
   s.measure_transition_accel(frame);
   s.remember(frame);
+}
+
+// The earlier frames' positions shifted into this frame's origin (a whole number of metres,
+// local_origin.hpp): positions near the character move by at most a float step there.
+void EvaluationAccumulator::State::follow_origin(const EvaluationFrame& r) {
+  if (frames == 0 || r.origin == previous.origin) return;
+  const glm::vec3 shift(r.origin - previous.origin);
+  for (std::vector<glm::vec3>& frame : positions) {
+    for (glm::vec3& p : frame) p -= shift;
+  }
+  previous.root_position -= shift;
+  previous.sim_position -= shift;
+  previous.origin = r.origin;
 }
 
 // Distance and facing to the simulation, timings, transitions, the responses.
@@ -449,31 +464,38 @@ std::string csv_header(const Database& db) {
   return h;
 }
 
+// Positions in the world: the frame's origin plus its relative positions, summed in double.
 std::string csv_row(const EvaluationFrame& r) {
   char buffer[256];
+  const glm::dvec3 sim = to_world(r.origin, r.sim_position);
+  const glm::dvec3 root = to_world(r.origin, r.root_position);
   std::snprintf(buffer, sizeof buffer, "%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%d,%d,%d",
-                r.t, r.sim_position.x, r.sim_position.z, glm::degrees(r.sim_yaw), r.root_position.x,
-                r.root_position.z, glm::degrees(r.root_yaw), r.desired_velocity.x,
-                r.desired_velocity.z, glm::degrees(r.desired_yaw), r.transition ? 1 : 0,
-                r.contact[0] ? 1 : 0, r.contact[1] ? 1 : 0);
+                r.t, sim.x, sim.z, glm::degrees(r.sim_yaw), root.x, root.z,
+                glm::degrees(r.root_yaw), r.desired_velocity.x, r.desired_velocity.z,
+                glm::degrees(r.desired_yaw), r.transition ? 1 : 0, r.contact[0] ? 1 : 0,
+                r.contact[1] ? 1 : 0);
   std::string row = buffer;
-  for (const glm::vec3& p : r.joints) {
+  for (const glm::vec3& joint : r.joints) {
+    const glm::dvec3 p = to_world(r.origin, joint);
     std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", p.x, p.y, p.z);
     row += buffer;
   }
   return row;
 }
 
-// The record of the update just made; `positions` receives the joints it views.
+// The record of the update just made, relative to the controller's origin (as the debug state
+// is); `positions` receives the joints it views.
 EvaluationFrame frame_record(const Controller& controller, float t, double update_seconds,
                              std::vector<glm::vec3>& positions) {
   const ControllerDebug& d = controller.debug();
+  const std::span<const Transform> globals = controller.origin_transforms();
   EvaluationFrame r;
   r.t = t;
+  r.origin = controller.origin();
   r.sim_position = d.simulation_position;
   r.sim_yaw = quat_yaw(d.simulation_rotation);
-  r.root_position = controller.root_transform().translation;
-  r.root_yaw = quat_yaw(controller.root_transform().rotation);
+  r.root_position = globals[0].translation;
+  r.root_yaw = quat_yaw(globals[0].rotation);
   r.desired_velocity = d.desired_velocity;
   r.desired_yaw = quat_yaw(d.desired_rotation);
   r.transition = d.transitioned;
@@ -482,7 +504,6 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.update_seconds = update_seconds;
   r.searched = d.searched;
   r.search_seconds = d.search_seconds;
-  const std::span<const Transform> globals = controller.global_transforms();
   for (size_t j = 0; j < positions.size(); ++j) positions[j] = globals[j].translation;
   r.joints = positions;
   return r;
@@ -550,10 +571,18 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   if (!std::isfinite(options.seconds) || options.seconds < 0.0f) {
     return Error{"evaluation: seconds must be >= 0"};
   }
+  if (!std::isfinite(options.start.x) || !std::isfinite(options.start.y)) {
+    return Error{"evaluation: the start position must be finite"};
+  }
   if (!database) return Error{"evaluation: no database"};
   Result<Controller> made = Controller::create(database, options.settings);
   if (!made) return Error{made.message()};
   Controller& controller = *made;
+  // A controller is created at the world origin; only a start elsewhere is a teleport, so a
+  // run from the origin is the same run it always was.
+  if (options.start != glm::dvec2(0.0)) {
+    controller.teleport_world(glm::dvec3(options.start.x, 0.0, options.start.y), 0.0f);
+  }
   const Database& db = database->database();
   const float dt = options.dt;
   const float seconds = options.seconds > 0.0f ? options.seconds : script.duration() + 2.0f;

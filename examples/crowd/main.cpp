@@ -163,7 +163,8 @@ double run_game_loop(Crowd& crowd, int frames, float dt) {
       const mm::ControllerInput input = crowd.inputs[i].at(game_time);
       crowd.controllers[i].update(dt, input);
       // This is where a game reads the pose back for rendering: global_transforms() (one
-      // world transform per joint of the database's skeleton) or skinning_matrices().
+      // world transform per joint of the database's skeleton) or skinning_matrices(). Far
+      // from the world origin: origin() (double) plus origin_transforms() relative to it.
     }
   }
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -25,6 +25,13 @@ inline std::shared_ptr<const ControllerDatabase> normal_controller_database() {
   return shared;
 }
 
+// A controller on normal_controller_database() (the test fails if it cannot be made).
+inline Controller make_controller(const ControllerSettings& settings = {}) {
+  Result<Controller> c = Controller::create(normal_controller_database(), settings);
+  EXPECT_TRUE(c.ok()) << (c.ok() ? "" : c.message());
+  return std::move(c).value();
+}
+
 // A stick pushed fully toward world yaw `degrees` with the camera at 0 (yaw 0 is +Z, 90 is +X).
 inline ControllerInput push_toward(float degrees, bool run = false) {
   ControllerInput input;

@@ -100,6 +100,49 @@ struct FrameFeed {
   EvaluationMetrics metrics() const { return accumulator.metrics(); }
 };
 
+// Frames relative to a moving origin (a controller's local origin, rebased by whole metres)
+// measure exactly as the same frames in world positions: the accumulator shifts its earlier
+// frames into each new origin before comparing (rounding by at most a float step of a few
+// metres, far below the tolerance; without the shift a rebase would read as a 1 m jump). The
+// body moves at 1.4 m/s and the toes, in contact (what the skating metric counts), slide with it
+// a little faster.
+TEST(Evaluation, FramesRelativeToAMovingOriginMeasureAsWorldFrames) {
+  EvaluationAccumulator world(synthetic_roles(), kJointCount, kDt);
+  EvaluationAccumulator rebased(synthetic_roles(), kJointCount, kDt);
+  glm::dvec3 origin(0.0);
+  for (int f = 0; f < 240; ++f) {  // 4 s: the last 2 count as idle (the head's speed)
+    const float x = static_cast<float>(f) / 128.0f;
+    Pose pose;
+    pose.toe[0] = {x, 0.0f, 0.25f};
+    pose.toe[1] = {x, 0.0f, -0.25f};
+    std::vector<glm::vec3> joints = joints_of(pose);
+    for (glm::vec3& j : joints) j.x += 3.0f * x;
+    EvaluationFrame frame;
+    frame.t = static_cast<float>(f + 1) * kDt;
+    frame.contact[0] = frame.contact[1] = true;
+    frame.root_position = joints[kRoot];
+    frame.sim_position = joints[kRoot] + glm::vec3(0.0f, 0.0f, 0.125f);
+    frame.joints = joints;
+    world.add(frame);
+    // Every 7 frames the origin jumps to the whole metre nearest the root.
+    if (f % 7 == 0) origin = glm::dvec3(std::round(frame.root_position.x), 0.0, 0.0);
+    std::vector<glm::vec3> local = joints;
+    for (glm::vec3& j : local) j -= glm::vec3(origin);
+    frame.origin = origin;
+    frame.root_position -= glm::vec3(origin);
+    frame.sim_position -= glm::vec3(origin);
+    frame.joints = local;
+    rebased.add(frame);
+  }
+  const EvaluationMetrics a = world.metrics(), b = rebased.metrics();
+  EXPECT_GT(a.foot_skate_cm_s_mean, 100.0);  // the slide is measured at all
+  EXPECT_NEAR(b.foot_skate_cm_s_mean, a.foot_skate_cm_s_mean, 1e-3);
+  EXPECT_NEAR(b.foot_skate_cm_s_p95, a.foot_skate_cm_s_p95, 1e-3);
+  EXPECT_NEAR(b.root_sim_distance_cm_mean, a.root_sim_distance_cm_mean, 1e-3);
+  EXPECT_NEAR(b.body_turn_rate_deg_s_max, a.body_turn_rate_deg_s_max, 1e-3);
+  EXPECT_NEAR(b.idle_head_speed_cm_s_mean, a.idle_head_speed_cm_s_mean, 1e-3);
+}
+
 TEST(Evaluation, BodyTurningAtAConstantRateGivesThatRateAtP99AndMax) {
   // 120 deg/s for 4 s: the hips' yaw wraps past 180 degrees on the way.
   FrameFeed run;

@@ -4,12 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <unistd.h>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include "mm/database/database_file.hpp"
@@ -201,6 +205,70 @@ TEST(ControllerCli, EvalUsageErrorsExitWith2) {
   const CommandRun missing = run_mm(eval_arguments(dir / "none.txt", ""));
   EXPECT_EQ(missing.exit_code, 1) << missing.output;
   EXPECT_NE(missing.output.find("none.txt"), std::string::npos) << missing.output;
+}
+
+// The rows of a --dump file as numbers, the header skipped.
+std::vector<std::vector<double>> dump_rows(const std::string& text) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream lines(text);
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line)) {
+    std::vector<double>& row = rows.emplace_back();
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+  }
+  return rows;
+}
+
+// --start places the character: the JSON says where, the dump's world positions start there,
+// and the run moves as the same run from the origin does.
+TEST(ControllerCli, EvalStartsTheCharacterWhereStartSays) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  std::vector<std::vector<double>> rows[2];
+  for (int far = 0; far < 2; ++far) {
+    const fs::path json = dir / ("run" + std::to_string(far) + ".json");
+    const fs::path dump = dir / ("run" + std::to_string(far) + ".csv");
+    const CommandRun run = run_mm(
+        eval_arguments(script, std::string(far ? "--start 100000.5,-20000 " : "") + "--json '" +
+                                   json.string() + "' --dump '" + dump.string() + "'"));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const nlohmann::json metrics = nlohmann::json::parse(read_text(json));
+    EXPECT_EQ(metrics["start"],
+              far ? nlohmann::json({100000.5, -20000.0}) : nlohmann::json({0.0, 0.0}));
+    rows[far] = dump_rows(read_text(dump));
+    ASSERT_EQ(rows[far].size(), 480u);
+  }
+  // Columns: t, sim_x, sim_z, sim_yaw_deg, root_x, root_z, ...
+  const glm::dvec2 start(100000.5, -20000.0);
+  EXPECT_NEAR(rows[1][0][1], start.x, 0.05);
+  EXPECT_NEAR(rows[1][0][2], start.y, 0.05);
+  // 8 s of walking and running go the same way from either start.
+  const std::vector<double>& last_near = rows[0].back();
+  const std::vector<double>& last_far = rows[1].back();
+  ASSERT_GT(std::hypot(last_near[4], last_near[5]), 5.0);
+  EXPECT_NEAR(last_far[4] - start.x, last_near[4], 0.05);
+  EXPECT_NEAR(last_far[5] - start.y, last_near[5], 0.05);
+}
+
+// A malformed --start is a usage error naming the option and the value.
+TEST(ControllerCli, EvalRefusesAMalformedStart) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  const std::pair<const char*, const char*> cases[] = {{"abc", "'abc' is not X,Z"},
+                                                       {"1,2,3", "'1,2,3' is not X,Z"},
+                                                       {"nan,0", "'nan,0' is not X,Z"},
+                                                       {"0,NaN", "'0,NaN' is not X,Z"},
+                                                       {"5", "'5' is not X,Z"},
+                                                       {"1e30,0", "1e30,0 has a number outside"},
+                                                       {"0,-2e7", "0,-2e7 has a number outside"}};
+  for (const auto& [value, message] : cases) {
+    const CommandRun run = run_mm(eval_arguments(script, std::string("--start ") + value));
+    EXPECT_EQ(run.exit_code, 2) << value << "\n" << run.output;
+    EXPECT_NE(run.output.find("--start"), std::string::npos) << value << "\n" << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << value << "\n" << run.output;
+  }
 }
 
 TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {

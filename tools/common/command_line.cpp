@@ -147,6 +147,20 @@ CLI::Validator number_over(double lo, double hi) {
   return finite_number(bounds_text("(", lo, hi), hi, [lo](double x) { return x <= lo; });
 }
 
+CLI::Validator number_pair_in(const std::string& form, double lo, double hi) {
+  const std::string range = bounds_text("[", lo, hi);
+  return CLI::Validator(
+      [form, lo, hi, range](std::string& text) -> std::string {
+        const auto pair = parse_number_pair(text);
+        if (!pair) return "'" + text + "' is not " + form + " (two finite numbers and a comma)";
+        for (const double value : {pair->first, pair->second}) {
+          if (value < lo || value > hi) return text + " has a number outside " + range;
+        }
+        return {};
+      },
+      "each in " + range);
+}
+
 CLI::Validator assignment(const std::string& form) {
   return CLI::Validator(
       [form](std::string& text) -> std::string {

@@ -37,6 +37,10 @@ CLI::Validator number_in(double lo, double hi);
 // a rate, a time step).
 CLI::Validator number_over(double lo, double hi);
 
+// A validator for "A,B" options: two finite numbers separated by a comma, each within
+// [lo, hi]; `form` names the parts in the message and the help, e.g. "X,Z".
+CLI::Validator number_pair_in(const std::string& form, double lo, double hi);
+
 // A validator for "NAME=VALUE" options (both sides non-empty); `form` names the parts in the
 // message and the help, e.g. "ROLE=JOINT".
 CLI::Validator assignment(const std::string& form);

@@ -28,6 +28,15 @@ std::optional<long long> parse_count(const std::string& text) {
   return value;
 }
 
+std::optional<std::pair<double, double>> parse_number_pair(const std::string& text) {
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos) return std::nullopt;
+  const std::optional<double> a = parse_number(text.substr(0, comma));
+  const std::optional<double> b = parse_number(text.substr(comma + 1));  // a second comma fails
+  if (!a || !b) return std::nullopt;
+  return std::pair{*a, *b};
+}
+
 std::optional<std::pair<std::string, std::string>> split_assignment(const std::string& text) {
   const size_t equals = text.find('=');
   if (equals == std::string::npos || equals == 0 || equals + 1 == text.size()) return std::nullopt;

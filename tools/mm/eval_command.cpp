@@ -13,6 +13,7 @@
 #include "command.hpp"
 #include "command_line.hpp"
 #include "mm/controller/evaluation.hpp"
+#include "number_parsing.hpp"
 #include "shared_options.hpp"
 
 namespace mm::cli {
@@ -24,7 +25,11 @@ struct Arguments {
   EvaluationOptions options;
   std::string json_path;
   std::string dump_path;
+  std::string start;  // "X,Z", validated by the parser
 };
+
+// --start farther than this (m) is a typo, not a world: even a planet is smaller.
+constexpr double kMaxStartMetres = 1e7;
 
 // Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
 int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
@@ -44,6 +49,11 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
   add_dt_option(app, out.options.dt, "default 1/60");
   add_ik_option(app, out.options.settings);
   add_set_option(app, out.options.settings);
+  app.add_option("--start", out.start,
+                 "where the character stands at t = 0, world X and Z in metres (default 0,0); "
+                 "the dump's positions include it")
+      ->type_name("X,Z")
+      ->check(number_pair_in("X,Z", -kMaxStartMetres, kMaxStartMetres));
   app.add_option("--json", out.json_path,
                  "also write the metrics as JSON (one script: the keys at the top level; "
                  "several: a list under \"runs\")")
@@ -53,6 +63,9 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "transition, contacts, then every joint's global position")
       ->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
+  if (const auto start = parse_number_pair(out.start)) {
+    out.options.start = glm::dvec2(start->first, start->second);
+  }
   if (!out.dump_path.empty() && out.scripts.size() != 1) {
     return usage_error(app, "--dump takes one script");
   }
@@ -209,6 +222,7 @@ int run_eval(const std::vector<std::string>& args) {
     json["script"] = path;
     json["dt"] = arguments.options.dt;
     json["ik"] = arguments.options.settings.ik_enabled;
+    json["start"] = {arguments.options.start.x, arguments.options.start.y};
     if (table) {
       print_table_row(name, result->metrics);
       rows.emplace_back(name, result->metrics);

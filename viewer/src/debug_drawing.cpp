@@ -25,11 +25,11 @@ glm::vec3 facing(const glm::quat& q, float length) {
 }
 
 void draw_trajectory(const ControllerDebug& d, DebugLines& lines) {
-  glm::vec3 previous_desired = ground(d.simulation_position);
+  glm::vec3 previous_desired = ground(d.world(d.simulation_position));
   glm::vec3 previous_predicted = previous_desired;
   for (int i = 0; i < d.trajectory_count; ++i) {
-    const glm::vec3 desired = ground(d.desired_positions[i]);
-    const glm::vec3 predicted = ground(d.predicted_positions[i]);
+    const glm::vec3 desired = ground(d.world(d.desired_positions[i]));
+    const glm::vec3 predicted = ground(d.world(d.predicted_positions[i]));
     lines.line(previous_desired, desired, kDesired);
     lines.line(previous_predicted, predicted, kPredicted);
     lines.cross(desired, 0.04f, kDesired);
@@ -41,8 +41,9 @@ void draw_trajectory(const ControllerDebug& d, DebugLines& lines) {
 
 void draw_roots(const Controller& controller, DebugLines& lines) {
   const ControllerDebug& d = controller.debug();
-  lines.circle(ground(d.simulation_position), 0.25f, kSimulation);
-  lines.arrow(ground(d.simulation_position), facing(d.simulation_rotation, 0.45f), kSimulation);
+  lines.circle(ground(d.world(d.simulation_position)), 0.25f, kSimulation);
+  lines.arrow(ground(d.world(d.simulation_position)), facing(d.simulation_rotation, 0.45f),
+              kSimulation);
   const Transform& root = controller.root_transform();
   lines.circle(ground(root.translation), 0.18f, kRoot);
   lines.arrow(ground(root.translation), facing(root.rotation, 0.35f), kRoot);
@@ -123,8 +124,8 @@ void draw_contacts(const Controller& controller, DebugLines& lines) {
     if (toes[side] < 0) continue;
     const glm::vec3 toe = globals[toes[side]].translation;
     lines.circle(ground(toe), 0.07f, d.contact[side] ? kContact : kAir, 16);
-    if (d.locked[side]) lines.cross(d.lock_position[side], 0.06f, kLock);
-    lines.cross(d.ik_target[side], 0.03f, kAir);
+    if (d.locked[side]) lines.cross(d.world(d.lock_position[side]), 0.06f, kLock);
+    lines.cross(d.world(d.ik_target[side]), 0.03f, kAir);
   }
 }
 

@@ -68,7 +68,7 @@ void Scene::record_sample() {
   const Transform& root = controller_->root_transform();
   RunSample s;
   s.time = time_;
-  s.simulation = d.simulation_position;
+  s.simulation = d.world(d.simulation_position);
   s.character = root.translation;
   const glm::vec3 forward = root.rotation * glm::vec3(0.0f, 0.0f, 1.0f);
   s.character_facing = glm::vec2(forward.x, forward.z);

@@ -20,6 +20,13 @@
 // update() never allocates, logs or touches files: every buffer is sized in create(). Any
 // number of controllers may share one ControllerDatabase and update in parallel threads.
 // Units: metres, seconds, radians; Y up (docs/conventions.md).
+//
+// Big worlds: the state is kept relative to a local origin that follows the character
+// (local_origin.hpp), so a character 100 km from the world origin moves exactly as one at it.
+// global_transforms() stay world transforms in float (exact as before near the world origin,
+// rounded to float far from it); a game far away reads origin() (double) and
+// origin_transforms() (float, relative to it) instead, and places characters with
+// teleport_world() and adjust_root_world(). See docs/controller.md, "Big worlds".
 
 #include <cstdint>
 #include <memory>
@@ -33,6 +40,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/controller/input.hpp"
+#include "mm/controller/local_origin.hpp"
 #include "mm/database/database.hpp"
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -216,8 +224,13 @@ Status set_controller_setting(ControllerSettings& settings, std::string_view nam
 // the chosen frame's features, channel by channel (as the database's schema lists them).
 inline constexpr int kMaxDebugChannels = 16;
 
-// What a debug drawing, a panel or an evaluation reads after update().
+// What a debug drawing, a panel or an evaluation reads after update(). Every position in it
+// is relative to `origin` (world() turns one into a world position).
 struct ControllerDebug {
+  // The controller's local origin (Controller::origin()): zero near the world origin.
+  glm::dvec3 origin{0.0};
+  // A position of this struct as a world position, rounded to float.
+  glm::vec3 world(const glm::vec3& local) const { return glm::vec3(to_world(origin, local)); }
   // Desired motion.
   glm::vec3 desired_velocity{0.0f};                    // m/s, world
   glm::quat desired_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // the desired facing
@@ -276,15 +289,36 @@ class Controller {
 
   // Places the character and its simulation object (cold; clears any transition).
   void teleport(const glm::vec3& position, float yaw);
+  // The same from a double-precision world position (only x and z count: the ground is y = 0);
+  // also moves origin() to the character.
+  void teleport_world(const glm::dvec3& position, float yaw);
 
-  // Global (model = world) transforms of every database joint after the last update.
-  std::span<const Transform> global_transforms() const { return globals_; }
-  // Local transforms after inertialization and IK.
+  // Global (model = world) transforms of every database joint after the last update, in float:
+  // exact near the world origin, rounded to float's steps far from it (at 100 km, 8 mm). Far
+  // away, use origin() and origin_transforms(). Ask again after each update: once the origin
+  // leaves zero the span views another buffer.
+  std::span<const Transform> global_transforms() const {
+    return origin_ == glm::dvec3(0.0) ? std::span<const Transform>(globals_) : world_globals_;
+  }
+  // The controller's local origin in the world (metres, double; on the ground, at whole metres).
+  // It follows the character (local_origin.hpp) and is zero near the world origin.
+  const glm::dvec3& origin() const { return origin_; }
+  // Global transforms relative to origin(): world = origin() + translation. Full float
+  // precision wherever the character is; what a game far from the world origin renders with.
+  std::span<const Transform> origin_transforms() const { return globals_; }
+  // The root's world position in double precision.
+  glm::dvec3 world_root_position() const { return to_world(origin_, globals_[0].translation); }
+  // The inverse bind matrices of skinning_matrices(): a game far away computes its own skinning
+  // matrices relative to origin() from origin_transforms() (runtime/skinning.hpp).
+  std::span<const glm::mat4> inverse_bind_matrices() const { return inverse_bind_; }
+  // Local transforms after inertialization and IK; the root's (joint 0) is relative to origin().
   std::span<const Transform> local_transforms() const { return locals_; }
-  // global * inverse(bind global), with the database skeleton's rest pose as the bind pose.
+  // global * inverse(bind global), with the database skeleton's rest pose as the bind pose
+  // (from global_transforms(), so in world space).
   std::span<const glm::mat4> skinning_matrices() const { return skinning_; }
-  // The character's root (joint 0): its ground position and facing.
-  const Transform& root_transform() const { return globals_[0]; }
+  // The character's root (joint 0): its ground position and facing (world, as
+  // global_transforms()).
+  const Transform& root_transform() const { return global_transforms()[0]; }
   const ControllerDebug& debug() const { return debug_; }
   const ControllerSettings& settings() const { return settings_; }
   const ControllerDatabase& controller_database() const { return *shared_; }
@@ -298,6 +332,8 @@ class Controller {
   // destination consistent so that playback continues from there (seed 004). Used by the
   // synchronization; public for games that move characters (teleports, collisions).
   void adjust_root(const glm::vec3& position, const glm::quat& rotation);
+  // The same from a double-precision world position.
+  void adjust_root_world(const glm::dvec3& position, const glm::quat& rotation);
 
  private:
   Controller() = default;
@@ -305,6 +341,13 @@ class Controller {
   Status resolve_joints();
   void size_buffers();
   void start_standing();
+  // Big worlds (controller_origin.cpp): placing relative to the origin, rebasing it, and the
+  // world transforms.
+  void place(const glm::vec3& position, float yaw);
+  void adjust_root_local(const glm::vec3& position, const glm::quat& rotation);
+  void follow_character();
+  void shift_origin(const glm::vec3& shift);
+  void publish_world_transforms();
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
@@ -364,6 +407,9 @@ class Controller {
   std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)  //
                                     // upper leg, lower leg, foot, toe per side
 
+  // Every position below is relative to this world position (local_origin.hpp).
+  glm::dvec3 origin_{0.0};
+
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
   glm::quat sim_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
@@ -401,7 +447,8 @@ class Controller {
   std::vector<Transform> locals_;       // displayed: inertialized, adjusted, with IK
   glm::vec3 displayed_velocity_{0.0f};  // of the root
   glm::vec3 displayed_angular_velocity_{0.0f};
-  std::vector<Transform> globals_;
+  std::vector<Transform> globals_;        // relative to origin_
+  std::vector<Transform> world_globals_;  // globals_ in the world, while origin_ is not zero
   std::vector<glm::mat4> inverse_bind_;
   std::vector<glm::mat4> skinning_;
   std::vector<float> query_;

@@ -4,7 +4,11 @@
 // The metrics are computed frame by frame from per-frame records (EvaluationFrame) by an
 // EvaluationAccumulator, so they can be fed synthetic frames and never need the whole run.
 //
-// Conventions: speeds are horizontal, from positions one frame apart, unless said 3-D; a value
+// Conventions: positions are relative to each frame's origin (the controller's local origin,
+// see local_origin.hpp), and a frame whose origin moved has the previous frames shifted into
+// its own before anything is compared, so no metric ever subtracts two world coordinates in
+// float and a run 100 km from the world origin measures like one at it;
+// speeds are horizontal, from positions one frame apart, unless said 3-D; a value
 // that needs the previous frame starts at the second frame; a mean over no values is 0 and the
 // count beside it (frames or events) says so; yaws are about +Y, atan2(x, z), and yaw errors
 // and rates are absolute and wrapped to [0, 180] degrees per frame.
@@ -160,9 +164,11 @@ struct EvaluationMetrics {
   double seconds = 0.0;
 };
 
-// What one frame of a run leaves behind for the metrics. Yaws in radians, positions in metres.
+// What one frame of a run leaves behind for the metrics. Yaws in radians, positions in metres,
+// relative to `origin`.
 struct EvaluationFrame {
   float t = 0.0f;
+  glm::dvec3 origin{0.0};  // world position of this frame's positions' origin
   glm::vec3 sim_position{0.0f};
   float sim_yaw = 0.0f;
   glm::vec3 root_position{0.0f};
@@ -207,6 +213,9 @@ struct EvaluationOptions {
   float seconds = 0.0f;
   ControllerSettings settings;
   bool keep_frames = false;  // fill EvaluationResult::csv_rows for --dump
+  // Where the character stands at t = 0 (world x and z, metres; `mm eval --start X,Z`), facing
+  // +Z. The dump's positions are world positions, so they include it.
+  glm::dvec2 start{0.0};
 };
 
 struct EvaluationResult {
