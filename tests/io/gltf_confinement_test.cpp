@@ -54,7 +54,8 @@ std::string gltf_text(const std::string& uri, uint64_t byte_length,
 
 void write_bytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
   std::ofstream file(path, std::ios::binary);
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  file.write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
 }
 
 fs::path write_gltf(const fs::path& path, const std::string& uri, uint64_t byte_length,
@@ -86,8 +87,8 @@ TEST(GltfConfinement, ReadsASiblingBinAndADataUri) {
   const fs::path dir = test::scratch_dir();
   write_bytes(dir / "clip data.bin", animation_bytes());
   // Percent-encoded, as glTF uris are: the file is "clip data.bin".
-  expect_animation_read(load_gltf(write_gltf(dir / "sibling.gltf", "clip%20data.bin", 32),
-                                  {.sample_rate = 1.0f}));
+  expect_animation_read(
+      load_gltf(write_gltf(dir / "sibling.gltf", "clip%20data.bin", 32), {.sample_rate = 1.0f}));
   fs::create_directories(dir / "sub");
   write_bytes(dir / "sub" / "below.bin", animation_bytes());
   expect_animation_read(
@@ -110,7 +111,8 @@ TEST(GltfConfinement, RefusesAFifoWithoutBlocking) {
     if (fd >= 0) ::close(fd);
     FAIL() << "load_gltf opened the FIFO and blocked";
   }
-  expect_refused(loading.get(), path, "buffer 0 (uri 'pipe.bin') is not a regular file (it is a FIFO)");
+  expect_refused(loading.get(), path,
+                 "buffer 0 (uri 'pipe.bin') is not a regular file (it is a FIFO)");
 }
 
 TEST(GltfConfinement, NeverOpensAnImageNamingAFifo) {
@@ -120,7 +122,8 @@ TEST(GltfConfinement, NeverOpensAnImageNamingAFifo) {
   const std::string data_uri =
       "data:application/octet-stream;base64," + test::base64(animation_bytes());
   const fs::path path = write_gltf(dir / "textured.gltf", data_uri, 32, "texture.png");
-  auto loading = std::async(std::launch::async, [&] { return load_gltf(path, {.sample_rate = 1.0f}); });
+  auto loading =
+      std::async(std::launch::async, [&] { return load_gltf(path, {.sample_rate = 1.0f}); });
   if (loading.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
     const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
     if (fd >= 0) ::close(fd);
@@ -133,7 +136,8 @@ TEST(GltfConfinement, RefusesAFolder) {
   const fs::path dir = test::scratch_dir();
   fs::create_directories(dir / "folder.bin");
   const fs::path path = write_gltf(dir / "folder.gltf", "folder.bin", 32);
-  expect_refused(load_gltf(path), path, "buffer 0 (uri 'folder.bin') is not a regular file (it is a folder)");
+  expect_refused(load_gltf(path), path,
+                 "buffer 0 (uri 'folder.bin') is not a regular file (it is a folder)");
 }
 
 TEST(GltfConfinement, RefusesDotDotOutOfTheFolder) {
@@ -172,8 +176,8 @@ TEST(GltfConfinement, RefusesASymlinkLeadingOutOfTheFolder) {
   // A link that stays inside the folder is followed.
   fs::create_symlink("../inner/data.bin", dir / "inner" / "inside_link.bin");
   write_bytes(dir / "inner" / "data.bin", animation_bytes());
-  expect_animation_read(
-      load_gltf(write_gltf(dir / "inner" / "ok.gltf", "inside_link.bin", 32), {.sample_rate = 1.0f}));
+  expect_animation_read(load_gltf(write_gltf(dir / "inner" / "ok.gltf", "inside_link.bin", 32),
+                                  {.sample_rate = 1.0f}));
 }
 
 TEST(GltfConfinement, RefusesAFileAboveTheCapWithoutReadingIt) {

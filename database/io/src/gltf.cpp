@@ -1173,8 +1173,8 @@ Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
   // Every file a buffer names is checked and read before tinygltf runs; tinygltf itself opens
   // nothing (see gltf_files.hpp), so the base folder it is given stays empty.
   auto external = gltf_files::read_external_buffers(
-      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()),
-      path.parent_path(), options.allow_external_files);
+      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()), path.parent_path(),
+      options.allow_external_files);
   if (!external) return external.error();
 
   tinygltf::Model model;
@@ -1183,12 +1183,12 @@ Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
   loader.SetFsCallbacks(gltf_files::confined_callbacks(*external));
   std::string err;
   std::string warn;
-  const bool loaded =
-      binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                           static_cast<unsigned int>(bytes.size()), "")
-             : loader.LoadASCIIFromString(&model, &err, &warn,
-                                          reinterpret_cast<const char*>(bytes.data()),
-                                          static_cast<unsigned int>(bytes.size()), "");
+  const bool loaded = binary
+                          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                                        static_cast<unsigned int>(bytes.size()), "")
+                          : loader.LoadASCIIFromString(&model, &err, &warn,
+                                                       reinterpret_cast<const char*>(bytes.data()),
+                                                       static_cast<unsigned int>(bytes.size()), "");
   if (!loaded) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     return Error{"not a valid glTF 2.0 file: " +

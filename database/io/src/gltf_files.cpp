@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 // One buffer that names a file, as the JSON gives it.
 struct FileBuffer {
   size_t index = 0;
-  std::string uri;                         // as written, for messages
-  std::optional<uint64_t> byte_length;     // absent when missing or not an unsigned integer
+  std::string uri;                      // as written, for messages
+  std::optional<uint64_t> byte_length;  // absent when missing or not an unsigned integer
 };
 
 // tinygltf percent-decodes a buffer's uri (and turns '+' into a space) before looking the file
@@ -152,7 +152,7 @@ Result<std::vector<unsigned char>> read_checked_file(const fs::path& path, uint6
   if (fd < 0) {
     return Error{label + " cannot be opened (" + std::generic_category().message(errno) + ")"};
   }
-  struct stat info{};
+  struct stat info {};
   const bool same = ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) &&
                     static_cast<uint64_t>(info.st_size) == size;
   std::vector<unsigned char> bytes;
@@ -198,8 +198,7 @@ bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const st
   return true;
 }
 
-bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&,
-                  void*) {
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
   if (err) *err += "the glTF importer writes no files";
   return false;
 }
