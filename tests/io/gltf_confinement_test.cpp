@@ -99,19 +99,26 @@ TEST(GltfConfinement, ReadsASiblingBinAndADataUri) {
       load_gltf(write_gltf(dir / "embedded.gltf", data_uri, 32), {.sample_rate = 1.0f}));
 }
 
+// load_gltf run on another thread; if it has not returned after 10 s (it opened the FIFO and
+// waits for a writer), a writer opens and closes the FIFO so that the read ends, and the test
+// fails.
+Result<GltfAsset> load_without_blocking(const fs::path& path, const fs::path& fifo,
+                                        const GltfImportOptions& options = {}) {
+  auto loading = std::async(std::launch::async, [&] { return load_gltf(path, options); });
+  if (loading.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) ::close(fd);
+    ADD_FAILURE() << "load_gltf opened the FIFO " << fifo << " and blocked";
+  }
+  return loading.get();
+}
+
 TEST(GltfConfinement, RefusesAFifoWithoutBlocking) {
   const fs::path dir = test::scratch_dir();
   const fs::path fifo = dir / "pipe.bin";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
   const fs::path path = write_gltf(dir / "fifo.gltf", "pipe.bin", 32);
-  auto loading = std::async(std::launch::async, [&] { return load_gltf(path); });
-  if (loading.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
-    // A writer that opens and closes the FIFO ends the reader's wait, so the test ends.
-    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-    if (fd >= 0) ::close(fd);
-    FAIL() << "load_gltf opened the FIFO and blocked";
-  }
-  expect_refused(loading.get(), path,
+  expect_refused(load_without_blocking(path, fifo), path,
                  "buffer 0 (uri 'pipe.bin') is not a regular file (it is a FIFO)");
 }
 
@@ -122,14 +129,7 @@ TEST(GltfConfinement, NeverOpensAnImageNamingAFifo) {
   const std::string data_uri =
       "data:application/octet-stream;base64," + test::base64(animation_bytes());
   const fs::path path = write_gltf(dir / "textured.gltf", data_uri, 32, "texture.png");
-  auto loading =
-      std::async(std::launch::async, [&] { return load_gltf(path, {.sample_rate = 1.0f}); });
-  if (loading.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
-    const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-    if (fd >= 0) ::close(fd);
-    FAIL() << "load_gltf opened the image's FIFO and blocked";
-  }
-  expect_animation_read(loading.get());
+  expect_animation_read(load_without_blocking(path, fifo, {.sample_rate = 1.0f}));
 }
 
 TEST(GltfConfinement, RefusesAFolder) {

@@ -1152,12 +1152,11 @@ Result<Clip> sample_animation(const tinygltf::Model& model, size_t animation_ind
   return clip;
 }
 
-Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
-                              const std::filesystem::path& path, const GltfImportOptions& options) {
-  if (!(options.sample_rate > 0.0f) || !std::isfinite(options.sample_rate)) {
-    return Error{"sample rate must be a positive finite number of Hz, got " +
-                 number(options.sample_rate)};
-  }
+// The file's JSON and buffers as tinygltf reads them, after the container and the files the
+// buffers name are checked.
+Result<tinygltf::Model> load_model(std::span<const unsigned char> bytes,
+                                   const std::filesystem::path& path,
+                                   const GltfImportOptions& options) {
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
     return Error{"file is larger than 4 GiB, which glTF cannot address"};
   }
@@ -1194,6 +1193,18 @@ Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
     return Error{"not a valid glTF 2.0 file: " +
                  (err.empty() ? std::string("unknown error") : err)};
   }
+  return model;
+}
+
+Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
+                              const std::filesystem::path& path, const GltfImportOptions& options) {
+  if (!(options.sample_rate > 0.0f) || !std::isfinite(options.sample_rate)) {
+    return Error{"sample rate must be a positive finite number of Hz, got " +
+                 number(options.sample_rate)};
+  }
+  auto loaded = load_model(bytes, path, options);
+  if (!loaded) return loaded.error();
+  const tinygltf::Model& model = *loaded;
 
   auto skeleton = build_skeleton(model, options.skin);
   if (!skeleton) return skeleton.error();
