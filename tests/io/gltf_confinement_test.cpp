@@ -180,7 +180,7 @@ TEST(GltfConfinement, RefusesASymlinkLeadingOutOfTheFolder) {
                                   {.sample_rate = 1.0f}));
 }
 
-TEST(GltfConfinement, RefusesAFileAboveTheCapWithoutReadingIt) {
+TEST(GltfConfinement, RefusesAFileAboveTheCap) {
   const fs::path dir = test::scratch_dir();
   // Sparse: no disk space and nothing to read, as the file is refused from its size.
   const uint64_t huge = kGltfMaxExternalBufferBytes + 1;
@@ -191,6 +191,30 @@ TEST(GltfConfinement, RefusesAFileAboveTheCapWithoutReadingIt) {
                  "buffer 0 (uri 'huge.bin') is " + std::to_string(huge) +
                      " bytes, above the cap of " + std::to_string(kGltfMaxExternalBufferBytes) +
                      " bytes on external buffers");
+}
+
+TEST(GltfConfinement, RefusesFilesAddingUpToMoreThanTheCap) {
+  const fs::path dir = test::scratch_dir();
+  // Two sparse files, each under the cap, together above it.
+  const uint64_t half = kGltfMaxExternalBufferBytes / 2 + 1;
+  for (const char* name : {"first.bin", "second.bin"}) {
+    { std::ofstream create(dir / name); }
+    fs::resize_file(dir / name, half);
+  }
+  std::string text = gltf_text("first.bin", half);
+  const std::string second = R"({"byteLength":)" + std::to_string(half) + R"(,"uri":"second.bin"})";
+  const size_t buffers_end = text.find("}],", text.find(R"("buffers")")) + 1;
+  text.insert(buffers_end, "," + second);
+  const fs::path path = dir / "two.gltf";
+  write_bytes(path, std::vector<unsigned char>(text.begin(), text.end()));
+  const Result<GltfAsset> asset = load_gltf(path);
+  ASSERT_FALSE(asset.ok());
+  EXPECT_NE(asset.message().find(path.string() + ": buffer 1 (uri 'second.bin') brings the " +
+                                 "external buffers to " + std::to_string(2 * half) +
+                                 " bytes, above the cap of " +
+                                 std::to_string(kGltfMaxExternalBufferBytes) + " bytes"),
+            std::string::npos)
+      << asset.message();
 }
 
 TEST(GltfConfinement, RefusesASizeThatIsNotTheByteLength) {

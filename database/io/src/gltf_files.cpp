@@ -222,10 +222,11 @@ Result<ExternalFiles> read_external_buffers(std::string_view json, const fs::pat
     return Error{"cannot resolve the glTF file's folder " + folder.string() + " (" +
                  error.message() + ") to check buffer uris"};
   }
+  // Every buffer is checked before any file is opened, so a refusal reads nothing at all.
+  std::vector<fs::path> targets;
   uint64_t total = 0;
   for (const FileBuffer& buffer : buffers) {
-    const std::string decoded = decode_uri(buffer.uri);
-    auto target = check_file(buffer, decoded, canonical_folder);
+    auto target = check_file(buffer, decode_uri(buffer.uri), canonical_folder);
     if (!target) return target.error();
     total += *buffer.byte_length;
     if (total > kGltfMaxExternalBufferBytes) {
@@ -233,9 +234,12 @@ Result<ExternalFiles> read_external_buffers(std::string_view json, const fs::pat
                    std::to_string(total) + " bytes, above the cap of " +
                    std::to_string(kGltfMaxExternalBufferBytes) + " bytes on external buffers"};
     }
-    ExternalFiles::File& file = external.files[decoded];
+    targets.push_back(std::move(*target));
+  }
+  for (size_t i = 0; i < buffers.size(); ++i) {
+    ExternalFiles::File& file = external.files[decode_uri(buffers[i].uri)];
     if (file.readers++ > 0) continue;  // the same file again: read once
-    auto bytes = read_checked_file(*target, *buffer.byte_length, buffer_label(buffer));
+    auto bytes = read_checked_file(targets[i], *buffers[i].byte_length, buffer_label(buffers[i]));
     if (!bytes) return bytes.error();
     file.bytes = std::move(*bytes);
   }
