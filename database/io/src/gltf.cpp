@@ -21,6 +21,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "gltf_files.hpp"
 #include "mm/database/files.hpp"
 #include "mm/runtime/pose.hpp"
 
@@ -364,6 +365,13 @@ Result<size_t> check_glb_container(std::span<const unsigned char> bytes) {
     ++chunk;
   }
   if (chunk == 0) return Error{"binary glTF (GLB) has no JSON chunk"};
+  return length;
+}
+
+// The length of the JSON chunk of a GLB that check_glb_container accepted.
+size_t glb_json_chunk_length(std::span<const unsigned char> bytes) {
+  uint32_t length;
+  std::memcpy(&length, bytes.data() + 12, sizeof length);
   return length;
 }
 
@@ -1144,41 +1152,59 @@ Result<Clip> sample_animation(const tinygltf::Model& model, size_t animation_ind
   return clip;
 }
 
+// The file's JSON and buffers as tinygltf reads them, after the container and the files the
+// buffers name are checked.
+Result<tinygltf::Model> load_model(std::span<const unsigned char> bytes,
+                                   const std::filesystem::path& path,
+                                   const GltfImportOptions& options) {
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+    return Error{"file is larger than 4 GiB, which glTF cannot address"};
+  }
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  std::span<const unsigned char> json = bytes;
+  if (binary) {
+    auto length = check_glb_container(bytes);
+    if (!length) return length.error();
+    json = bytes.subspan(20, glb_json_chunk_length(bytes));
+  } else if (lower_extension(path) == ".glb") {
+    return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
+  }
+  // Every file a buffer names is checked and read before tinygltf runs; tinygltf itself opens
+  // nothing (see gltf_files.hpp), so the base folder it is given stays empty.
+  auto external = gltf_files::read_external_buffers(
+      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()), path.parent_path(),
+      options.allow_external_files);
+  if (!external) return external.error();
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetFsCallbacks(gltf_files::confined_callbacks(*external));
+  std::string err;
+  std::string warn;
+  const bool loaded = binary
+                          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                                        static_cast<unsigned int>(bytes.size()), "")
+                          : loader.LoadASCIIFromString(&model, &err, &warn,
+                                                       reinterpret_cast<const char*>(bytes.data()),
+                                                       static_cast<unsigned int>(bytes.size()), "");
+  if (!loaded) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    return Error{"not a valid glTF 2.0 file: " +
+                 (err.empty() ? std::string("unknown error") : err)};
+  }
+  return model;
+}
+
 Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
                               const std::filesystem::path& path, const GltfImportOptions& options) {
   if (!(options.sample_rate > 0.0f) || !std::isfinite(options.sample_rate)) {
     return Error{"sample rate must be a positive finite number of Hz, got " +
                  number(options.sample_rate)};
   }
-  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
-    return Error{"file is larger than 4 GiB, which glTF cannot address"};
-  }
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&skip_image, nullptr);
-  std::string err;
-  std::string warn;
-  const std::string base_dir = path.parent_path().string();
-  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  bool loaded = false;
-  if (binary) {
-    auto length = check_glb_container(bytes);
-    if (!length) return length.error();
-    loaded = loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                         static_cast<unsigned int>(*length), base_dir);
-  } else {
-    if (lower_extension(path) == ".glb") {
-      return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
-    }
-    loaded =
-        loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
-                                   static_cast<unsigned int>(bytes.size()), base_dir);
-  }
-  if (!loaded) {
-    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    return Error{"not a valid glTF 2.0 file: " +
-                 (err.empty() ? std::string("unknown error") : err)};
-  }
+  auto loaded = load_model(bytes, path, options);
+  if (!loaded) return loaded.error();
+  const tinygltf::Model& model = *loaded;
 
   auto skeleton = build_skeleton(model, options.skin);
   if (!skeleton) return skeleton.error();

@@ -28,7 +28,19 @@
 //   The skin's optional "skeleton" property is not needed and not read.
 // - Everything is validated (indices, accessor types and bounds, counts, finite values,
 //   increasing key times, the GLB container); an error names the file and what is wrong.
-//   Sparse accessors and images are not read (images are skipped, never decoded).
+//   Sparse accessors and images are not read (images are skipped, never decoded; an image
+//   naming a file is never opened).
+// - External files: a glTF file is untrusted input, so its buffers come only from data: URIs,
+//   the GLB binary chunk, or a relative path (percent-decoded) to a file inside the glTF
+//   file's own folder or below it: no absolute path, no ".." out of the folder, no symbolic
+//   link resolving outside it (paths are made canonical before the check). The file must be
+//   a regular file (not a FIFO, folder or device) whose size equals the buffer's byteLength,
+//   at most kGltfMaxExternalBufferBytes, the external buffers together at most that too. All
+//   of this is checked for every buffer before any file is opened, and each file is checked
+//   again on its open descriptor; a refusal names the buffer, its uri and the reason:
+//   "<file>: buffer 0 (uri '../x.bin') leaves the glTF file's folder through '..'". With
+//   GltfImportOptions::allow_external_files false (bytes from anywhere but a file) every
+//   buffer naming a file is refused.
 // - Skinned mesh (only with GltfImportOptions::read_skinned_mesh): the first primitive of the
 //   mesh of the first node (in node order) skinned with the chosen skin. Triangles only
 //   (mode 4), indexed (UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT) or not; POSITION
@@ -55,6 +67,7 @@
 //
 // Units as everywhere in the project: metres, seconds, Y up, right-handed.
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <span>
@@ -71,6 +84,11 @@
 
 namespace mm {
 
+// The largest external buffer file the importer reads, and the most all of one glTF file's
+// external buffers may add up to (1 GiB: hours of animation of a detailed skeleton; the
+// bytes are held in memory while the file is parsed).
+inline constexpr uint64_t kGltfMaxExternalBufferBytes = uint64_t{1} << 30;
+
 // Settings of the glTF importer.
 struct GltfImportOptions {
   // Animations are resampled to this fixed rate (Hz); must be finite and > 0.
@@ -80,6 +98,10 @@ struct GltfImportOptions {
   // Also read the mesh skinned with that skin into GltfAsset::skinned_mesh; a file without
   // one, or whose mesh is malformed, is then refused. Off, meshes are not looked at.
   bool read_skinned_mesh = false;
+  // Whether buffers may name files beside the glTF file (see "External files" above). Off, as
+  // for bytes that did not come from a file (fuzzing, the network), only data: URIs and the
+  // GLB binary chunk are read.
+  bool allow_external_files = true;
 };
 
 // What a glTF file holds for us: one skeleton and its animations.
@@ -100,7 +122,8 @@ Result<GltfAsset> load_gltf(const std::filesystem::path& path,
                             const GltfImportOptions& options = {});
 
 // Parses a glTF file already in memory; path_for_messages names it in errors, becomes each
-// clip's source_path, and its folder is where external buffers are looked up.
+// clip's source_path, and its folder is where external buffers are looked up (unless
+// options.allow_external_files is false).
 Result<GltfAsset> parse_gltf(std::span<const unsigned char> bytes,
                              const std::filesystem::path& path_for_messages,
                              const GltfImportOptions& options = {});
