@@ -15,6 +15,7 @@
 #include "command.hpp"
 #include "command_line.hpp"
 #include "mm/controller/crowd.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "shared_options.hpp"
 
 namespace mm::cli {
@@ -81,7 +82,7 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   std::set<int> thread_counts = {1, 2};
   if (arguments.extra_threads > 0) thread_counts.insert(arguments.extra_threads);
   std::printf("%d characters, %.1f s at 60 Hz (%d frames each)\n", options.characters,
-              options.seconds, static_cast<int>(std::ceil(options.seconds * 60.0f)));
+              options.seconds, clamped_integer<int>(std::ceil(options.seconds * 60.0f)));
   std::printf("%8s %14s %14s %13s %14s %16s\n", "threads", "update us mean", "update us p99",
               "search share", "frame ms mean", "max chars 60 Hz");
   std::vector<glm::vec3> reference;
