@@ -24,8 +24,9 @@ template <std::integral I>
 constexpr bool fits_integer(double value) {
   constexpr double upper = static_cast<double>(std::numeric_limits<I>::max() / 2 + 1) * 2.0;
   constexpr double lower = std::numeric_limits<I>::is_signed ? -upper : 0.0;
-  // -1 < value < 0 truncates to 0, which fits an unsigned type too.
-  return value > lower - 1.0 && value < upper;
+  // Truncation toward zero: lower - 1 < value < lower still gives lower (0 for unsigned types).
+  // For 64-bit types lower - 1 rounds to lower in double, hence the first test.
+  return value < upper && (value >= lower || value > lower - 1.0);
 }
 
 // `value` truncated toward zero, or nullopt when it is NaN, infinite or does not fit I.
