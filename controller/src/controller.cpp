@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "mm/runtime/constraints.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/ik.hpp"
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
@@ -452,7 +453,7 @@ SearchResult Controller::search_candidates() const {
   SearchConstraints constraints;
   constraints.current_frame = playback_point().frame0;
   const float window = on_idle_clip() ? settings_.idle_ignore_window : settings_.ignore_window;
-  constraints.window_frames = static_cast<int>(std::lround(window / db.frame_time));
+  constraints.window_frames = clamped_integer<int>(std::round(window / db.frame_time));
   constraints.transition_cost = settings_.transition_cost;
   if (tag_bits_ == 0) {
     if (stopping_) {
@@ -542,7 +543,7 @@ void Controller::advance_playback(float dt) {
 Controller::PlaybackPoint Controller::playback_point() const {
   const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
   const float x = clip_time_ / db_->frame_time;
-  const int i0 = std::clamp(static_cast<int>(std::floor(x)), 0, clip.frame_count() - 1);
+  const int i0 = std::clamp(clamped_integer<int>(std::floor(x)), 0, clip.frame_count() - 1);
   const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
   return {clip.start + i0, clip.start + i1, std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f)};
 }
@@ -761,8 +762,8 @@ void Controller::finish_pose() {
   const Database& db = *db_;
   const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
   const int frame =
-      std::clamp(clip.start + static_cast<int>(std::lround(clip_time_ / db.frame_time)), clip.start,
-                 clip.end - 1);
+      std::clamp(clip.start + clamped_integer<int>(std::round(clip_time_ / db.frame_time)),
+                 clip.start, clip.end - 1);
   debug_.clip = clip_;
   debug_.frame = frame;
   debug_.clip_time = clip_time_;

@@ -7,6 +7,7 @@
 #include "mm/controller/controller.hpp"
 #include "mm/database/idle.hpp"
 #include "mm/database/search_input.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 
 namespace mm {
 
@@ -103,7 +104,7 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   out->action_tags_ = tag_bit(db, "action");
   out->idle_tags_ = tag_bit(db, kIdleTag);
 
-  const int excluded = static_cast<int>(std::lround(options.clip_end_exclusion / db.frame_time));
+  const int excluded = clamped_integer<int>(std::round(options.clip_end_exclusion / db.frame_time));
   out->candidates_.assign(db.searchable.begin(), db.searchable.end());
   for (const ClipRange& clip : db.clips) {
     // The synthesized idle clip is one held pose: its end is as good as its start. Idle clips

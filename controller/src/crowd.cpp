@@ -2,6 +2,7 @@
 // game loop, every update timed.
 
 #include "mm/controller/crowd.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
 #include <barrier>
@@ -85,7 +86,7 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
     scripts.push_back(varied_input_script(static_cast<uint32_t>(i), options.seconds));
   }
 
-  const int frames = static_cast<int>(std::ceil(options.seconds / options.dt));
+  const int frames = clamped_integer<int>(std::ceil(options.seconds / options.dt));
   const int threads = std::min<int>(options.threads, options.characters);
   // Per character: every update's time, and the summed search time.
   std::vector<float> update_us(n * static_cast<size_t>(frames));
@@ -131,18 +132,18 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   result.search_share = total_update > 0.0 ? total_search / total_update : 0.0;
   const size_t all_frames = static_cast<size_t>(frames);
   const size_t window = std::clamp<size_t>(
-      static_cast<size_t>(std::lround(kCrowdWindowSeconds / options.dt)), 1, all_frames);
+      clamped_integer<size_t>(std::round(kCrowdWindowSeconds / options.dt)), 1, all_frames);
   result.update_us_first_window = mean_update_us(update_us, n, all_frames, 0, window);
   result.update_us_last_window =
       mean_update_us(update_us, n, all_frames, all_frames - window, all_frames);
-  const size_t rank =
-      std::min(update_us.size() - 1, static_cast<size_t>(std::ceil(0.99 * update_us.size())) - 1);
+  const size_t rank = std::min(update_us.size() - 1,
+                               clamped_integer<size_t>(std::ceil(0.99 * update_us.size())) - 1);
   std::nth_element(update_us.begin(), update_us.begin() + static_cast<std::ptrdiff_t>(rank),
                    update_us.end());
   result.update_us_p99 = update_us[rank];
   result.frame_ms_mean = wall * 1e3 / frames;
   result.max_characters_60hz =
-      static_cast<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / (wall / frames)));
+      clamped_integer<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / (wall / frames)));
   for (const Controller& c : controllers)
     result.final_positions.push_back(c.root_transform().translation);
   return result;

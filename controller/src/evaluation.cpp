@@ -10,8 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <numeric>
+#include <ostream>
 
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
 #include "playback.hpp"
@@ -24,16 +25,78 @@ float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
   return std::hypot(a.x - b.x, a.z - b.z);
 }
 
-// The p-th percentile (0..100) by nearest rank; 0 for no values. Reorders `values`.
-double percentile(std::vector<double>& values, double p) {
-  if (values.empty()) return 0.0;
-  const size_t rank =
-      std::min(values.size() - 1,
-               static_cast<size_t>(std::ceil(p / 100.0 * values.size())) - (p > 0.0 ? 1 : 0));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank),
-                   values.end());
-  return values[rank];
-}
+// The percentiles of a run in fixed memory, whatever its length: a histogram of the values by
+// their binary exponent and the first kMantissaBits bits of their mantissa, so a bin spans a
+// 2^-kMantissaBits fraction of its lower edge. A percentile is taken by nearest rank, as over
+// the sorted values, and reported as the middle of the bin that rank falls in, clamped to the
+// smallest and largest value seen: within 2^-(kMantissaBits + 1) (0.05 %) of the exact
+// nearest-rank value (exact when all the values are equal).
+// Values below 2^kLowestExponent (zero included) share one bin (absolute resolution
+// 2^kLowestExponent in the values' unit); values from 2^kHighestExponent up and infinity
+// share the last, reported as the largest value seen; NaN is not counted. The bins (about
+// 0.5 MB) are allocated by the first value.
+class PercentileHistogram {
+ public:
+  void add(double value) {
+    if (std::isnan(value)) return;
+    if (bins_.empty()) bins_.assign(kBinCount, 0);
+    ++bins_[bin_of(value)];
+    ++count_;
+    if (count_ == 1) min_ = max_ = value;
+    min_ = std::min(min_, value);
+    max_ = std::max(max_, value);
+  }
+
+  size_t count() const { return count_; }
+  double max() const { return count_ > 0 ? max_ : 0.0; }
+
+  // The p-th percentile (0..100) by nearest rank (see the class); 0 for no values.
+  double percentile(double p) const {
+    if (count_ == 0) return 0.0;
+    const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count_));
+    const size_t rank =
+        std::min(count_ - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
+    size_t below = 0;
+    for (size_t bin = 0; bin < kBinCount; ++bin) {
+      below += bins_[bin];
+      if (below > rank) return std::clamp(middle_of(bin), min_, max_);
+    }
+    return max_;
+  }
+
+ private:
+  static constexpr int kMantissaBits = 10;
+  static constexpr int kLowestExponent = -20;
+  static constexpr int kHighestExponent = 40;
+  static constexpr size_t kSubBins = size_t{1} << kMantissaBits;
+  // The bin below 2^kLowestExponent, kSubBins per octave, the bin from 2^kHighestExponent up.
+  static constexpr size_t kBinCount = 2 + (kHighestExponent - kLowestExponent) * kSubBins;
+
+  static size_t bin_of(double value) {
+    if (!(value < std::ldexp(1.0, kHighestExponent))) return kBinCount - 1;
+    if (value < std::ldexp(1.0, kLowestExponent)) return 0;
+    int exponent = 0;
+    const double mantissa = std::frexp(value, &exponent);  // value = mantissa * 2^exponent
+    // value in [2^(exponent - 1), 2^exponent); 2 * mantissa in [1, 2).
+    const size_t octave = clamped_integer<size_t>(exponent - 1 - kLowestExponent);
+    const size_t sub =
+        std::min(kSubBins - 1,
+                 clamped_integer<size_t>((2.0 * mantissa - 1.0) * static_cast<double>(kSubBins)));
+    return 1 + octave * kSubBins + sub;
+  }
+
+  double middle_of(size_t bin) const {
+    if (bin == 0) return std::ldexp(0.5, kLowestExponent);
+    if (bin == kBinCount - 1) return max_;
+    const size_t octave = (bin - 1) / kSubBins, sub = (bin - 1) % kSubBins;
+    return std::ldexp(1.0 + (static_cast<double>(sub) + 0.5) / static_cast<double>(kSubBins),
+                      static_cast<int>(octave) + kLowestExponent);
+  }
+
+  std::vector<uint64_t> bins_;
+  size_t count_ = 0;
+  double min_ = 0.0, max_ = 0.0;
+};
 
 // A mean kept as a sum and a count: 0 for no values.
 struct RunningMean {
@@ -65,15 +128,15 @@ float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback) {
 // Whole frames covering `seconds` at dt (at least one), so a settle time is compared as a
 // frame count without float drift.
 int frames_for(float seconds, float dt) {
-  return std::max(1, static_cast<int>(std::ceil(seconds / dt - 1e-3f)));
+  return std::max(1, clamped_integer<int>(std::ceil(seconds / dt - 1e-3f)));
 }
 
 // Acceleration magnitudes (second differences) of every joint but joint 0 from three
 // consecutive frames' joint positions.
 void joint_accelerations(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                         std::span<const glm::vec3> c, float dt, std::vector<double>& out) {
+                         std::span<const glm::vec3> c, float dt, PercentileHistogram& out) {
   for (size_t j = 1; j < b.size(); ++j) {
-    out.push_back(glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt));
+    out.add(glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt));
   }
 }
 
@@ -143,8 +206,8 @@ struct EvaluationAccumulator::State {
   std::vector<float> desired_yaw_history;
 
   // Plain metrics.
-  std::vector<double> skate, accelerations, hips_rates;
-  RunningMean distance, facing, updates, searches, stand_root, stand_foot;
+  PercentileHistogram skate, accelerations, hips_rates;
+  RunningMean skate_mean, distance, facing, updates, searches, stand_root, stand_foot;
   double distance_max = 0.0;
   int transitions = 0;
   ResponseEvent speed_event, heading_event;
@@ -183,7 +246,7 @@ struct EvaluationAccumulator::State {
 };
 
 EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count,
-                                             float dt, size_t expected_frames)
+                                             float dt)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
   s.roles = roles;
@@ -191,15 +254,13 @@ EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size
   s.dt = dt;
   s.toes[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
   s.toes[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
-  s.lookback_frames = std::max(1, static_cast<int>(std::lround(kStandTurnLookback / dt)));
+  s.lookback_frames = std::max(1, clamped_integer<int>(std::round(kStandTurnLookback / dt)));
   s.stand_settle_frames = frames_for(kStandSettleSeconds, dt);
   s.idle_settle_frames = frames_for(kIdleSettleSeconds, dt);
   s.strafe_settle_frames = frames_for(kStrafeSettleSeconds, dt);
   for (std::vector<glm::vec3>& p : s.positions) p.assign(joint_count, glm::vec3(0.0f));
   s.desired_speed_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
   s.desired_yaw_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
-  s.skate.reserve(2 * expected_frames);
-  s.hips_rates.reserve(expected_frames);
 }
 
 EvaluationAccumulator::~EvaluationAccumulator() = default;
@@ -297,7 +358,10 @@ void EvaluationAccumulator::State::measure_feet(const EvaluationFrame& r) {
     if (frames == 0) continue;
     const float moved = horizontal_distance(toe, previous.joints[static_cast<size_t>(toes[side])]);
     const double speed_cm = 100.0 * moved / dt;
-    if (r.contact[side] && previous.contact[side]) skate.push_back(speed_cm);
+    if (r.contact[side] && previous.contact[side]) {
+      skate.add(speed_cm);
+      skate_mean.add(speed_cm);
+    }
     if (standing) stand_foot.add(speed_cm);
     measure_pivot(r, side, moved / dt);
   }
@@ -329,7 +393,7 @@ float EvaluationAccumulator::State::measure_hips(const EvaluationFrame& r) {
   float rate = 0.0f;
   if (frames > 0) {
     rate = static_cast<float>(yaw_error_deg(yaw, hips_yaw) / dt);
-    hips_rates.push_back(rate);
+    hips_rates.add(rate);
   }
   hips_yaw = yaw;
   return rate;
@@ -411,11 +475,8 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   EvaluationMetrics m;
   m.frames = s.frames;
   m.seconds = static_cast<double>(s.frames) * s.dt;
-  std::vector<double> skate = s.skate, accelerations = s.accelerations, rates = s.hips_rates;
-  m.foot_skate_cm_s_mean =
-      RunningMean{std::accumulate(skate.begin(), skate.end(), 0.0), static_cast<int>(skate.size())}
-          .value();
-  m.foot_skate_cm_s_p95 = percentile(skate, 95.0);
+  m.foot_skate_cm_s_mean = s.skate_mean.value();
+  m.foot_skate_cm_s_p95 = s.skate.percentile(95.0);
   m.root_sim_distance_cm_mean = s.distance.value();
   m.root_sim_distance_cm_max = s.distance_max;
   m.facing_error_deg_mean = s.facing.value();
@@ -431,10 +492,10 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.transitions_per_s = m.seconds > 0.0 ? s.transitions / m.seconds : 0.0;
   m.search_us_mean = s.searches.value();
   m.update_us_mean = s.updates.value();
-  m.transition_accel_p99 = percentile(accelerations, 99.0);
+  m.transition_accel_p99 = s.accelerations.percentile(99.0);
 
-  m.body_turn_rate_deg_s_max = rates.empty() ? 0.0 : *std::max_element(rates.begin(), rates.end());
-  m.body_turn_rate_deg_s_p99 = percentile(rates, 99.0);
+  m.body_turn_rate_deg_s_max = s.hips_rates.max();
+  m.body_turn_rate_deg_s_p99 = s.hips_rates.percentile(99.0);
   m.foot_pivot_deg_s_mean = s.pivot.value();
   m.foot_pivot_frames = s.pivot.count;
   StandTurnSums turns = s.stand_turn_sums;
@@ -529,19 +590,22 @@ void compare_with_database(const ControllerDatabase& database, const EvaluationO
 }  // namespace
 
 double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags, bool cubic) {
+  if (!(dt > 0.0f)) return 0.0;
   const size_t joints = static_cast<size_t>(db.joint_count());
-  std::vector<double> accelerations;
+  PercentileHistogram accelerations;
   std::vector<Transform> local(joints), global(joints);
-  std::vector<glm::vec3> positions;
+  // The joint positions of the last three steps, by step modulo 3: the second difference needs
+  // no more, so memory does not grow with the clips' length or a small dt.
+  std::vector<glm::vec3> recent[3];
+  for (std::vector<glm::vec3>& step : recent) step.assign(joints, glm::vec3(0.0f));
   for (const ClipRange& clip : db.clips) {
     if (clip.tags & excluded_tags) continue;
     const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time;
-    const int steps = static_cast<int>(std::floor(duration / dt)) + 1;
+    const int64_t steps = clamped_integer<int64_t>(std::floor(duration / dt)) + 1;
     if (steps < 3) continue;
-    positions.assign(static_cast<size_t>(steps) * joints, glm::vec3(0.0f));
-    for (int s = 0; s < steps; ++s) {
+    for (int64_t s = 0; s < steps; ++s) {
       const float x = static_cast<float>(s) * dt / db.frame_time;
-      const int i0 = std::min(static_cast<int>(std::floor(x)), clip.frame_count() - 1);
+      const int i0 = std::min(clamped_integer<int>(std::floor(x)), clip.frame_count() - 1);
       const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
       const float a = x - static_cast<float>(i0);
       for (size_t j = 0; j < joints; ++j) {
@@ -549,31 +613,29 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
                                                  InterpolationMethod::Nlerp);
       }
       forward_kinematics(db.skeleton.parents(), local, global);
-      for (size_t j = 0; j < joints; ++j) {
-        positions[static_cast<size_t>(s) * joints + j] = global[j].translation;
+      std::vector<glm::vec3>& now = recent[s % 3];
+      for (size_t j = 0; j < joints; ++j) now[j] = global[j].translation;
+      if (s >= 2) {
+        joint_accelerations(recent[(s - 2) % 3], recent[(s - 1) % 3], now, dt, accelerations);
       }
     }
-    const std::span<const glm::vec3> all = positions;
-    for (size_t s = 1; s + 1 < static_cast<size_t>(steps); ++s) {
-      joint_accelerations(all.subspan((s - 1) * joints, joints), all.subspan(s * joints, joints),
-                          all.subspan((s + 1) * joints, joints), dt, accelerations);
-    }
   }
-  return percentile(accelerations, 99.0);
+  return accelerations.percentile(99.0);
 }
 
 Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabase> database,
                                          const InputScript& script,
                                          const EvaluationOptions& options) {
-  if (!(options.dt > 0.0f) || !(options.dt <= 1.0f)) {
-    return Error{"evaluation: dt must be in (0, 1] seconds"};
-  }
   if (!std::isfinite(options.seconds) || options.seconds < 0.0f) {
     return Error{"evaluation: seconds must be >= 0"};
   }
   if (!std::isfinite(options.start.x) || !std::isfinite(options.start.y)) {
     return Error{"evaluation: the start position must be finite"};
   }
+  const float dt = options.dt;
+  const float seconds = options.seconds > 0.0f ? options.seconds : script.duration() + 2.0f;
+  const Result<int> frame_count = scripted_run_frames(seconds, dt);
+  if (!frame_count) return Error{"evaluation: " + frame_count.message()};
   if (!database) return Error{"evaluation: no database"};
   Result<Controller> made = Controller::create(database, options.settings);
   if (!made) return Error{made.message()};
@@ -584,18 +646,13 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     controller.teleport_world(glm::dvec3(options.start.x, 0.0, options.start.y), 0.0f);
   }
   const Database& db = database->database();
-  const float dt = options.dt;
-  const float seconds = options.seconds > 0.0f ? options.seconds : script.duration() + 2.0f;
-  const size_t frame_count = static_cast<size_t>(std::ceil(seconds / dt));
   const size_t joints = static_cast<size_t>(db.joint_count());
 
-  EvaluationResult result;
-  result.csv_header = csv_header(db);
-  if (options.keep_frames) result.csv_rows.reserve(frame_count);
-  EvaluationAccumulator accumulator(db.roles, joints, dt, frame_count);
+  if (options.dump) *options.dump << csv_header(db) << "\n";
+  EvaluationAccumulator accumulator(db.roles, joints, dt);
   std::vector<glm::vec3> positions(joints);
   using Clock = std::chrono::steady_clock;
-  for (size_t f = 0; f < frame_count; ++f) {
+  for (int f = 0; f < *frame_count; ++f) {
     const float t = static_cast<float>(f + 1) * dt;
     const ControllerInput input = script.at(t);
     const Clock::time_point start = Clock::now();
@@ -603,8 +660,9 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
     accumulator.add(frame);
-    if (options.keep_frames) result.csv_rows.push_back(csv_row(frame));
+    if (options.dump) *options.dump << csv_row(frame) << "\n";
   }
+  EvaluationResult result;
   result.metrics = accumulator.metrics();
   compare_with_database(*database, options, result.metrics);
   return result;

@@ -1,16 +1,20 @@
 #include "mm/controller/script.hpp"
 
 #include "mm/database/files.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <concepts>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -58,9 +62,21 @@ bool parse_finite(std::string_view token, float& value) {
 }
 
 // The shortest text that reads back as `value` ("2.5", not "2.500000").
-std::string shortest(float value) {
+template <std::floating_point Float>
+std::string shortest(Float value) {
   char buffer[32];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  assert(ec == std::errc());
+  (void)ec;
+  return std::string(buffer, end);
+}
+
+// The shortest fixed-point text that reads back as `value` ("0.0001", not "1e-04"), for values
+// known to be of moderate size (the limits, a valid time step).
+std::string fixed(float value) {
+  char buffer[64];  // enough for any float of moderate size
+  const auto [end, ec] =
+      std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
   assert(ec == std::errc());
   (void)ec;
   return std::string(buffer, end);
@@ -86,6 +102,29 @@ void append_fixed(std::string& out, double value, int decimals) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Run limits
+
+Result<int> scripted_run_frames(float seconds, float dt) {
+  if (!(dt >= kMinRunDt && dt <= kMaxRunDt)) {
+    return Error{"the time step must be in [" + fixed(kMinRunDt) + ", " + fixed(kMaxRunDt) +
+                 "] seconds, found " + shortest(dt)};
+  }
+  if (!(seconds >= 0.0f) || !std::isfinite(seconds)) {
+    return Error{"the run length must be a finite number of seconds >= 0, found " +
+                 shortest(seconds)};
+  }
+  const float needed = std::ceil(seconds / dt);
+  const std::optional<int> frames = checked_integer<int>(needed);
+  if (!frames || *frames > kMaxRunFrames) {
+    const std::optional<int64_t> whole = checked_integer<int64_t>(needed);
+    return Error{"a run of " + shortest(seconds) + " s at a time step of " + fixed(dt) +
+                 " s needs " + (whole ? std::to_string(*whole) : shortest(needed)) +
+                 " frames, more than the limit of " + std::to_string(kMaxRunFrames)};
+  }
+  return *frames;
+}
 
 // ---------------------------------------------------------------------------------------------
 // InputScript
@@ -168,9 +207,10 @@ struct ScriptLine {
 // The time (never before the previous line's) and the four stick values.
 Status parse_time_and_sticks(const ScriptLine& line, const std::vector<ScriptEvent>& events,
                              ScriptEvent& event) {
-  if (!parse_finite(line.tokens[0], event.time) || event.time < 0.0f) {
-    return Error{line.where + "expected the time in seconds (a number >= 0), found " +
-                 line.found(0)};
+  if (!parse_finite(line.tokens[0], event.time) || event.time < 0.0f ||
+      event.time > kMaxScriptSeconds) {
+    return Error{line.where + "expected the time in seconds (a number in [0, " +
+                 shortest(kMaxScriptSeconds) + "], the longest script), found " + line.found(0)};
   }
   if (!events.empty() && event.time < events.back().time) {
     return Error{line.where + "expected a time >= " + shortest(events.back().time) +

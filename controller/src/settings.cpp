@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <iterator>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "mm/controller/controller.hpp"
 
@@ -69,6 +72,37 @@ constexpr FlagField kFlagFields[] = {
     {"cubic_playback", &ControllerSettings::cubic_playback},
 };
 
+// Every enum setting once: its name, its value as an integer (any integer of the underlying type
+// can be stored, from a cast or a struct filled by other code) and the names of its valid values,
+// by value from 0.
+// The names of InterpolationMethod's values, by value.
+constexpr std::string_view kInterpolationNames[] = {"nlerp", "slerp", "sclerp"};
+
+// "a, b, c".
+std::string joined(std::span<const std::string_view> names) {
+  std::string list;
+  for (std::string_view n : names) list.append(list.empty() ? "" : ", ").append(n);
+  return list;
+}
+
+struct EnumField {
+  const char* name;
+  int value;
+  std::vector<std::string_view> names;
+};
+
+std::vector<EnumField> enum_fields(const ControllerSettings& s) {
+  return {
+      {"interpolation",
+       static_cast<int>(s.interpolation),
+       {std::begin(kInterpolationNames), std::end(kInterpolationNames)}},
+      {"sync_mode",
+       static_cast<int>(s.sync_mode),
+       {sync_mode_name(SyncMode::CharacterFollowsSimulation),
+        sync_mode_name(SyncMode::SimulationFollowsCharacter), sync_mode_name(SyncMode::None)}},
+  };
+}
+
 Error bad_value(std::string_view name, std::string_view value, const char* expected) {
   return Error{"setting '" + std::string(name) + "': expected " + expected + ", found '" +
                std::string(value) + "'"};
@@ -85,16 +119,21 @@ Status ControllerSettings::validate() const {
                    std::to_string(value)};
     }
   }
+  for (const EnumField& f : enum_fields(*this)) {
+    if (f.value < 0 || static_cast<size_t>(f.value) >= f.names.size()) {
+      return Error{std::string("controller settings: ") + f.name + " must be one of " +
+                   joined(f.names) + " (0 to " + std::to_string(f.names.size() - 1) + "), found " +
+                   std::to_string(f.value)};
+    }
+  }
   if (bone_length_iterations < 0 || bone_length_iterations > 100) {
     return Error{"controller settings: bone_length_iterations must be in [0, 100], found " +
                  std::to_string(bone_length_iterations)};
   }
   const auto names = search_method_names();
   if (std::find(names.begin(), names.end(), search_method) == names.end()) {
-    std::string list;
-    for (std::string_view n : names) list.append(list.empty() ? "" : ", ").append(n);
     return Error{"controller settings: unknown search method '" + search_method + "' (one of " +
-                 list + ")"};
+                 joined(names) + ")"};
   }
   return Status::success();
 }
@@ -142,15 +181,13 @@ Status set_controller_setting(ControllerSettings& settings, std::string_view nam
     return Status::success();
   }
   if (name == "interpolation") {
-    if (value == "nlerp") {
-      settings.interpolation = InterpolationMethod::Nlerp;
-    } else if (value == "slerp") {
-      settings.interpolation = InterpolationMethod::Slerp;
-    } else if (value == "sclerp") {
-      settings.interpolation = InterpolationMethod::Sclerp;
-    } else {
+    const auto* found =
+        std::find(std::begin(kInterpolationNames), std::end(kInterpolationNames), value);
+    if (found == std::end(kInterpolationNames)) {
       return bad_value(name, value, "nlerp, slerp or sclerp");
     }
+    settings.interpolation =
+        static_cast<InterpolationMethod>(found - std::begin(kInterpolationNames));
     return Status::success();
   }
   return Error{"unknown setting '" + std::string(name) + "'"};

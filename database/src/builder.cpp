@@ -19,6 +19,7 @@
 #include "mm/database/idle.hpp"
 #include "mm/database/io/gltf.hpp"
 #include "mm/database/retarget.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/workers.hpp"
 
 namespace mm {
@@ -152,7 +153,7 @@ Result<int> idle_frame_count(const BuildOptions& options) {
                  std::to_string(seconds)};
   }
   if (seconds == 0.0f) return 0;
-  const int frames = static_cast<int>(std::lround(static_cast<double>(seconds) * options.rate));
+  const int frames = clamped_integer<int>(std::round(static_cast<double>(seconds) * options.rate));
   // A frame is searchable only when every feature time lies inside its clip; an idle clip with
   // no searchable frame could never be chosen by the search.
   const FeatureFrameMargins margins = feature_frame_margins(options.schema, 1.0f / options.rate);

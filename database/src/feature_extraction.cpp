@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
 
 namespace mm {
@@ -66,9 +67,9 @@ FeatureFrameMargins feature_frame_margins(const FeatureSchema& schema, float fra
     for (float t : c.times) {
       const float frames = t / frame_time;
       if (frames > 0.0f) {
-        margins.after = std::max(margins.after, static_cast<int>(std::ceil(frames - 1e-3f)));
+        margins.after = std::max(margins.after, clamped_integer<int>(std::ceil(frames - 1e-3f)));
       } else if (frames < 0.0f) {
-        margins.before = std::max(margins.before, static_cast<int>(std::ceil(-frames - 1e-3f)));
+        margins.before = std::max(margins.before, clamped_integer<int>(std::ceil(-frames - 1e-3f)));
       }
     }
   }
@@ -167,7 +168,7 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
           for (float t : channel.times) {
             const float x = std::clamp(snapped_frame(static_cast<float>(f) + t * rate), 0.0f,
                                        static_cast<float>(frames - 1));
-            const int i0 = static_cast<int>(std::floor(x));
+            const int i0 = clamped_integer<int>(std::floor(x));
             const int i1 = std::min(i0 + 1, frames - 1);
             const float a = x - static_cast<float>(i0);
             const size_t k0 = static_cast<size_t>(i0) * joints;

@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm {
@@ -252,7 +253,8 @@ float angle_between(float a, float b) {
 
 Clip segment_of(const Clip& clip, int first, int end) {
   Clip out;
-  out.name = clip.name + "_at" + std::to_string(static_cast<int>(first * clip.frame_time)) + "s";
+  out.name =
+      clip.name + "_at" + std::to_string(clamped_integer<int>(first * clip.frame_time)) + "s";
   out.source_path = clip.source_path;
   out.skeleton = clip.skeleton;
   out.end_sites = clip.end_sites;
@@ -269,7 +271,7 @@ Clip segment_of(const Clip& clip, int first, int end) {
 std::vector<Clip> calm_idle_segments(const Clip& clip, const JointRoleIndices& roles,
                                      const CalmIdleCriteria& criteria) {
   const std::vector<FrameCalm> calm = frame_calm(clip, roles, criteria);
-  const int min_frames = static_cast<int>(std::ceil(criteria.min_seconds / clip.frame_time));
+  const int min_frames = clamped_integer<int>(std::ceil(criteria.min_seconds / clip.frame_time));
   std::vector<Clip> out;
   int f = 0;
   while (f < clip.frame_count) {

@@ -13,6 +13,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "cpu_features.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
 #include "validation.hpp"
@@ -284,7 +285,7 @@ void smooth_gaussian_linear(std::span<const glm::vec3> in, float sigma_frames,
     std::copy(in.begin(), in.end(), out.begin());
     return;
   }
-  const int radius = std::max(1, static_cast<int>(std::ceil(3.0f * sigma_frames)));
+  const int radius = std::max(1, clamped_integer<int>(std::ceil(3.0f * sigma_frames)));
   weights.resize(radius + 1);
   for (int k = 0; k <= radius; ++k) {
     weights[k] = std::exp(-0.5f * static_cast<float>(k * k) / (sigma_frames * sigma_frames));
@@ -615,7 +616,7 @@ Clip resample_clip(const Clip& clip, float rate) {
   const double duration = static_cast<double>(clip.frame_count - 1) * clip.frame_time;
   out.frame_count = clip.frame_count <= 1
                         ? clip.frame_count
-                        : static_cast<int>(std::floor(duration * rate + 1e-3)) + 1;
+                        : clamped_integer<int>(std::floor(duration * rate + 1e-3)) + 1;
   out.local.resize(static_cast<size_t>(out.frame_count) * joints);
   for (int f = 0; f < out.frame_count; ++f) {
     const float time = static_cast<float>(static_cast<double>(f) / rate);
@@ -861,7 +862,7 @@ Status preprocess_clip(const Clip& clip, const JointRoleIndices& roles,
               : 0;
     }
   }
-  int width = static_cast<int>(std::lround(c.filter_window / dt));
+  int width = clamped_integer<int>(std::round(c.filter_window / dt));
   if (width % 2 == 0) width += 1;
   for (int side = 0; side < 2; ++side) {
     const std::span<const uint8_t> raw = std::span<const uint8_t>(scratch.raw_contacts)

@@ -1,4 +1,5 @@
 #include "mm/runtime/body.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
 #include <array>
@@ -167,7 +168,7 @@ Result<Grid> make_grid(std::span<const BoneSegment> segments, const BodyMeshOpti
   for (int axis = 0; axis < 3; ++axis) {
     const double n = std::ceil(static_cast<double>(hi[axis] - lo[axis]) / options.voxel_size) + 1.0;
     total *= n;
-    grid.points[axis] = static_cast<int>(std::min(n, 2.0e9));
+    grid.points[axis] = clamped_integer<int>(std::min(n, 2.0e9));
   }
   if (!(total <= static_cast<double>(options.max_grid_points))) {
     return Error{"body mesh: a grid of " + std::to_string(grid.points.x) + " x " +

@@ -1,4 +1,5 @@
 #include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 
 #include <cassert>
 #include <cmath>
@@ -272,7 +273,7 @@ void sample_pose(std::span<const Transform> frames, int joint_count, float frame
   if (wrap == WrapMode::Loop) {
     position = std::fmod(position, static_cast<double>(frame_count));
     if (position < 0.0) position += static_cast<double>(frame_count);
-    i0 = static_cast<long>(std::floor(position));
+    i0 = clamped_integer<long>(std::floor(position));
     if (i0 >= frame_count) {  // fmod + frame_count can round up to exactly frame_count
       i0 = 0;
       position = 0.0;
@@ -281,7 +282,7 @@ void sample_pose(std::span<const Transform> frames, int joint_count, float frame
   } else {
     const double last = static_cast<double>(frame_count - 1);
     position = position < 0.0 ? 0.0 : (position > last ? last : position);
-    i0 = static_cast<long>(std::floor(position));
+    i0 = clamped_integer<long>(std::floor(position));
     i1 = i0 + 1 < frame_count ? i0 + 1 : i0;
   }
   const float alpha = static_cast<float>(position - static_cast<double>(i0));

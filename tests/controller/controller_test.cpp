@@ -38,6 +38,41 @@ bool finite_pose(const Controller& c) {
   return true;
 }
 
+// An enum field can hold any value of its underlying type (a cast, a struct filled by other
+// code); validate() refuses every value but the named ones.
+TEST(ControllerSettingsTest, InterpolationOutsideItsValuesIsRefused) {
+  ControllerSettings s;
+  for (const int value : {0, 1, 2}) {
+    s.interpolation = static_cast<InterpolationMethod>(value);
+    EXPECT_TRUE(s.validate().ok()) << value;
+  }
+  for (const int value : {3, 255, -1}) {
+    s.interpolation = static_cast<InterpolationMethod>(value);
+    EXPECT_EQ(s.validate().message(),
+              "controller settings: interpolation must be one of nlerp, slerp, sclerp (0 to 2), "
+              "found " +
+                  std::to_string(value));
+  }
+}
+
+TEST(ControllerSettingsTest, SyncModeOutsideItsValuesIsRefused) {
+  ControllerSettings s;
+  for (const int value : {0, 1, 2}) {
+    s.sync_mode = static_cast<SyncMode>(value);
+    EXPECT_TRUE(s.validate().ok()) << value;
+  }
+  for (const int value : {3, 128, 255}) {
+    s.sync_mode = static_cast<SyncMode>(value);
+    EXPECT_EQ(s.validate().message(),
+              "controller settings: sync_mode must be one of character, simulation, none (0 to "
+              "2), found " +
+                  std::to_string(value));
+  }
+  Result<Controller> bad = Controller::create(normal_controller_database(), s);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("sync_mode must be one of"), std::string::npos);
+}
+
 TEST(ControllerSettingsTest, EveryInvalidFieldIsNamed) {
   ControllerSettings s;
   EXPECT_TRUE(s.validate().ok());

@@ -231,7 +231,9 @@ TEST(InputScript, EveryMalformedLineIsRefusedWithItsMessage) {
        "walk.txt:1: expected the right stick's x (a number in [-1, 1]), found the end of the line"},
       {"1 0 0 0 # the comment is not a field\n",
        "walk.txt:1: expected the right stick's y (a number in [-1, 1]), found the end of the line"},
-      {"run 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found 'run'"},
+      {"run 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found 'run'"},
       // Not numbers, or not whole numbers.
       {"0 0,5 0 0 0\n",
        "walk.txt:1: expected the left stick's x (a number in [-1, 1]), found '0,5'"},
@@ -244,7 +246,9 @@ TEST(InputScript, EveryMalformedLineIsRefusedWithItsMessage) {
       {"0 0 0 +-1 0\n",
        "walk.txt:1: expected the right stick's x (a number in [-1, 1]), found '+-1'"},
       {"0 0 0 + 0\n", "walk.txt:1: expected the right stick's x (a number in [-1, 1]), found '+'"},
-      {"1s 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found '1s'"},
+      {"1s 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found '1s'"},
       // Sticks out of range, each naming its field.
       {"0 1.5 0 0 0\n",
        "walk.txt:1: expected the left stick's x (a number in [-1, 1]), found '1.5'"},
@@ -254,17 +258,26 @@ TEST(InputScript, EveryMalformedLineIsRefusedWithItsMessage) {
       {"0 0 0 0 -7\n",
        "walk.txt:1: expected the right stick's y (a number in [-1, 1]), found '-7'"},
       // Not finite.
-      {"nan 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found 'nan'"},
-      {"inf 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found 'inf'"},
-      {"1e39 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found '1e39'"},
+      {"nan 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found 'nan'"},
+      {"inf 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found 'inf'"},
+      {"1e39 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found '1e39'"},
       {"0 NaN 0 0 0\n",
        "walk.txt:1: expected the left stick's x (a number in [-1, 1]), found 'NaN'"},
       {"0 0 -infinity 0 0\n",
        "walk.txt:1: expected the left stick's y (a number in [-1, 1]), found '-infinity'"},
       // Negative and decreasing time.
-      {"-1 0 0 0 0\n", "walk.txt:1: expected the time in seconds (a number >= 0), found '-1'"},
+      {"-1 0 0 0 0\n",
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found '-1'"},
       {"-0.001 0 0 0 0\n",
-       "walk.txt:1: expected the time in seconds (a number >= 0), found '-0.001'"},
+       "walk.txt:1: expected the time in seconds (a number in [0, 28800], the longest script), "
+       "found '-0.001'"},
       {"2.5 0 0 0 0\n# pause\n1 0 0 0 0\n",
        "walk.txt:3: expected a time >= 2.5 (the time of line 1), found '1'"},
       {"0 0 0 0 0\n3 0 0 0 0\n3 0 1 0 0\n2.999 0 0 0 0\n",
@@ -335,6 +348,56 @@ TEST(InputScript, MessagesGiveTheNameAndTheLineOfALongFile) {
   // The first malformed line is the one reported.
   EXPECT_EQ(parse_error("0 0 0 0 0\n1 x 0 0 0\n2 y 0 0 0\n", "a.txt"),
             "a.txt:2: expected the left stick's x (a number in [-1, 1]), found 'x'");
+}
+
+// Bounded runs (script.hpp): a time past kMaxScriptSeconds is refused at parse, by file and
+// line, before a run could try to turn it into a frame count.
+TEST(InputScript, TimesPastTheLongestScriptAreRefusedByFileAndLine) {
+  EXPECT_EQ(parse_error("0 0 1 0 0\n1e30 0 0 0 0\n", "far.txt"),
+            "far.txt:2: expected the time in seconds (a number in [0, 28800], the longest "
+            "script), found '1e30'");
+  EXPECT_EQ(parse_error("0 0 1 0 0\n# a million seconds\n1e6 0 0 0 0\n", "long.txt"),
+            "long.txt:3: expected the time in seconds (a number in [0, 28800], the longest "
+            "script), found '1e6'");
+  EXPECT_EQ(parse_error("28800.01 0 0 0 0\n", "long.txt"),
+            "long.txt:1: expected the time in seconds (a number in [0, 28800], the longest "
+            "script), found '28800.01'");
+  // The limit itself is a time a script may have.
+  const InputScript longest = parse_ok("0 0 1 0 0\n28800 0 0 0 0\n");
+  EXPECT_EQ(longest.duration(), kMaxScriptSeconds);
+}
+
+TEST(InputScript, RunFramesAreTheCeilingOfSecondsOverDt) {
+  EXPECT_EQ(*scripted_run_frames(8.0f, 0.02f), 400);
+  EXPECT_EQ(*scripted_run_frames(0.0f, 0.02f), 0);
+  EXPECT_EQ(*scripted_run_frames(1.0f, 0.3f), 4);
+  // The longest script at 1/144 s, with the 2 s mm eval adds, fits the frame limit.
+  EXPECT_TRUE(scripted_run_frames(kMaxScriptSeconds + 2.0f, 1.0f / 144.0f).ok());
+}
+
+TEST(InputScript, RunsOutsideTheLimitsAreRefusedWithTheirValues) {
+  auto message = [](float seconds, float dt) {
+    const Result<int> frames = scripted_run_frames(seconds, dt);
+    return frames ? std::string("(accepted)") : frames.message();
+  };
+  EXPECT_EQ(message(18.0f, 1e-6f), "the time step must be in [0.0001, 1] seconds, found 1e-06");
+  EXPECT_EQ(message(18.0f, 0.0f), "the time step must be in [0.0001, 1] seconds, found 0");
+  EXPECT_EQ(message(18.0f, -0.01f), "the time step must be in [0.0001, 1] seconds, found -0.01");
+  EXPECT_EQ(message(18.0f, 2.0f), "the time step must be in [0.0001, 1] seconds, found 2");
+  EXPECT_EQ(message(18.0f, kNaN), "the time step must be in [0.0001, 1] seconds, found nan");
+  EXPECT_EQ(message(18.0f, kInf), "the time step must be in [0.0001, 1] seconds, found inf");
+  EXPECT_EQ(message(kInf, 0.01f),
+            "the run length must be a finite number of seconds >= 0, found inf");
+  EXPECT_EQ(message(-1.0f, 0.01f),
+            "the run length must be a finite number of seconds >= 0, found -1");
+  // The longest script at the smallest step: 288 million frames.
+  EXPECT_EQ(message(28800.0f, 1e-4f),
+            "a run of 28800 s at a time step of 0.0001 s needs 288000000 frames, more than the "
+            "limit of 4194304");
+  // Far past int: refused, not converted.
+  EXPECT_EQ(message(1e30f, 0.01f),
+            "a run of 1e+30 s at a time step of 0.01 s needs 1e+32 frames, more than the limit "
+            "of 4194304");
 }
 
 TEST(InputScript, ALongTokenIsCutInTheMessage) {

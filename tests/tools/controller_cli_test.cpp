@@ -191,6 +191,27 @@ TEST(ControllerCli, EvalRefusesABadScriptLineByFileAndLine) {
   EXPECT_NE(run.output.find("bad.txt:2:"), std::string::npos) << run.output;
 }
 
+// Bounded runs (script.hpp): a time step that would need millions of frames for a few seconds
+// is a usage error; a script time past the longest script is refused by file and line, where it
+// used to run "0 frames" (a float-to-int overflow) or abort allocating every frame.
+TEST(ControllerCli, EvalRefusesRunsPastTheLimits) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path walk = write_script(dir, "walk.txt", kScript);
+  CommandRun run = run_mm(eval_arguments(walk, "--dt 0.000001"));
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--dt: 0.000001 is outside [0.0001, 1]"), std::string::npos)
+      << run.output;
+
+  const fs::path far = write_script(dir, "far.txt", "0 0 1 0 0\n1e30 0 0 0 0\n");
+  run = run_mm(eval_arguments(far, ""));
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("mm eval: " + far.string() +
+                            ":2: expected the time in seconds (a number in [0, 28800], the "
+                            "longest script), found '1e30'"),
+            std::string::npos)
+      << run.output;
+}
+
 TEST(ControllerCli, EvalUsageErrorsExitWith2) {
   const fs::path dir = test::scratch_dir();
   const fs::path script = write_script(dir, "walk.txt", kScript);

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 
@@ -241,6 +242,27 @@ TEST(ViewerCli, RefusesBadUsageAndBadFiles) {
   EXPECT_NE(r.output.find("no display"), std::string::npos) << r.output;
 }
 
+// Bounded runs (script.hpp), as mm eval: an absurd time step is a usage error, a script time
+// past the longest script is refused by file and line. `--frames 2` keeps a run that is wrongly
+// accepted short, so that the test fails rather than runs for hours.
+TEST(ViewerCli, HeadlessRefusesRunsPastTheLimits) {
+  const fs::path dir = test::scratch_dir();  // first: it empties the folder the database goes to
+  const std::string headless = viewer() + " --db '" + database_file().string() +
+                               "' --headless --frames 2 --size 320x180 --no-panel --script ";
+  ProgramRun r = run(headless + "'" + script("showcase.txt") + "' --dt 0.000001");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--dt: 0.000001 is outside [0.0001, 1]"), std::string::npos) << r.output;
+
+  const fs::path far = dir / "far.txt";
+  std::ofstream(far) << "0 0 1 0 0\n1e30 0 0 0 0\n";
+  r = run(headless + "'" + far.string() + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("far.txt:2: expected the time in seconds (a number in [0, 28800], the "
+                          "longest script), found '1e30'"),
+            std::string::npos)
+      << r.output;
+}
+
 // The generated help lists every option; typed options refuse bad values naming the option,
 // and the options that go together stay usage errors.
 TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
@@ -258,9 +280,11 @@ TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
   const std::pair<std::string, std::string> cases[] = {
       {" --frames 1.5", "--frames: '1.5' is not an integer"},
       {" --every 2.5 --screenshot s.png", "--every: '2.5' is not an integer"},
-      {" --frames 0", "--frames: 0 is outside [1, 10000000]"},
+      {" --frames 0", "--frames: 0 is outside [1, 4194304]"},
+      {" --frames 4194305", "--frames: 4194305 is outside [1, 4194304]"},
       {" --dt nan", "--dt: 'nan' is not a finite number"},
-      {" --dt 0", "--dt: 0 is outside (0, 1]"},
+      {" --dt 0", "--dt: 0 is outside [0.0001, 1]"},
+      {" --dt 0.000001", "--dt: 0.000001 is outside [0.0001, 1]"},
       {" --size 640x10", "--size: '640x10' is not WxH"},
       {" --skinning fancy", "--skinning: fancy not in {lbs,dqs}"},
       {" --debug roots,sparkles", "--debug: 'roots,sparkles' is not a list of"},

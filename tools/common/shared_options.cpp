@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "command_line.hpp"
+#include "mm/controller/script.hpp"
 #include "mm/database/database_file.hpp"
 #include "number_parsing.hpp"
 
@@ -34,8 +35,9 @@ void add_ik_option(CLI::App& app, ControllerSettings& settings) {
 }
 
 void add_dt_option(CLI::App& app, float& dt, const std::string& default_text) {
+  // The bounds of every scripted run (script.hpp), so that a run is refused before it starts.
   app.add_option("--dt", dt, "seconds per update (" + default_text + ")")
-      ->check(number_over(0.0, 1.0))
+      ->check(number_in(kMinRunDt, kMaxRunDt))
       ->type_name("SECONDS");
 }
 

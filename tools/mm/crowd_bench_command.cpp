@@ -15,6 +15,7 @@
 #include "command.hpp"
 #include "command_line.hpp"
 #include "mm/controller/crowd.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "shared_options.hpp"
 
 namespace mm::cli {
@@ -88,12 +89,12 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   std::set<int> thread_counts = {1, 2};
   if (arguments.extra_threads > 0) thread_counts.insert(arguments.extra_threads);
   std::printf("%d characters, %.1f s at 60 Hz (%d frames each)\n", options.characters,
-              options.seconds, static_cast<int>(std::ceil(options.seconds * 60.0f)));
+              options.seconds, clamped_integer<int>(std::ceil(options.seconds * 60.0f)));
   // The update cost over the first and the last window of game time, and their ratio: a cost
   // that grows over a long run shows there.
   auto window_label = [](const char* which) {
     std::string label = which;  // appended: see the -Wrestrict note below
-    return label.append(std::to_string(std::lround(kCrowdWindowSeconds))).append(" s us");
+    return label.append(std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds)))).append(" s us");
   };
   const std::string first = window_label("first ");
   const std::string last = window_label("last ");

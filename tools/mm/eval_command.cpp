@@ -37,7 +37,12 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       "Runs one character controller on a script of timed stick and button states (see "
       "controller/include/mm/controller/script.hpp; examples in scripts/input/), headless, at a "
       "fixed dt, and prints its quality metrics. Several --script options print one row per "
-      "script.",
+      "script. Runs are bounded: script times at most " +
+          std::to_string(static_cast<int>(kMaxScriptSeconds)) + " s, at most " +
+          std::to_string(kMaxRunFrames) +
+          " updates a run (8 hours at 1/144 s); a longer run is refused before it starts. "
+          "Memory does not grow with the run's length, --dump included (rows are written as "
+          "they are made).",
       "mm eval");
   set_up_app(app);
   app.footer("exit status: 0 fine, 1 bad database or script, 2 bad usage");
@@ -193,12 +198,22 @@ void print_metrics(const EvaluationMetrics& m) {
 int run_eval(const std::vector<std::string>& args) {
   Arguments arguments;
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
-  arguments.options.keep_frames = !arguments.dump_path.empty();
 
   Result<std::shared_ptr<const ControllerDatabase>> shared = load_controller_database(arguments.db);
   if (!shared) {
     std::fprintf(stderr, "mm eval: %s\n", shared.message().c_str());
     return 1;
+  }
+
+  // Opened before the run, which writes its rows as it goes.
+  std::ofstream dump;
+  if (!arguments.dump_path.empty()) {
+    dump.open(arguments.dump_path);
+    if (!dump) {
+      std::fprintf(stderr, "mm eval: could not write %s\n", arguments.dump_path.c_str());
+      return 1;
+    }
+    arguments.options.dump = &dump;
   }
 
   const bool table = arguments.scripts.size() > 1;
@@ -235,9 +250,7 @@ int run_eval(const std::vector<std::string>& args) {
       single = json;
     }
     if (!arguments.dump_path.empty()) {
-      std::ofstream dump(arguments.dump_path);
-      dump << result->csv_header << "\n";
-      for (const std::string& row : result->csv_rows) dump << row << "\n";
+      dump.flush();
       if (!dump) {
         std::fprintf(stderr, "mm eval: could not write %s\n", arguments.dump_path.c_str());
         return 1;

@@ -15,6 +15,7 @@
 #include "input_recorder.hpp"
 #include "live_input.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "panel.hpp"
 
 namespace mm::viewer {
@@ -149,6 +150,16 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
     std::fprintf(stderr, "mm-viewer: %s\n", script.message().c_str());
     return 1;
   }
+  const float dt = options.dt > 0.0f ? options.dt : 1.0f / 60.0f;
+  // The same bounds as mm eval (script.hpp): a run too long is refused before anything is
+  // built for it.
+  const Result<int> script_frames = scripted_run_frames(script->duration() + 2.0f, dt);
+  if (!script_frames) {
+    std::fprintf(stderr, "mm-viewer: %s: %s\n", options.script_path.c_str(),
+                 script_frames.message().c_str());
+    return 1;
+  }
+  const int frames = options.frames > 0 ? options.frames : *script_frames;
   Stage stage;
   Result<std::unique_ptr<GlContext>> context =
       GlContext::create_headless(options.width, options.height);
@@ -166,10 +177,6 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
   }
   stage.panel.input_source = "script: " + options.script_path;
 
-  const float dt = options.dt > 0.0f ? options.dt : 1.0f / 60.0f;
-  const int frames = options.frames > 0
-                         ? options.frames
-                         : static_cast<int>(std::ceil((script->duration() + 2.0f) / dt));
   const auto start = std::chrono::steady_clock::now();
   int written = 0;
   for (int frame = 1; frame <= frames; ++frame) {
@@ -301,7 +308,7 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
       const std::string path =
           done && !options.screenshot_path.empty()
               ? options.screenshot_path
-              : "mm-viewer-" + std::to_string(static_cast<long>(now * 1000)) + ".png";
+              : "mm-viewer-" + std::to_string(clamped_integer<long>(now * 1000)) + ".png";
       const Status s = save_screenshot(*stage.context, path);
       stage.panel.message = s ? "saved " + path : s.message();
       std::printf("mm-viewer: %s\n", stage.panel.message.c_str());

@@ -13,6 +13,7 @@
 // (and none has to pass this project's warnings).
 #include <stb_easy_font.h>
 #include <stb_image_write.h>
+#include "mm/runtime/float_to_integer.hpp"
 
 namespace mm::viewer {
 namespace {
@@ -51,7 +52,7 @@ void blend(Image& image, int x, int y, Rgb colour, float coverage) {
   unsigned char* p = &image.rgb[(static_cast<size_t>(y) * image.width + x) * 3];
   for (int k = 0; k < 3; ++k) {
     const float mixed = p[k] + (static_cast<float>(colour[k]) - p[k]) * coverage;
-    p[k] = static_cast<unsigned char>(std::lround(mixed));
+    p[k] = clamped_integer<unsigned char>(std::round(mixed));
   }
 }
 
@@ -140,10 +141,10 @@ void draw_text(Image& image, int x, int y, const std::string& text, int scale, R
                 qx1 = std::max(corner[0][0], corner[2][0]);
     const float qy0 = std::min(corner[0][1], corner[2][1]),
                 qy1 = std::max(corner[0][1], corner[2][1]);
-    fill_rect(image, x + static_cast<int>(std::lround(qx0 * scale)),
-              y + static_cast<int>(std::lround(qy0 * scale)),
-              x + static_cast<int>(std::lround(qx1 * scale)),
-              y + static_cast<int>(std::lround(qy1 * scale)), colour);
+    fill_rect(image, x + clamped_integer<int>(std::round(qx0 * scale)),
+              y + clamped_integer<int>(std::round(qy0 * scale)),
+              x + clamped_integer<int>(std::round(qx1 * scale)),
+              y + clamped_integer<int>(std::round(qy1 * scale)), colour);
   }
 }
 
@@ -352,7 +353,7 @@ void grid_lines(double world_center, double pixel_center, double scale, int size
   for (int k = 0; k < 100000; ++k) {
     const double pixel = pixel_center + ((first + k) * step - world_center) * scale;
     if (!(pixel < size)) break;
-    draw_line(static_cast<int>(std::floor(pixel)));
+    draw_line(clamped_integer<int>(std::floor(pixel)));
   }
 }
 
@@ -512,7 +513,7 @@ int draw_scale_bar(Image& image, const RunPlotView& view, const RunPlotOptions& 
   const double plot_metres = (o.width - 2.0 * o.margin) / view.pixels_per_metre;
   const double metres = round_length(plot_metres / 5.0);
   const int length =
-      static_cast<int>(std::lround(std::min(metres * view.pixels_per_metre, 4.0 * o.width)));
+      clamped_integer<int>(std::round(std::min(metres * view.pixels_per_metre, 4.0 * o.width)));
   const int y = at.y + 4 * o.text_scale;
   fill_rect(image, at.x, y - 1, at.x + length, y + 2, o.text);
   fill_rect(image, at.x, y - 6, at.x + 2, y + 7, o.text);

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "command_line.hpp"
+#include "mm/controller/script.hpp"
 #include "number_parsing.hpp"
 #include "shared_options.hpp"
 
@@ -105,7 +106,7 @@ void add_run_options(CLI::App& app, ViewerOptions& out) {
                "no window: render offscreen (EGL surfaceless); needs --script");
   app.add_option("--frames", out.frames,
                  "stop after N frames (headless default: the script's length and 2 s)")
-      ->check(cli::integer_in(1, 10'000'000))
+      ->check(cli::integer_in(1, kMaxRunFrames))
       ->type_name("N");
   app.add_option("--screenshot", out.screenshot_path, "a PNG of the last frame")->type_name("FILE");
   app.add_option("--every", out.every,

@@ -23,6 +23,7 @@
 
 #include "gltf_files.hpp"
 #include "mm/database/files.hpp"
+#include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm {
@@ -1107,7 +1108,7 @@ Result<Clip> sample_animation(const tinygltf::Model& model, size_t animation_ind
   }
   // The small tolerance keeps the last key when (end - begin) * rate is an integer up to
   // rounding.
-  const int frame_count = static_cast<int>(std::floor(intervals + 1e-3)) + 1;
+  const int frame_count = clamped_integer<int>(std::floor(intervals + 1e-3)) + 1;
 
   Clip clip;
   clip.name = !animation.name.empty()        ? animation.name

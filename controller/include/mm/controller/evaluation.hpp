@@ -11,7 +11,9 @@
 // speeds are horizontal, from positions one frame apart, unless said 3-D; a value
 // that needs the previous frame starts at the second frame; a mean over no values is 0 and the
 // count beside it (frames or events) says so; yaws are about +Y, atan2(x, z), and yaw errors
-// and rates are absolute and wrapped to [0, 180] degrees per frame.
+// and rates are absolute and wrapped to [0, 180] degrees per frame; percentiles are by nearest
+// rank, read from a histogram whose bins are 2^-10 of their value wide (EvaluationAccumulator),
+// so they are within 0.05 % of the exact nearest-rank value.
 //
 // Metrics:
 // - foot_skate_cm_s_mean / _p95: the toe's speed on frames where that foot is in contact (the
@@ -79,6 +81,7 @@
 // does), so a slow drift also counts as a change once it adds up.
 
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <span>
 #include <string>
@@ -184,14 +187,15 @@ struct EvaluationFrame {
   std::span<const glm::vec3> joints;
 };
 
-// The metrics of a run, fed one frame at a time. Holds the previous frames it needs and the
-// values that go into percentiles, never the whole run. Not copyable (one run each).
+// The metrics of a run, fed one frame at a time. Holds the previous frames it needs, running
+// sums and fixed-size histograms for the percentiles (foot_skate_cm_s_p95,
+// transition_accel_p99, body_turn_rate_deg_s_p99: nearest rank, within 0.05 % of the exact
+// value), never the whole run: its memory does not depend on the run's length. Not copyable
+// (one run each).
 class EvaluationAccumulator {
  public:
-  // `roles` picks the joints; every frame carries `joint_count` joints; `dt` is the frame time;
-  // `expected_frames` only reserves room for the percentile samples.
-  EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count, float dt,
-                        size_t expected_frames = 0);
+  // `roles` picks the joints; every frame carries `joint_count` joints; `dt` is the frame time.
+  EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count, float dt);
   ~EvaluationAccumulator();
   EvaluationAccumulator(const EvaluationAccumulator&) = delete;
   EvaluationAccumulator& operator=(const EvaluationAccumulator&) = delete;
@@ -208,20 +212,23 @@ class EvaluationAccumulator {
 };
 
 struct EvaluationOptions {
-  float dt = 1.0f / 60.0f;  // seconds per update
-  // Seconds to run; 0: the script's duration plus 2 s (so its last line is seen through).
+  // Seconds per update, in [kMinRunDt, kMaxRunDt] (script.hpp).
+  float dt = 1.0f / 60.0f;
+  // Seconds to run; 0: the script's duration plus 2 s (so its last line is seen through). The
+  // run may take at most kMaxRunFrames updates (script.hpp).
   float seconds = 0.0f;
   ControllerSettings settings;
-  bool keep_frames = false;  // fill EvaluationResult::csv_rows for --dump
   // Where the character stands at t = 0 (world x and z, metres; `mm eval --start X,Z`), facing
   // +Z. The dump's positions are world positions, so they include it.
   glm::dvec2 start{0.0};
+  // When set, `mm eval --dump`: a CSV header line, then one row per frame written as the frame
+  // is made (t, simulation, root, desired motion, transition, contacts, every joint's global
+  // position). The caller checks the stream's state afterwards.
+  std::ostream* dump = nullptr;
 };
 
 struct EvaluationResult {
   EvaluationMetrics metrics;
-  std::string csv_header;             // the --dump header (no newline)
-  std::vector<std::string> csv_rows;  // one per frame when keep_frames
 };
 
 // The database's own joint acceleration, 99th percentile (m/s^2): every clip that carries none

@@ -4,7 +4,8 @@
 //
 // Format: one line per change of state,
 //   t lx ly rx ry [run] [strafe] [tag=NAME] [camera=DEGREES]
-// - t: seconds, non-decreasing from line to line (equal times: the later line wins);
+// - t: seconds, non-decreasing from line to line (equal times: the later line wins), at most
+//   kMaxScriptSeconds;
 // - lx ly: the left stick, rx ry: the right stick, each in [-1, 1] (see input.hpp for axes);
 // - run, strafe: the buttons held (absent: released);
 // - tag=NAME: request clips carrying the tag NAME (absent: locomotion);
@@ -23,6 +24,26 @@
 #include "mm/runtime/result.hpp"
 
 namespace mm {
+
+// Bounded runs. A scripted run (mm eval, mm-viewer --headless) is refused up front, with a
+// message, when it would be longer than these limits, instead of running for days or converting
+// an absurd frame count to an integer:
+// - a script's times are at most kMaxScriptSeconds (8 hours; refused at parse, naming the file
+//   and line). Times are floats: at 8 hours they still resolve 2 ms, a quarter of a 1/144 s
+//   frame;
+// - a run's time step is in [kMinRunDt, kMaxRunDt] seconds (10 kHz to 1 Hz);
+// - a run takes at most kMaxRunFrames updates (2^22: 8 hours at 1/144 s, 19 hours at 1/60 s).
+// The evaluation streams its frames (evaluation.hpp), so memory does not grow with the frame
+// count; the limit keeps run times and frame indices (int) sane.
+inline constexpr float kMaxScriptSeconds = 8.0f * 3600.0f;
+inline constexpr float kMinRunDt = 1e-4f;
+inline constexpr float kMaxRunDt = 1.0f;
+inline constexpr int kMaxRunFrames = 1 << 22;
+
+// The number of updates a run of `seconds` at `dt` takes (ceil(seconds / dt) in float), or
+// an error naming the values and the limit when dt is outside [kMinRunDt, kMaxRunDt], seconds
+// is negative or not finite, or the count exceeds kMaxRunFrames.
+Result<int> scripted_run_frames(float seconds, float dt);
 
 // One line of a script.
 struct ScriptEvent {
