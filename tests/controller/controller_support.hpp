@@ -1,21 +1,20 @@
 #pragma once
 // The controller tests' shared database: the whole Bandai normal folder built with the default
-// options (the database the controller's targets are measured on), once per test program.
+// options (the database the controller's targets are measured on), once per test program
+// (normal_database.hpp: loaded from the file ctest's setup test writes).
 
 #include <gtest/gtest.h>
 
 #include <memory>
 
 #include "mm/controller/controller.hpp"
-#include "mm/database/builder.hpp"
-#include "test_support.hpp"
+#include "normal_database.hpp"
 
 namespace mm::test {
 
 inline std::shared_ptr<const ControllerDatabase> normal_controller_database() {
   static const std::shared_ptr<const ControllerDatabase> shared = [] {
-    const std::filesystem::path inputs[] = {data_dir()};
-    Result<Database> db = build_database(inputs, BuildOptions{});
+    Result<Database> db = normal_database();
     EXPECT_TRUE(db.ok()) << (db.ok() ? "" : db.message());
     Result<std::shared_ptr<const ControllerDatabase>> made =
         ControllerDatabase::create(std::make_shared<const Database>(std::move(db).value()));

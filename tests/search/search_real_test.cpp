@@ -18,6 +18,7 @@
 #include "mm/search/search.hpp"
 #include "mm/search_baselines/baselines.hpp"
 #include "mm/search_baselines/synthetic.hpp"
+#include "normal_database.hpp"
 #include "search_rules.hpp"
 #include "test_support.hpp"
 
@@ -57,10 +58,9 @@ const Database& subset_database() {
 
 const Database& normal_database() {
   static const Database db = [] {
-    const fs::path folder = test::data_dir();
-    auto built = build_database(std::span<const fs::path>(&folder, 1), BuildOptions{});
-    EXPECT_TRUE(built) << built.message();
-    return built ? std::move(built).value() : Database{};
+    auto loaded = test::normal_database();
+    EXPECT_TRUE(loaded) << loaded.message();
+    return loaded ? std::move(loaded).value() : Database{};
   }();
   return db;
 }

@@ -16,8 +16,8 @@
 #include <sys/wait.h>
 
 #include "mm/controller/script.hpp"
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
+#include "normal_database.hpp"
 #include "test_support.hpp"
 
 namespace mm {
@@ -57,12 +57,13 @@ std::string script(const std::string& name) {
   return std::string(MM_SOURCE_DIR) + "/scripts/input/" + name;
 }
 
-// The Bandai normal database, built once per test program into the build tree.
+// The Bandai normal database: the file of ctest's setup test, or built once per test program
+// into the build tree when the program runs by hand.
 const fs::path& database_file() {
   static const fs::path path = [] {
+    if (const fs::path file = test::normal_database_file(); !file.empty()) return file;
     const fs::path out = test::scratch_dir() / "normal.mmdb";
-    const fs::path inputs[] = {test::data_dir()};
-    Result<Database> db = build_database(inputs, BuildOptions{});
+    Result<Database> db = test::build_normal_database();
     EXPECT_TRUE(db.ok()) << (db.ok() ? "" : db.message());
     if (db.ok()) {
       EXPECT_TRUE(save_database(*db, out).ok());
