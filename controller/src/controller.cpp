@@ -83,13 +83,20 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 // the shorter span it leaves makes knees snap straight at the transitions.
 constexpr float kSoftReach = 0.96f;
 constexpr float kMinSoftSpan = 0.01f;
+// Halflife (s) of the easing between keeping the animation's extension (standing) and not.
+constexpr float kStandingReachHalflife = 0.1f;
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
 
-glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, float length) {
+// `keep_animated` in [0, 1] is how much of the animation's own extension beyond kSoftReach is
+// kept (1 standing, 0 in motion, eased between, so the reach never jumps).
+glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, float keep_animated,
+                     float length) {
   const float d = glm::length(hip_to_ankle);
-  const float kept = std::max(kSoftReach * length, std::min(animated_distance, length));
+  const float soft = kSoftReach * length;
+  const float kept =
+      soft + keep_animated * std::max(0.0f, std::min(animated_distance, length) - soft);
   if (d <= kept || d < 1e-6f) return hip_to_ankle;
   const float span = std::max(length - kept, kMinSoftSpan * length);
   const float reached = kept + span * (1.0f - std::exp(-(d - kept) / span));
@@ -271,6 +278,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   desired_velocity_ = glm::vec3(0.0f);
   offsets_.clear();
   for (FootLock& f : feet_) f = FootLock{};
+  standing_reach_ = 0.0f;
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
@@ -781,6 +789,8 @@ void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
   const bool settling = on_idle_clip();
+  standing_reach_ +=
+      ((settling ? 1.0f : 0.0f) - standing_reach_) * pull_fraction(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
     const std::vector<int>& leg = leg_joints_[side];
     const int effector = leg[3] >= 0 ? leg[3] : leg[2];
@@ -907,10 +917,9 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   glm::vec3 ankle_target =
       target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
   const float animated_reach =
-      on_idle_clip() ? glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position)
-                     : 0.0f;
-  ankle_target =
-      hip_position + soft_reach(ankle_target - hip_position, animated_reach, leg_length(side));
+      glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
+  ankle_target = hip_position + soft_reach(ankle_target - hip_position, animated_reach,
+                                           standing_reach_, leg_length(side));
   // The knee bends toward where it points now; a nearly straight leg has no such direction
   // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
   // so the character's forward breaks the tie.

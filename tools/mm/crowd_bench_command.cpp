@@ -94,7 +94,8 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   // that grows over a long run shows there.
   auto window_label = [](const char* which) {
     std::string label = which;  // appended: see the -Wrestrict note below
-    return label.append(std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds)))).append(" s us");
+    return label.append(std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds))))
+        .append(" s us");
   };
   const std::string first = window_label("first ");
   const std::string last = window_label("last ");

@@ -472,6 +472,8 @@ class Controller {
     float heading_offset_velocity = 0.0f;
   };
   FootLock feet_[2];
+  // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
+  float standing_reach_ = 0.0f;
 
   ControllerDebug debug_;
 };
