@@ -31,20 +31,24 @@ case "$config" in
   release)
     cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DMM_WERROR=ON >/dev/null ;;
   asan)
-    # Optimized but with asserts on (no NDEBUG), so the sanitizer pass also checks them.
+    # The libraries optimized (the tests, tools and viewer not: MM_DRIVER_COMPILE_OPTIONS in
+    # CMakeLists.txt) but with asserts on (no NDEBUG), so the sanitizer pass also checks them.
+    # Line tables (-g1) are all a sanitizer's stack trace reads; full debug information costs
+    # much of an instrumented build's time.
     cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON -DMM_WERROR=ON \
-      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" \
+      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
       -DMM_BUILD_BENCH=OFF >/dev/null ;;
   tsan)
     # ThreadSanitizer, optimized like asan, over the thread tests only (the target
     # mm_thread_tests of tests/CMakeLists.txt): the rest runs on one thread, and the tools and the
     # viewer are not built.
     cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE_THREAD=ON \
-      -DMM_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" -DMM_BUILD_BENCH=OFF >/dev/null
+      -DMM_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DMM_BUILD_BENCH=OFF >/dev/null
     targets=(--target mm_thread_tests) ;;
   fuzz)
     CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_BUILD_FUZZ=ON \
-      -DMM_BUILD_TESTS=OFF -DMM_BUILD_BENCH=OFF >/dev/null
+      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DMM_BUILD_TESTS=OFF \
+      -DMM_BUILD_BENCH=OFF >/dev/null
     # The fuzz targets and the libraries they link (mm_fuzz_targets, fuzz/CMakeLists.txt): the
     # tools and the viewer add minutes of clang build that no fuzzer runs.
     targets=(--target mm_fuzz_targets) ;;

@@ -255,12 +255,15 @@ TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
   const fs::path dir = test::scratch_dir();
   for (bool playing : {false, true}) {
     const fs::path json_path = dir / (playing ? "playing.json" : "plain.json");
-    const CommandRun run = run_mm(std::string("search-bench --synthetic --queries 300 --quiet ") +
-                                  (playing ? "--playing " : "") + "--json " + quoted(json_path));
+    // A tenth of the default synthetic data: every method's structure is built for it.
+    const CommandRun run =
+        run_mm(std::string("search-bench --synthetic --synthetic-clips 60 --queries 300 --quiet ") +
+               (playing ? "--playing " : "") + "--json " + quoted(json_path));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     std::ifstream file(json_path);
     const nlohmann::json json = nlohmann::json::parse(file, nullptr, /*allow_exceptions=*/false);
     ASSERT_FALSE(json.is_discarded()) << json_path;
+    EXPECT_EQ(json["run"]["database"], "synthetic (60 clips)");
     for (const char* method :
          {"brute", "brute-simd", "aabb", "kdtree", "boxtree", "approx", "kdtree-eps"}) {
       ASSERT_TRUE(json.contains(method)) << method;
@@ -304,7 +307,7 @@ TEST(Cli, SearchBenchJsonHoldsEveryMethodWithItsFields) {
 TEST(Cli, SearchBenchNeighbourhoodOfExactRowsIsTheRowItself) {
   const fs::path json_path = test::scratch_dir() / "noiseless.json";
   const CommandRun run = run_mm(
-      "search-bench --synthetic --queries 100 --noise 0 --quiet "
+      "search-bench --synthetic --synthetic-clips 60 --queries 100 --noise 0 --quiet "
       "--methods brute,brute-simd --no-flann-reference --json " +
       quoted(json_path));
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -317,12 +320,15 @@ TEST(Cli, SearchBenchNeighbourhoodOfExactRowsIsTheRowItself) {
 }
 
 // search-bench parses integers as integers: a fractional query count is a usage error that
-// names the option and the value.
+// names the option and the value; a count out of range is refused the same way.
 TEST(Cli, SearchBenchRefusesAFractionalQueryCount) {
   const CommandRun run = run_mm("search-bench --synthetic --queries 1.5");
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find("--queries"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("'1.5' is not an integer"), std::string::npos) << run.output;
+  const CommandRun none = run_mm("search-bench --synthetic --synthetic-clips 0");
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_NE(none.output.find("--synthetic-clips"), std::string::npos) << none.output;
 }
 
 // Every command's --help exits 0, starts with its usage line and lists the options it declares

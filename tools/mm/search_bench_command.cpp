@@ -55,6 +55,7 @@ const std::vector<std::string> kBruteForceRows = {"brute", "brute-simd", "brute-
 struct Arguments {
   std::string db_path;
   bool synthetic = false;
+  int synthetic_clips = 600;
   int queries = 2000;
   float noise = 0.1f;
   std::vector<std::string> methods;
@@ -78,6 +79,10 @@ struct Arguments {
 void add_data_options(CLI::App& app, Arguments& out) {
   app.add_option("--db", out.db_path, "the database (.mmdb, from `mm build`)")->type_name("FILE");
   app.add_flag("--synthetic", out.synthetic, "use generated curve-like data instead (no file)");
+  app.add_option("--synthetic-clips", out.synthetic_clips,
+                 "clips of generated data with --synthetic (60 to 300 frames each)")
+      ->check(integer_in(1, 100'000))
+      ->capture_default_str();
   app.add_option("--queries", out.queries, "number of queries")
       ->check(integer_in(1, 10'000'000))
       ->capture_default_str();
@@ -304,10 +309,10 @@ int resolve_tags(const Arguments& arguments, BenchData& data) {
 int load_data(const Arguments& arguments, BenchData& data) {
   if (arguments.synthetic) {
     SyntheticSearchSpec spec;
-    spec.clip_count = 600;
+    spec.clip_count = arguments.synthetic_clips;
     data.synthetic = make_synthetic_search_data(spec);
     data.input = data.synthetic.input();
-    data.source = "synthetic (600 clips)";
+    data.source = "synthetic (" + std::to_string(spec.clip_count) + " clips)";
   } else {
     auto loaded = load_database(arguments.db_path);
     if (!loaded) {
