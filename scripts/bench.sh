@@ -21,7 +21,7 @@ scripts=()
 for f in scripts/input/*.txt; do scripts+=(--script "$f"); done
 "$mm" eval --db out/database.mmdb "${scripts[@]}" --json out/eval.json
 
-# Two minutes of game time: the steady state of a long run, whose last 5 s the table compares
+# Two minutes of game time: the steady state of a long run, whose last 20 s the table compares
 # with the first (a cost that creeps up as the characters' state ages shows in that ratio).
 printf '\n=== 3/4 Crowd benchmark (mm crowd-bench, 1500 characters, 120 s at 60 Hz) ===\n'
 "$mm" crowd-bench --db out/database.mmdb --characters 1500 --seconds 120 --json out/crowd-bench.json

@@ -30,15 +30,18 @@ struct Arguments {
 
 // Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
 int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
+  const std::string window = std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds)));
   CLI::App app(
       "Updates N character controllers over one shared database at 60 Hz for S seconds of game "
       "time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera "
       "turns), and prints the update cost per character per frame (mean, p99, the share spent in "
       "search) and the largest crowd a 1/60 s frame holds at that cost, on 1 and on 2 threads "
       "(and on --threads T when it is another count), with the mean cost over the first and the "
-      "last 5 s of game time and their ratio, which a cost creeping up over a long run raises. "
-      "Every run ends with the same character "
-      "positions whatever the thread count; the tool checks that.",
+      "last " +
+          window +
+          " s of game time and their ratio, which a cost creeping up over a long "
+          "run raises. Every run ends with the same character positions whatever the thread count; "
+          "the tool checks that.",
       "mm crowd-bench");
   set_up_app(app);
   app.footer(

@@ -22,9 +22,11 @@ InputScript varied_input_script(uint32_t seed, float seconds);
 
 // The length (s of game time) of the windows at the start and at the end of a run whose update
 // costs CrowdResult compares: a controller's cost must not creep up over a long run (its
-// decaying state shrinking into slow subnormal floats did once). Shorter runs have one window,
-// the whole run.
-inline constexpr float kCrowdWindowSeconds = 5.0f;
+// decaying state shrinking into slow subnormal floats did once, and kept growing for a minute).
+// Long enough to average out what the machine itself does over seconds (clock boost, other
+// tenants of a virtual machine), which moves a few seconds' mean by as much as the creep this
+// ratio is there to see. Runs shorter than a window have one window, the whole run.
+inline constexpr float kCrowdWindowSeconds = 20.0f;
 
 struct CrowdOptions {
   int characters = 100;
