@@ -279,6 +279,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   offsets_.clear();
   for (FootLock& f : feet_) f = FootLock{};
   standing_reach_ = 0.0f;
+  body_yaw_known_ = false;
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
@@ -318,6 +319,7 @@ void Controller::update(float dt, const ControllerInput& input) {
       rotation_vector_rate_to_angular_velocity(offsets_.rotations[0], offsets_.rotation_rates[0]);
   simulate(dt);
   synchronize(dt);
+  limit_body_turn(dt);
   predict();
   refresh_outputs(dt);
 }
@@ -615,10 +617,23 @@ void Controller::simulate(float dt) {
   if (stopping_) {
     stand_turn(dt);
   } else {
+    const glm::quat before = sim_rotation_;
     critical_spring_update(sim_rotation_, sim_angular_velocity_, desired_rotation_,
                            settings_.simulation_rotation_halflife, dt);
+    limit_turn_rate(before, dt);
   }
   sim_position_.y = 0.0f;
+}
+
+// The rotation spring's step, and its rate, cut to simulation_max_turn_rate: a large change of
+// facing then turns at that rate until the spring's own rate falls below it.
+void Controller::limit_turn_rate(const glm::quat& before, float dt) {
+  const float max_rate = settings_.simulation_max_turn_rate;
+  const float step = wrap_angle(quat_yaw(sim_rotation_) - quat_yaw(before));
+  if (std::abs(step) > max_rate * dt) {
+    sim_rotation_ = glm::normalize(yaw_rotation(std::copysign(max_rate * dt, step)) * before);
+  }
+  sim_angular_velocity_.y = std::clamp(sim_angular_velocity_.y, -max_rate, max_rate);
 }
 
 // Standing, the facing turns the way a person turns on the spot: the rotation spring alone
@@ -651,6 +666,18 @@ void Controller::predict() {
                            trajectory_times_);
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_, desired_rotation_,
                           settings_.simulation_rotation_halflife, trajectory_times_);
+  // The turn-rate limit as update applies it, closely enough for the query: no farther from
+  // today's facing than the fastest turn reaches in the time.
+  const float yaw = quat_yaw(sim_rotation_);
+  const float max_rate =
+      stopping_ ? settings_.stand_turn_max_rate : settings_.simulation_max_turn_rate;
+  for (size_t i = 0; i < n; ++i) {
+    const float reach = max_rate * std::max(0.0f, trajectory_times_[i]);
+    const float turn = wrap_angle(quat_yaw(rotations[i]) - yaw);
+    if (std::abs(turn) > reach) {
+      rotations[i] = glm::normalize(yaw_rotation(std::copysign(reach, turn)) * sim_rotation_);
+    }
+  }
   for (size_t i = 0; i < n; ++i) {
     debug_.desired_positions[i] =
         sim_position_ + desired_velocity_ * std::max(0.0f, trajectory_times_[i]);
@@ -697,7 +724,12 @@ void Controller::synchronize(float dt) {
 
   const float root_yaw = quat_yaw(root.rotation);
   float angle = wrap_angle(quat_yaw(sim_rotation_) - root_yaw) * fraction;
-  float max_angle = settings_.adjustment_max_angular_velocity_ratio * turn_rate * dt;
+  // At least as fast as the simulation itself turns: held to the character's own turning, a
+  // clip that does not turn would leave the root behind a turning simulation until the clamp
+  // dragged it.
+  float max_angle = std::max(settings_.adjustment_max_angular_velocity_ratio * turn_rate,
+                             std::abs(sim_angular_velocity_.y)) *
+                    dt;
   if (stopping_) {
     // The idle pose does not turn by itself, so a standing character turns with the
     // simulation's own (bounded, eased) turning, and catches up on what remains no faster:
@@ -706,6 +738,13 @@ void Controller::synchronize(float dt) {
     max_angle = std::max(max_angle, settings_.stand_turn_max_rate * dt);
   }
   angle = std::clamp(angle, -max_angle, max_angle);
+  if (!stopping_) {
+    // Moving, the pull never makes the root turn faster than the simulation may: the body
+    // would spin at its own turning plus the pull's.
+    const float own = displayed_angular_velocity_.y * dt;
+    const float limit = std::max(std::abs(own), settings_.simulation_max_turn_rate * dt);
+    angle = std::clamp(own + angle, -limit, limit) - own;
+  }
   float yaw = root_yaw + angle;
 
   // Never farther than the clamping limits.
@@ -727,9 +766,38 @@ void Controller::synchronize(float dt) {
   move_root(position, glm::normalize(delta * root.rotation));
 }
 
+// The body's facing in the displayed pose: the yaw across the upper legs (pair_yaw), from the
+// local pose before forward kinematics.
+float Controller::body_yaw() const {
+  const std::span<const int> parents = db_->skeleton.parents();
+  const glm::vec3 left = forward_kinematics_joint(parents, locals_, leg_joints_[0][0]).translation;
+  const glm::vec3 right = forward_kinematics_joint(parents, locals_, leg_joints_[1][0]).translation;
+  return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
+}
+
+// The body turns no faster than body_max_turn_rate: the root takes back what the clip's own
+// turning, a transition's offsets and the pull toward the simulation would add beyond it (the
+// pull makes it up on later updates).
+void Controller::limit_body_turn(float dt) {
+  if (settings_.sync_mode == SyncMode::None) return;
+  float yaw = body_yaw();
+  const float limit = settings_.body_max_turn_rate * dt;
+  if (body_yaw_known_ && limit > 0.0f) {
+    const float turn = wrap_angle(yaw - body_yaw_);
+    if (std::abs(turn) > limit) {
+      const float back = std::copysign(limit, turn) - turn;
+      move_root(locals_[0].translation, glm::normalize(yaw_rotation(back) * locals_[0].rotation));
+      yaw = wrap_angle(yaw + back);
+    }
+  }
+  body_yaw_ = yaw;
+  body_yaw_known_ = true;
+}
+
 // adjust_root() relative to the origin.
 void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& rotation) {
   if (!finite(position) || !finite(rotation) || clip_ < 0) return;
+  body_yaw_known_ = false;
   move_root(position, glm::normalize(rotation));
   // The feet go with the body: held toes would otherwise pull the legs back.
   for (FootLock& f : feet_) f = FootLock{};

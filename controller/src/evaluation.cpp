@@ -119,12 +119,6 @@ float direction_yaw(const glm::vec3& v, float fallback) {
   return std::hypot(v.x, v.z) > 1e-6f ? std::atan2(v.x, v.z) : fallback;
 }
 
-// The body yaw of a left/right pair: the yaw of (L - R) x up = (-(L - R).z, 0, (L - R).x).
-float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback) {
-  const glm::vec3 across = left - right;
-  return direction_yaw(glm::vec3(-across.z, 0.0f, across.x), fallback);
-}
-
 // Whole frames covering `seconds` at dt (at least one), so a settle time is compared as a
 // frame count without float drift.
 int frames_for(float seconds, float dt) {

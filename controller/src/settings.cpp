@@ -36,6 +36,8 @@ constexpr FloatField kFloatFields[] = {
      10.0f},
     {"simulation_rotation_halflife", &ControllerSettings::simulation_rotation_halflife, 0.0f,
      10.0f},
+    {"simulation_max_turn_rate", &ControllerSettings::simulation_max_turn_rate, 0.1f, 100.0f},
+    {"body_max_turn_rate", &ControllerSettings::body_max_turn_rate, 0.0f, 100.0f},
     {"search_interval", &ControllerSettings::search_interval, 0.0f, 10.0f},
     {"transition_cost", &ControllerSettings::transition_cost, 0.0f, 1e6f},
     {"ignore_window", &ControllerSettings::ignore_window, 0.0f, 10.0f},

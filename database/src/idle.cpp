@@ -228,10 +228,8 @@ std::vector<FrameCalm> frame_calm(const Clip& clip, const JointRoleIndices& role
     forward_kinematics(clip.skeleton.parents(), clip.pose(static_cast<int>(f)), global);
     feet[2 * f] = global[static_cast<size_t>(roles.left_foot)].translation;
     feet[2 * f + 1] = global[static_cast<size_t>(roles.right_foot)].translation;
-    const glm::vec3 across = global[static_cast<size_t>(roles.left_upper_leg)].translation -
-                             global[static_cast<size_t>(roles.right_upper_leg)].translation;
-    // Forward is across x up: (-across.z, 0, across.x).
-    out[f].yaw = std::atan2(-across.z, across.x);
+    out[f].yaw = pair_yaw(global[static_cast<size_t>(roles.left_upper_leg)].translation,
+                          global[static_cast<size_t>(roles.right_upper_leg)].translation);
   }
   const float limit = criteria.max_foot_speed * clip.frame_time;
   for (size_t f = 0; f < frames; ++f) {

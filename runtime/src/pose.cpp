@@ -1,6 +1,7 @@
 #include "mm/runtime/pose.hpp"
 
 #include <cassert>
+#include <cmath>
 
 namespace mm {
 
@@ -30,6 +31,13 @@ void bone_lengths(std::span<const int> parents, std::span<const Transform> globa
     lengths[i] = p < 0 ? glm::length(global[i].translation)
                        : glm::distance(global[i].translation, global[p].translation);
   }
+}
+
+float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback) {
+  const glm::vec3 across = left - right;
+  // (left - right) x up = (-across.z, 0, across.x).
+  if (std::hypot(across.x, across.z) <= 1e-6f) return fallback;
+  return std::atan2(-across.z, across.x);
 }
 
 }  // namespace mm

@@ -141,6 +141,14 @@ struct ControllerSettings {
   // distance to its goal in one halflife).
   float simulation_velocity_halflife = 0.3f;   // s
   float simulation_rotation_halflife = 0.15f;  // s
+  // The fastest the simulation's facing turns while moving (rad/s). A person running into a
+  // reversal turns no faster than the data's own hips do; the rotation spring alone swings a
+  // half turn at twice that, and the character, held near the simulation, spins with it.
+  float simulation_max_turn_rate = 5.0f;
+  // The fastest the body (the hips' facing across the upper legs) turns, standing or moving
+  // (rad/s): whatever the clip, the transition and the pull toward the simulation add up to,
+  // the root yields the excess. People do not spin their hips faster; 0: no limit.
+  float body_max_turn_rate = 5.2f;
 
   // ---- Matching.
   std::string search_method = "boxtree";  // a name from search_method_names()
@@ -351,6 +359,9 @@ class Controller {
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
+  void limit_turn_rate(const glm::quat& before, float dt);
+  float body_yaw() const;
+  void limit_body_turn(float dt);
   void predict();
   bool should_search() const;
   void build_query();
@@ -474,6 +485,9 @@ class Controller {
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
   float standing_reach_ = 0.0f;
+  // The body's facing after the last update (see body_max_turn_rate), unknown after a placement.
+  float body_yaw_ = 0.0f;
+  bool body_yaw_known_ = false;
 
   ControllerDebug debug_;
 };

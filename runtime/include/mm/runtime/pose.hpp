@@ -20,6 +20,12 @@ void forward_kinematics(std::span<const int> parents, std::span<const Transform>
 Transform forward_kinematics_joint(std::span<const int> parents, std::span<const Transform> local,
                                    int joint);
 
+// The facing of a body from a left/right pair of joints' global positions (the hips' from the
+// upper legs, the chest's from the upper arms): the yaw (radians about +Y, atan2(x, z), as
+// quat_yaw) of the horizontal vector (left - right) x up, or `fallback` when the pair has no
+// horizontal separation. Any skeleton gives it the same way, whatever its bones' axes.
+float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback = 0.0f);
+
 // Bone lengths from global transforms: a child's length is the distance between its global
 // position and its parent's; a root's length is the length of its translation.
 void bone_lengths(std::span<const int> parents, std::span<const Transform> global,
