@@ -925,6 +925,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
                          settings_.foot_lock_release_halflife, dt);
   glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
+  // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
+  // otherwise sink a toe into the ground.
+  target.y = std::max(target.y, shared_->lowest_foot_end(side));
   f.target = target;
   // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
   // turning round its toe still has its heel's arc to go); the lift itself follows that height

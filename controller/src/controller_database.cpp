@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "mm/controller/controller.hpp"
 #include "mm/database/idle.hpp"
@@ -74,6 +76,25 @@ ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_
   return speeds;
 }
 
+// The lowest height above the ground of `joint` in any frame (m): its global transform composed
+// along its chain of ancestors, joint 0 being relative to the ground.
+float lowest_height(const Database& db, int joint) {
+  std::vector<int> chain;
+  for (int j = joint; j >= 0; j = db.skeleton.parent(j)) chain.push_back(j);
+  std::reverse(chain.begin(), chain.end());
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  float lowest = std::numeric_limits<float>::infinity();
+  for (size_t f = 0; f < static_cast<size_t>(db.frame_count); ++f) {
+    Transform global;
+    for (const int j : chain) {
+      const size_t k = f * joints + static_cast<size_t>(j);
+      global = compose(global, Transform{db.local_rotations[k], db.local_positions[k]});
+    }
+    lowest = std::min(lowest, global.translation.y);
+  }
+  return std::isfinite(lowest) ? lowest : 0.0f;
+}
+
 }  // namespace
 
 Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
@@ -121,6 +142,13 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
         "times and the clip-end exclusion need)"};
   }
   out->speeds_ = measure_speeds(db, out->action_tags_ | out->idle_tags_);
+  // The same end joint per leg as the controller's foot IK (Controller::resolve_joints).
+  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
+  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  for (int side = 0; side < 2; ++side) {
+    const bool toe = toes[side] >= 0 && db.skeleton.parent(toes[side]) == feet[side];
+    out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
+  }
   return std::shared_ptr<const ControllerDatabase>(std::move(out));
 }
 

@@ -97,6 +97,11 @@ class ControllerDatabase {
   };
   const Speeds& speeds() const { return speeds_; }
 
+  // The lowest each leg's end joint (the toe when it hangs from the foot, else the foot; index 0
+  // left, 1 right) comes above the ground in any frame of the data (m): foot IK never puts it
+  // lower, so feet do not sink where the data's never do.
+  float lowest_foot_end(int side) const { return lowest_foot_end_[side != 0 ? 1 : 0]; }
+
   // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
   uint64_t action_tags() const { return action_tags_; }
   uint64_t idle_tags() const { return idle_tags_; }
@@ -112,6 +117,7 @@ class ControllerDatabase {
   ControllerDatabaseOptions options_;
   std::vector<uint8_t> candidates_;
   Speeds speeds_;
+  float lowest_foot_end_[2] = {0.0f, 0.0f};
   uint64_t action_tags_ = 0;
   uint64_t idle_tags_ = 0;
   struct SearcherEntry {
