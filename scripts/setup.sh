@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project needs (only those missing), then configures and
-# builds one configuration. Usage: scripts/setup.sh [release|asan|tsan|fuzz]   (default: release)
+# builds one configuration. Usage: scripts/setup.sh [release|asan|tsan]   (default: release;
+# fuzz is asan, whose tree holds the libFuzzer targets)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -31,12 +32,17 @@ case "$config" in
   release)
     cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release -DMM_WERROR=ON >/dev/null ;;
   asan)
-    # The libraries optimized (the tests, tools and viewer not: MM_DRIVER_COMPILE_OPTIONS in
-    # CMakeLists.txt) but with asserts on (no NDEBUG), so the sanitizer pass also checks them.
-    # Line tables (-g1) are all a sanitizer's stack trace reads; full debug information costs
-    # much of an instrumented build's time.
-    cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON -DMM_WERROR=ON \
-      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
+    # clang, with the libFuzzer targets (fuzz/, MM_BUILD_FUZZ) in the same tree: the libraries are
+    # compiled once for the tests and the fuzzers. The libraries optimized (the tests, tools and
+    # viewer not: MM_DRIVER_COMPILE_OPTIONS in CMakeLists.txt) but with asserts on (no NDEBUG),
+    # so the sanitizer pass also checks them. Line tables (-g1) are all a sanitizer's stack
+    # trace reads; full debug information costs much of an instrumented build's time. A tree
+    # configured with another compiler (gcc, before) is configured afresh.
+    if [ -f build/asan/CMakeCache.txt ] && ! grep -q '^CMAKE_CXX_COMPILER:.*clang' build/asan/CMakeCache.txt; then
+      rm -rf build/asan
+    fi
+    CXX=clang++ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_SANITIZE=ON \
+      -DMM_BUILD_FUZZ=ON -DMM_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
       -DMM_BUILD_BENCH=OFF >/dev/null ;;
   tsan)
     # ThreadSanitizer, optimized like asan, over the thread tests only (the target
@@ -46,12 +52,8 @@ case "$config" in
       -DMM_WERROR=ON "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DMM_BUILD_BENCH=OFF >/dev/null
     targets=(--target mm_thread_tests) ;;
   fuzz)
-    CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMM_BUILD_FUZZ=ON \
-      "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" -DMM_BUILD_TESTS=OFF \
-      -DMM_BUILD_BENCH=OFF >/dev/null
-    # The fuzz targets and the libraries they link (mm_fuzz_targets, fuzz/CMakeLists.txt): the
-    # tools and the viewer add minutes of clang build that no fuzzer runs.
-    targets=(--target mm_fuzz_targets) ;;
+    # The fuzz targets are built by the asan configuration (build/asan/fuzz/).
+    exec "$0" asan ;;
   *) echo "setup: unknown configuration '$config' (release, asan, tsan or fuzz)" >&2; exit 2 ;;
 esac
 echo "setup: building build/$config with $jobs jobs"

@@ -2,10 +2,10 @@
 # The test command. Installs missing Debian packages, then:
 #   0. every tracked C++ file is clang-formatted (.clang-format);
 #   1. Release build with -Wall -Wextra -Werror, every test;
-#   2. ASan + UBSan build, every test;
+#   2. ASan + UBSan build (clang, with the libFuzzer targets), every test;
 #   3. ThreadSanitizer build of the thread tests only (suites named *Threads, see
 #      tests/CMakeLists.txt), those tests;
-#   4. the libFuzzer targets (clang), each for a bounded time (MM_FUZZ_SECONDS, default 30).
+#   4. the libFuzzer targets of step 2, each for a bounded time (MM_FUZZ_SECONDS, default 30).
 # Each step's wall time is printed when the next begins, and all of them at the end.
 # Usage: scripts/test.sh [--fast]   (--fast: Release tests only)
 set -euo pipefail
@@ -48,7 +48,6 @@ TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
   ctest --test-dir build/tsan -R 'Threads\.' --no-tests=error --output-on-failure -j "$jobs"
 
 step "Fuzz targets (${MM_FUZZ_SECONDS:-30} s each)"
-scripts/setup.sh fuzz
 scripts/fuzz.sh "${MM_FUZZ_SECONDS:-30}"
 
 step "All tests passed"

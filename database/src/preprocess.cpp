@@ -404,8 +404,13 @@ inline void store_vec3(const QuatLanes<Floats4>& v, glm::vec3* out) {
 }
 
 inline void store_vec3(const QuatLanes<Floats8>& v, glm::vec3* out) {
-  const auto low = [](Floats8 f) { return Floats4(__builtin_shufflevector(f, f, 0, 1, 2, 3)); };
-  const auto high = [](Floats8 f) { return Floats4(__builtin_shufflevector(f, f, 4, 5, 6, 7)); };
+  // By reference: a vector argument by value outside an AVX function would change the ABI.
+  const auto low = [](const Floats8& f) {
+    return Floats4(__builtin_shufflevector(f, f, 0, 1, 2, 3));
+  };
+  const auto high = [](const Floats8& f) {
+    return Floats4(__builtin_shufflevector(f, f, 4, 5, 6, 7));
+  };
   store_vec3_x4(low(v.x), low(v.y), low(v.z), out);
   store_vec3_x4(high(v.x), high(v.y), high(v.z), out + 4);
 }

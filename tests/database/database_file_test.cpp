@@ -23,7 +23,6 @@ namespace {
 constexpr int kJoints = 4;
 constexpr int kClip0Frames = 12;
 constexpr int kClip1Frames = 8;
-constexpr int kFrames = kClip0Frames + kClip1Frames;
 constexpr int kDims = 3 + 4;  // left foot position + 2 trajectory times x (x, z)
 constexpr float nan = std::numeric_limits<float>::quiet_NaN();
 
