@@ -85,6 +85,10 @@ constexpr float kSoftReach = 0.96f;
 constexpr float kMinSoftSpan = 0.01f;
 // Halflife (s) of the easing between keeping the animation's extension (standing) and not.
 constexpr float kStandingReachHalflife = 0.1f;
+// The width (m) of the smooth maximum that keeps a toe target above the data's lowest toe: the
+// target is raised by at most half of it where it meets the floor, and less above.
+constexpr float kFloorSoftness = 0.005f;
+
 // How far forward (m) the knee's pole leans, on top of the knee's own offset from the hip-ankle
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
@@ -926,8 +930,11 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
                          settings_.foot_lock_release_halflife, dt);
   glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
-  // otherwise sink a toe into the ground.
-  target.y = std::max(target.y, shared_->lowest_foot_end(side));
+  // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
+  // toe dead at the floor, a jerk the legs show.
+  const float floor = shared_->lowest_foot_end(side);
+  const float below = target.y - floor;
+  target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
   f.target = target;
   // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
   // turning round its toe still has its heel's arc to go); the lift itself follows that height
