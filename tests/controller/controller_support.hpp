@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <span>
 
 #include "mm/controller/controller.hpp"
+#include "mm/runtime/pose.hpp"
 #include "normal_database.hpp"
 
 namespace mm::test {
@@ -39,6 +41,14 @@ inline ControllerInput push_toward(float degrees, bool run = false) {
   input.left_stick = glm::vec2(-std::sin(yaw), std::cos(yaw));
   input.run = run;
   return input;
+}
+
+// The hips' facing as `mm eval` reads it: pair_yaw across the upper legs' world positions.
+inline float hips_yaw(const Controller& c) {
+  const Database& db = c.controller_database().database();
+  const std::span<const Transform> g = c.global_transforms();
+  return pair_yaw(g[static_cast<size_t>(db.roles.left_upper_leg)].translation,
+                  g[static_cast<size_t>(db.roles.right_upper_leg)].translation);
 }
 
 inline float horizontal_speed(const glm::vec3& a, const glm::vec3& b, float dt) {

@@ -10,20 +10,13 @@
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
 #include "mm/runtime/interpolation.hpp"
-#include "mm/runtime/pose.hpp"
 
 namespace mm {
 namespace {
 
+using test::hips_yaw;
 using test::make_controller;
 using test::push_toward;
-
-float body_yaw(const Controller& c) {
-  const Database& db = c.controller_database().database();
-  const std::span<const Transform> g = c.global_transforms();
-  return pair_yaw(g[static_cast<size_t>(db.roles.left_upper_leg)].translation,
-                  g[static_cast<size_t>(db.roles.right_upper_leg)].translation);
-}
 
 struct Reversal {
   float peak_body_rate = 0.0f;        // rad/s, frame to frame
@@ -38,12 +31,12 @@ Reversal reverse(float from, float to, bool run, float dt,
   const int lead = static_cast<int>(std::lround(2.0f / dt));
   for (int i = 0; i < lead; ++i) c.update(dt, push_toward(from, run));
   Reversal r;
-  float body = body_yaw(c);
+  float body = hips_yaw(c);
   float simulation = quat_yaw(c.debug().simulation_rotation);
   const int frames = static_cast<int>(std::lround(3.0f / dt));
   for (int i = 0; i < frames; ++i) {
     c.update(dt, push_toward(to, run));
-    const float next_body = body_yaw(c);
+    const float next_body = hips_yaw(c);
     const float next_simulation = quat_yaw(c.debug().simulation_rotation);
     r.peak_body_rate = std::max(r.peak_body_rate, std::abs(wrap_angle(next_body - body)) / dt);
     r.peak_simulation_rate =

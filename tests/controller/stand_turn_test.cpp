@@ -9,20 +9,13 @@
 
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
-#include "mm/runtime/pose.hpp"
 
 namespace mm {
 namespace {
 
+using test::hips_yaw;
 using test::normal_controller_database;
 using test::push_toward;
-
-// The hips' yaw as the evaluation reads it: across the upper legs.
-float hips_yaw(const Controller& c) {
-  const Database& db = c.controller_database().database();
-  return pair_yaw(c.global_transforms()[static_cast<size_t>(db.roles.left_upper_leg)].translation,
-                  c.global_transforms()[static_cast<size_t>(db.roles.right_upper_leg)].translation);
-}
 
 float yaw_error_degrees(float a, float b) {
   return std::abs(glm::degrees(wrap_angle(a - b)));
