@@ -28,9 +28,14 @@ struct Arguments {
   int extra_threads = 0;
 };
 
+// The length of crowd.hpp's comparison windows, whole seconds, for the help and the table.
+std::string window_seconds() {
+  return std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds)));
+}
+
 // Parses the arguments into `out`; returns an exit code to stop with, or -1 to go on.
 int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
-  const std::string window = std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds)));
+  const std::string window = window_seconds();
   CLI::App app(
       "Updates N character controllers over one shared database at 60 Hz for S seconds of game "
       "time, each with its own varied scripted input (walks, turns, runs, stops, strafes, camera "
@@ -97,8 +102,7 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   // that grows over a long run shows there.
   auto window_label = [](const char* which) {
     std::string label = which;  // appended: see the -Wrestrict note below
-    return label.append(std::to_string(clamped_integer<int>(std::round(kCrowdWindowSeconds))))
-        .append(" s us");
+    return label.append(window_seconds()).append(" s us");
   };
   const std::string first = window_label("first ");
   const std::string last = window_label("last ");
