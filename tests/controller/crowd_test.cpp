@@ -59,6 +59,9 @@ TEST(CrowdThreads, TwoAndFourThreadsGiveTheOneThreadCrowd) {
     ASSERT_TRUE(run.ok()) << run.message();
     EXPECT_EQ(run->threads, threads);
     ASSERT_EQ(run->final_positions.size(), 12u);
+    // The run is shorter than one window: nothing to replay, one window.
+    EXPECT_TRUE(run->replay_final_positions.empty()) << threads << " threads";
+    EXPECT_EQ(run->update_us_first_window, run->update_us_last_window) << threads << " threads";
     if (threads == 1) {
       reference = run->final_positions;
       continue;
@@ -75,6 +78,25 @@ TEST(CrowdThreads, TwoAndFourThreadsGiveTheOneThreadCrowd) {
     moved += glm::distance(reference[i], start) > 0.5f;
   }
   EXPECT_GE(moved, 9);
+}
+
+TEST(CrowdThreads, TheReplayedFirstWindowEndsWhereTheRunsFirstWindowDid) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 4;
+  options.dt = 0.1f;  // coarse, to cover more than a window in few frames
+  options.threads = 2;
+  options.seconds = kCrowdWindowSeconds;
+  Result<CrowdResult> first_window = run_crowd(shared, options);
+  ASSERT_TRUE(first_window.ok()) << first_window.message();
+  options.seconds = kCrowdWindowSeconds + 5.0f;
+  Result<CrowdResult> longer = run_crowd(shared, options);
+  ASSERT_TRUE(longer.ok()) << longer.message();
+  EXPECT_EQ(longer->replay_final_positions, first_window->final_positions);
+  EXPECT_NE(longer->final_positions, first_window->final_positions);
+  EXPECT_GT(longer->update_us_first_window, 0.0);
+  EXPECT_GT(longer->update_us_last_window, 0.0);
 }
 
 // One character's run: created over `shared` with this search method, then three seconds of

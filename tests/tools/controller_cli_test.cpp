@@ -313,6 +313,7 @@ TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
   EXPECT_EQ(json["update_us_first_window"], json["update_us_last_window"]);
   EXPECT_NEAR(json["update_us_first_window"].get<double>(), json["update_us_mean"].get<double>(),
               1e-6 * json["update_us_mean"].get<double>());
+  EXPECT_EQ(json["update_us_window_ratio"].get<double>(), 1.0);
   EXPECT_NE(run.output.find("first 20 s us"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("last/first"), std::string::npos) << run.output;
 
