@@ -107,6 +107,16 @@ glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, flo
   return hip_to_ankle * (reached / d);
 }
 
+// The root (joint 0) and the body (joints 1..) of a per-joint array: transitions treat them apart.
+template <typename T>
+std::span<T> root_of(std::vector<T>& joints) {
+  return std::span(joints).first(1);
+}
+template <typename T>
+std::span<T> body_of(std::vector<T>& joints) {
+  return std::span(joints).subspan(1);
+}
+
 // Fraction of the remaining distance an exponential pull with this halflife closes in dt.
 float pull_fraction(float halflife, float dt) {
   return 1.0f - std::exp2(-dt / std::max(halflife, kMinSpringHalflife));
@@ -216,7 +226,9 @@ Status Controller::resolve_joints() {
 void Controller::size_buffers() {
   const Database& db = *db_;
   const size_t n = static_cast<size_t>(db.joint_count());
-  offsets_.resize(db.joint_count());
+  root_offsets_.resize(1);
+  body_offsets_.resize(db.joint_count() - 1);
+  body_blend_.resize(db.joint_count() - 1);
   for (auto* v : {&sampled_, &other_, &locals_, &globals_, &world_globals_}) v->resize(n);
   for (auto* v : {&sampled_velocities_, &sampled_angular_velocities_, &other_velocities_,
                   &other_angular_velocities_}) {
@@ -247,7 +259,7 @@ void Controller::start_standing() {
   }
   teleport(glm::vec3(0.0f), 0.0f);
   transition_to(start);
-  offsets_.clear();
+  clear_transitions();
   std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
   displayed_velocity_ = sampled_velocities_[0];
   predict();
@@ -259,6 +271,11 @@ Status Controller::set_settings(const ControllerSettings& settings) {
   Result<const Searcher*> searcher = shared_->searcher(settings.search_method);
   if (!searcher) return Error{"controller: " + searcher.message()};
   searcher_ = *searcher;
+  // The body's transition state of one mode means nothing to the other.
+  if (settings.transition_mode != settings_.transition_mode) {
+    body_offsets_.clear();
+    body_blend_.clear();
+  }
   settings_ = settings;
   const ControllerDatabase::Speeds& measured = shared_->speeds();
   auto pick = [](float setting, float fallback) { return setting > 0.0f ? setting : fallback; };
@@ -280,7 +297,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
   sim_rotation_ = desired_rotation_ = rotation;
   desired_velocity_ = glm::vec3(0.0f);
-  offsets_.clear();
+  clear_transitions();
   for (FootLock& f : feet_) f = FootLock{};
   standing_reach_ = 0.0f;
   body_yaw_known_ = false;
@@ -313,14 +330,13 @@ void Controller::update(float dt, const ControllerInput& input) {
   if (should_search()) search();
   advance_playback(dt);
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
-  inertialize_update(offsets_, {sampled_, sampled_velocities_, sampled_angular_velocities_},
-                     settings_.inertialization_halflife, dt, locals_, {}, {});
+  show_transitions(dt);
   // Only the root's displayed motion is needed (by the synchronization): the playing root's
   // plus its offsets' rates.
-  displayed_velocity_ = sampled_velocities_[0] + offsets_.velocities[0];
-  displayed_angular_velocity_ =
-      sampled_angular_velocities_[0] +
-      rotation_vector_rate_to_angular_velocity(offsets_.rotations[0], offsets_.rotation_rates[0]);
+  displayed_velocity_ = sampled_velocities_[0] + root_offsets_.velocities[0];
+  displayed_angular_velocity_ = sampled_angular_velocities_[0] +
+                                rotation_vector_rate_to_angular_velocity(
+                                    root_offsets_.rotations[0], root_offsets_.rotation_rates[0]);
   simulate(dt);
   synchronize(dt);
   limit_body_turn(dt);
@@ -531,8 +547,7 @@ void Controller::transition_to(int frame) {
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time;
   sample_playback(other_, other_velocities_, other_angular_velocities_);
   if (had_clip) {
-    inertialize_transition(offsets_, {sampled_, sampled_velocities_, sampled_angular_velocities_},
-                           {other_, other_velocities_, other_angular_velocities_});
+    start_transition();
     ++debug_.transitions;
     debug_.transitioned = true;
     since_transition_ = 0.0f;
@@ -540,6 +555,54 @@ void Controller::transition_to(int frame) {
   std::swap(sampled_, other_);
   std::swap(sampled_velocities_, other_velocities_);
   std::swap(sampled_angular_velocities_, other_angular_velocities_);
+}
+
+// At a jump, the outgoing clip (sampled_) hands over to the incoming one (other_).
+void Controller::start_transition() {
+  inertialize_transition(
+      root_offsets_,
+      {root_of(sampled_), root_of(sampled_velocities_), root_of(sampled_angular_velocities_)},
+      {root_of(other_), root_of(other_velocities_), root_of(other_angular_velocities_)});
+  const PoseMotion outgoing{body_of(sampled_), body_of(sampled_velocities_),
+                            body_of(sampled_angular_velocities_)};
+  switch (settings_.transition_mode) {
+    case TransitionMode::Inertialization:
+      inertialize_transition(
+          body_offsets_, outgoing,
+          {body_of(other_), body_of(other_velocities_), body_of(other_angular_velocities_)});
+      return;
+    case TransitionMode::DeadBlending:
+      dead_blend_transition(body_blend_, outgoing, settings_.dead_blend_time);
+      std::copy(std::begin(shown_contact_), std::end(shown_contact_),
+                std::begin(blend_source_contact_));
+      return;
+  }
+}
+
+// The playing clip (sampled_, at the new time) through the running transitions into locals_.
+void Controller::show_transitions(float dt) {
+  const float halflife = settings_.inertialization_halflife;
+  inertialize_update(
+      root_offsets_,
+      {root_of(sampled_), root_of(sampled_velocities_), root_of(sampled_angular_velocities_)},
+      halflife, dt, root_of(locals_), {}, {});
+  const PoseMotion incoming{body_of(sampled_), body_of(sampled_velocities_),
+                            body_of(sampled_angular_velocities_)};
+  switch (settings_.transition_mode) {
+    case TransitionMode::Inertialization:
+      inertialize_update(body_offsets_, incoming, halflife, dt, body_of(locals_), {}, {});
+      return;
+    case TransitionMode::DeadBlending:
+      dead_blend_update(body_blend_, incoming, settings_.dead_blend_time,
+                        settings_.dead_blend_decay_halflife, dt, body_of(locals_), {}, {});
+      return;
+  }
+}
+
+void Controller::clear_transitions() {
+  root_offsets_.clear();
+  body_offsets_.clear();
+  body_blend_.clear();
 }
 
 // Seconds from the playing clip's first frame to its last.
@@ -811,8 +874,8 @@ void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& r
 void Controller::move_root(const glm::vec3& position, const glm::quat& rotation) {
   // The displayed root is the playing root plus the inertialization offsets; find the playing
   // root that displays as requested.
-  const glm::quat offset = quat_from_scaled_angle_axis(offsets_.rotations[0]);
-  const glm::vec3 played_position = position - offsets_.positions[0];
+  const glm::quat offset = quat_from_scaled_angle_axis(root_offsets_.rotations[0]);
+  const glm::vec3 played_position = position - root_offsets_.positions[0];
   const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
   // The database root relative to the destination: M = inverse(destination) * root(t).
   const Transform root = sample_joint(playback_point(), 0);
@@ -847,8 +910,16 @@ void Controller::finish_pose() {
   debug_.clip = clip_;
   debug_.frame = frame;
   debug_.clip_time = clip_time_;
-  debug_.contact[0] = db.contacts[static_cast<size_t>(frame) * 2] != 0;
-  debug_.contact[1] = db.contacts[static_cast<size_t>(frame) * 2 + 1] != 0;
+  // While a dead blend is under half way, what shows is mostly the pose it started from: its
+  // feet, perhaps swinging where the incoming clip's are down, keep that pose's contacts.
+  const bool early_blend = settings_.transition_mode == TransitionMode::DeadBlending &&
+                           body_blend_.active &&
+                           body_blend_.time < 0.5f * settings_.dead_blend_time;
+  for (size_t side = 0; side < 2; ++side) {
+    shown_contact_[side] = early_blend ? blend_source_contact_[side]
+                                       : db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
+    debug_.contact[side] = shown_contact_[side];
+  }
 }
 
 // Foot locking. A foot whose playing frame says "contact" keeps its toe where it was when the

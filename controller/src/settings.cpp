@@ -47,6 +47,8 @@ constexpr FloatField kFloatFields[] = {
     {"clip_end_lookahead", &ControllerSettings::clip_end_lookahead, 0.0f, 10.0f},
     {"transition_cooldown", &ControllerSettings::transition_cooldown, 0.0f, 10.0f},
     {"inertialization_halflife", &ControllerSettings::inertialization_halflife, 0.0f, 10.0f},
+    {"dead_blend_time", &ControllerSettings::dead_blend_time, 0.0f, 10.0f},
+    {"dead_blend_decay_halflife", &ControllerSettings::dead_blend_decay_halflife, 0.0f, 10.0f},
     {"adjustment_halflife", &ControllerSettings::adjustment_halflife, 0.0f, 10.0f},
     {"simulation_yield_halflife", &ControllerSettings::simulation_yield_halflife, 0.0f, 100.0f},
     {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio, 0.0f,
@@ -79,6 +81,8 @@ constexpr FlagField kFlagFields[] = {
 // by value from 0.
 // The names of InterpolationMethod's values, by value.
 constexpr std::string_view kInterpolationNames[] = {"nlerp", "slerp", "sclerp"};
+// By TransitionMode's values.
+constexpr std::string_view kTransitionModeNames[] = {"dead-blending", "inertialization"};
 
 // "a, b, c".
 std::string joined(std::span<const std::string_view> names) {
@@ -98,6 +102,9 @@ std::vector<EnumField> enum_fields(const ControllerSettings& s) {
       {"interpolation",
        static_cast<int>(s.interpolation),
        {std::begin(kInterpolationNames), std::end(kInterpolationNames)}},
+      {"transition_mode",
+       static_cast<int>(s.transition_mode),
+       {std::begin(kTransitionModeNames), std::end(kTransitionModeNames)}},
       {"sync_mode",
        static_cast<int>(s.sync_mode),
        {sync_mode_name(SyncMode::CharacterFollowsSimulation),
@@ -180,6 +187,16 @@ Status set_controller_setting(ControllerSettings& settings, std::string_view nam
     if (!parse_sync_mode(value, settings.sync_mode)) {
       return bad_value(name, value, "character, simulation or none");
     }
+    return Status::success();
+  }
+  if (name == "transition_mode") {
+    const auto* found =
+        std::find(std::begin(kTransitionModeNames), std::end(kTransitionModeNames), value);
+    if (found == std::end(kTransitionModeNames)) {
+      return bad_value(name, value, "dead-blending or inertialization");
+    }
+    settings.transition_mode =
+        static_cast<TransitionMode>(found - std::begin(kTransitionModeNames));
     return Status::success();
   }
   if (name == "interpolation") {

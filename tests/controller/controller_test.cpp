@@ -73,6 +73,21 @@ TEST(ControllerSettingsTest, SyncModeOutsideItsValuesIsRefused) {
   EXPECT_NE(bad.message().find("sync_mode must be one of"), std::string::npos);
 }
 
+TEST(ControllerSettingsTest, TransitionModeOutsideItsValuesIsRefused) {
+  ControllerSettings s;
+  for (const int value : {0, 1}) {
+    s.transition_mode = static_cast<TransitionMode>(value);
+    EXPECT_TRUE(s.validate().ok()) << value;
+  }
+  for (const int value : {2, 255}) {
+    s.transition_mode = static_cast<TransitionMode>(value);
+    EXPECT_EQ(s.validate().message(),
+              "controller settings: transition_mode must be one of dead-blending, "
+              "inertialization (0 to 1), found " +
+                  std::to_string(value));
+  }
+}
+
 TEST(ControllerSettingsTest, EveryInvalidFieldIsNamed) {
   ControllerSettings s;
   EXPECT_TRUE(s.validate().ok());
@@ -105,6 +120,13 @@ TEST(ControllerSettingsTest, SetByName) {
             "setting 'inertialization_halflife': expected a number, found 'fast'");
   EXPECT_EQ(set_controller_setting(s, "sync_mode", "both").message(),
             "setting 'sync_mode': expected character, simulation or none, found 'both'");
+  EXPECT_TRUE(set_controller_setting(s, "transition_mode", "inertialization").ok());
+  EXPECT_EQ(s.transition_mode, TransitionMode::Inertialization);
+  EXPECT_TRUE(set_controller_setting(s, "transition_mode", "dead-blending").ok());
+  EXPECT_EQ(s.transition_mode, TransitionMode::DeadBlending);
+  EXPECT_EQ(set_controller_setting(s, "transition_mode", "crossfade").message(),
+            "setting 'transition_mode': expected dead-blending or inertialization, found "
+            "'crossfade'");
   EXPECT_EQ(set_controller_setting(s, "warp_speed", "9").message(), "unknown setting 'warp_speed'");
 }
 
@@ -226,16 +248,57 @@ std::pair<float, float> transition_steps(const ControllerSettings& settings) {
   return {at_transitions, elsewhere};
 }
 
-TEST(ControllerTest, TransitionsAreContinuous) {
+TEST(ControllerTest, TransitionsAreContinuousInEveryMode) {
+  for (const TransitionMode mode :
+       {TransitionMode::DeadBlending, TransitionMode::Inertialization}) {
+    SCOPED_TRACE(static_cast<int>(mode));
+    ControllerSettings settings;
+    settings.ik_enabled = false;  // the animation alone
+    settings.transition_mode = mode;
+    const auto [at_transitions, elsewhere] = transition_steps(settings);
+    // A transition frame moves no joint more than ordinary playback does.
+    EXPECT_LE(at_transitions, elsewhere);
+  }
+  // With no time to blend or decay in, the same run pops: the test can tell.
+  ControllerSettings popping;
+  popping.ik_enabled = false;
+  popping.inertialization_halflife = 0.0f;
+  popping.dead_blend_time = 0.0f;
+  const auto [pops, ordinary] = transition_steps(popping);
+  EXPECT_GT(pops, ordinary);
+}
+
+// Early in a dead blend the pose shown is mostly the outgoing one: its contacts hold (a swinging
+// foot is not locked in mid-swing because the incoming clip has it down) until half the blend.
+TEST(ControllerTest, EarlyInADeadBlendTheFeetKeepTheOutgoingPosesContacts) {
   ControllerSettings settings;
-  settings.ik_enabled = false;  // the animation alone
-  const auto [at_transitions, elsewhere] = transition_steps(settings);
-  // A transition frame moves no joint more than ordinary playback does.
-  EXPECT_LE(at_transitions, elsewhere);
-  // Without inertialization the same run pops: the test can tell.
-  settings.inertialization_halflife = 0.0f;
-  const auto [popping, ordinary] = transition_steps(settings);
-  EXPECT_GT(popping, ordinary);
+  ASSERT_EQ(settings.transition_mode, TransitionMode::DeadBlending);
+  settings.ik_enabled = false;  // no stepping feet: debug().contact is exactly the contact shown
+  Controller c = make(settings);
+  const Database& db = c.controller_database().database();
+  bool held[2] = {false, false};
+  float blend_time = 1e9f;  // since the last transition, summed as the blend sums it
+  int early = 0, differing = 0;
+  for (int i = 0; i < 1200; ++i) {
+    const bool previous[2] = {c.debug().contact[0], c.debug().contact[1]};
+    c.update(kDt, push_toward(static_cast<float>((i / 100) * 100)));
+    const ControllerDebug& d = c.debug();
+    if (d.transitioned) {
+      held[0] = previous[0];
+      held[1] = previous[1];
+      blend_time = 0.0f;
+    }
+    blend_time += kDt;
+    const bool is_early = blend_time < 0.5f * settings.dead_blend_time;
+    early += is_early;
+    for (int side = 0; side < 2; ++side) {
+      const bool label = db.contacts[static_cast<size_t>(d.frame) * 2 + side] != 0;
+      EXPECT_EQ(d.contact[side], is_early ? held[side] : label) << "frame " << i << " " << side;
+      differing += is_early && label != held[side];
+    }
+  }
+  EXPECT_GT(early, 100);
+  EXPECT_GT(differing, 10);  // the incoming clips' contacts often differed: the test can tell
 }
 
 TEST(ControllerTest, RootAdjustmentKeepsTransitionSourceAndDestinationConsistent) {

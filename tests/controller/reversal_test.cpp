@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/evaluation.hpp"
+#include "mm/controller/script.hpp"
 #include "mm/runtime/interpolation.hpp"
 
 namespace mm {
@@ -78,6 +81,28 @@ TEST(ReversalTest, WithoutTheBodyLimitARunningReversalSpinsFaster) {
   unlimited.body_max_turn_rate = 0.0f;
   const Reversal r = reverse(0.0f, 178.0f, true, 1.0f / 60.0f, unlimited);
   EXPECT_GT(r.peak_body_rate, ControllerSettings{}.body_max_turn_rate * 1.1f);
+}
+
+// The transition modes on the shipped reversals, IK on, at the coarsest and the usual rate:
+// dead blending's transitions (the default) are the smoother, by the evaluation's measure.
+TEST(ReversalTest, DeadBlendingTransitionsAreSmootherThanInertialization) {
+  Result<InputScript> script =
+      load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input/reversals.txt");
+  ASSERT_TRUE(script.ok()) << script.message();
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f}) {
+    double ratio[2] = {0.0, 0.0};
+    for (const TransitionMode mode :
+         {TransitionMode::DeadBlending, TransitionMode::Inertialization}) {
+      EvaluationOptions options;
+      options.dt = dt;
+      options.settings.transition_mode = mode;
+      Result<EvaluationResult> run =
+          evaluate_script(test::normal_controller_database(), *script, options);
+      ASSERT_TRUE(run.ok()) << run.message();
+      ratio[static_cast<int>(mode)] = run->metrics.transition_accel_ratio;
+    }
+    EXPECT_LT(ratio[0], 0.9 * ratio[1]) << "dt " << dt;
+  }
 }
 
 }  // namespace

@@ -42,6 +42,7 @@
 #include "mm/controller/input.hpp"
 #include "mm/controller/local_origin.hpp"
 #include "mm/database/database.hpp"
+#include "mm/runtime/dead_blending.hpp"
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/result.hpp"
@@ -55,6 +56,13 @@ enum class SyncMode : uint8_t {
   CharacterFollowsSimulation,  // the character's root is pulled toward the simulation object
   SimulationFollowsCharacter,  // the simulation object is placed where the character went
   None,                        // each goes its own way (for debugging)
+};
+
+// How the body (every joint below the root) goes from one clip to the next. The root is always
+// inertialized: the synchronization with the simulation works on its offsets.
+enum class TransitionMode : uint8_t {
+  DeadBlending,     // cross-fade from the extrapolated outgoing pose (dead_blending.hpp)
+  Inertialization,  // decaying offsets on the incoming clip (inertialization.hpp)
 };
 
 // "character", "simulation" or "none".
@@ -182,7 +190,13 @@ struct ControllerSettings {
   InterpolationMethod interpolation = InterpolationMethod::Nlerp;
 
   // ---- Transitions.
-  float inertialization_halflife = 0.12f;  // s
+  TransitionMode transition_mode = TransitionMode::DeadBlending;
+  float inertialization_halflife = 0.2f;  // s: the root's offsets, and the body's if inertialized
+  // Dead blending: the cross-fade's length and the extrapolated pose's velocity halflife (s).
+  // While the fade is under half way, the feet keep the contacts the outgoing pose had: what
+  // shows is mostly that pose, whose feet may be swinging where the incoming clip's are down.
+  float dead_blend_time = 0.5f;
+  float dead_blend_decay_halflife = 0.1f;
 
   // ---- Synchronization.
   SyncMode sync_mode = SyncMode::CharacterFollowsSimulation;
@@ -228,9 +242,10 @@ struct ControllerSettings {
 };
 
 // Sets one field of `settings`, named as in the struct (e.g. "inertialization_halflife"), from
-// text: a number, "on"/"off" for flags, a search method, a sync mode name or an interpolation
-// ("nlerp", "slerp", "sclerp"). Fails, naming the field and the value, on an unknown name or
-// unreadable value; range checks are validate()'s.
+// text: a number, "on"/"off" for flags, a search method, a sync mode name, an interpolation
+// ("nlerp", "slerp", "sclerp") or a transition mode ("dead-blending", "inertialization"). Fails,
+// naming the field and the value, on an unknown name or unreadable value; range checks are
+// validate()'s.
 Status set_controller_setting(ControllerSettings& settings, std::string_view name,
                               std::string_view value);
 
@@ -377,6 +392,9 @@ class Controller {
   bool playing_idle_through() const;
   void record_search(const SearchResult& best);
   void transition_to(int frame);
+  void start_transition();
+  void show_transitions(float dt);
+  void clear_transitions();
   float clip_duration() const;
   void advance_playback(float dt);
   // Where playback is: two database frames and the weight of the second.
@@ -453,7 +471,13 @@ class Controller {
   glm::vec3 transition_dst_position_{0.0f};
   glm::quat transition_dst_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
 
-  InertializationOffsets offsets_;
+  // Transitions: the root's offsets (one joint), and the body's (joints 1..) by transition_mode.
+  InertializationOffsets root_offsets_;
+  InertializationOffsets body_offsets_;
+  DeadBlend body_blend_;
+  // The contacts of the pose shown (finish_pose), and of the pose a dead blend started from.
+  bool shown_contact_[2] = {false, false};
+  bool blend_source_contact_[2] = {false, false};
   // Per-joint buffers, sized at create().
   std::vector<Transform> sampled_;  // the playing animation (root in world space)
   std::vector<glm::vec3> sampled_velocities_;
