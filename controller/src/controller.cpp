@@ -910,14 +910,15 @@ void Controller::finish_pose() {
   debug_.clip = clip_;
   debug_.frame = frame;
   debug_.clip_time = clip_time_;
-  // While a dead blend is under half way, what shows is mostly the pose it started from: its
-  // feet, perhaps swinging where the incoming clip's are down, keep that pose's contacts.
+  // While a dead blend is under half way, a foot is down only if it is in both poses: what
+  // shows is mostly the pose the blend started from, whose foot may be swinging where the
+  // incoming clip's is down, while the blend already carries a foot the incoming clip lifts.
   const bool early_blend = settings_.transition_mode == TransitionMode::DeadBlending &&
                            body_blend_.active &&
                            body_blend_.time < 0.5f * settings_.dead_blend_time;
   for (size_t side = 0; side < 2; ++side) {
-    shown_contact_[side] = early_blend ? blend_source_contact_[side]
-                                       : db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
+    const bool label = db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
+    shown_contact_[side] = label && (!early_blend || blend_source_contact_[side]);
     debug_.contact[side] = shown_contact_[side];
   }
 }

@@ -193,9 +193,10 @@ struct ControllerSettings {
   TransitionMode transition_mode = TransitionMode::DeadBlending;
   float inertialization_halflife = 0.2f;  // s: the root's offsets, and the body's if inertialized
   // Dead blending: the cross-fade's length and the extrapolated pose's velocity halflife (s).
-  // While the fade is under half way, the feet keep the contacts the outgoing pose had: what
-  // shows is mostly that pose, whose feet may be swinging where the incoming clip's are down.
-  float dead_blend_time = 0.5f;
+  // While the fade is under half way, a foot is down only where both poses have it down: what
+  // shows is mostly the outgoing pose, whose feet may be swinging where the incoming clip's are
+  // down, and the fade already moves a foot the incoming clip lifts.
+  float dead_blend_time = 0.6f;
   float dead_blend_decay_halflife = 0.1f;
 
   // ---- Synchronization.
