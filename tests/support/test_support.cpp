@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 
 namespace mm::test {
@@ -20,6 +22,8 @@ std::filesystem::path scratch_dir() {
   for (char& c : name) {
     if (c == '/') c = '_';
   }
+  // The same tests also run without AVX (tests/CMakeLists.txt), maybe at the same time.
+  if (std::getenv("MM_DISABLE_AVX") != nullptr) name += "-without-avx";
   auto dir = std::filesystem::path(MM_BINARY_DIR) / "test-scratch" / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
