@@ -22,6 +22,11 @@ namespace {
 const glm::vec3 kUp(0.0f, 1.0f, 0.0f);
 // A foot released during a contact locks again once its easing offset is this small (m).
 constexpr float kRelockOffset = 0.01f;
+// Strafing, the chest's twist toward the facing (turn_chest_to_facing): at most this (radians),
+// and its spring's halflife (s).
+constexpr float kMaxChestTwist = 1.0f;
+constexpr float kChestTwistReach = 1.75f;
+constexpr float kChestTwistHalflife = 0.1f;
 // Standing, a held toe farther than this (m) from where the idle pose puts it steps there.
 constexpr float kSettleDistance = 0.08f;
 // Standing, a held foot turned farther than this (radians) from the idle pose's heading steps
@@ -301,6 +306,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   for (FootLock& f : feet_) f = FootLock{};
   standing_reach_ = 0.0f;
   body_yaw_known_ = false;
+  chest_twist_ = chest_twist_velocity_ = 0.0f;
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
@@ -340,6 +346,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   simulate(dt);
   synchronize(dt);
   limit_body_turn(dt);
+  turn_chest_to_facing(dt);
   predict();
   refresh_outputs(dt);
 }
@@ -388,6 +395,7 @@ void Controller::desired_motion(const ControllerInput& input) {
   debug_.desired_velocity = desired_velocity_;
   debug_.desired_rotation = desired_rotation_;
   debug_.standing = released;
+  strafing_ = input.strafe && !released;
 }
 
 uint64_t Controller::resolve_tag(std::string_view tag) const {
@@ -859,6 +867,44 @@ void Controller::limit_body_turn(float dt) {
   }
   body_yaw_ = yaw;
   body_yaw_known_ = true;
+}
+
+// Strafing, the chest faces the desired facing. The data has no side steps: a strafe plays
+// clips whose body faces more or less where it walks. A twist about the vertical, half in the
+// spine and half in the chest, turns the chest toward the facing; it follows its goal on a
+// spring slow enough to leave the gait's own shoulder swing, and eases out when the strafe
+// ends. (Skeletons without spine or chest roles, or without upper arms to measure the chest's
+// facing by, are left as they are.)
+void Controller::turn_chest_to_facing(float dt) {
+  const JointRoleIndices& roles = db_->roles;
+  if (roles.left_upper_arm < 0 || roles.right_upper_arm < 0 ||
+      (roles.spine < 0 && roles.chest < 0)) {
+    return;
+  }
+  const std::span<const int> parents = db_->skeleton.parents();
+  float goal = 0.0f;
+  if (strafing_) {
+    const float chest_yaw =
+        pair_yaw(forward_kinematics_joint(parents, locals_, roles.left_upper_arm).translation,
+                 forward_kinematics_joint(parents, locals_, roles.right_upper_arm).translation,
+                 quat_yaw(locals_[0].rotation));
+    const float error = wrap_angle(quat_yaw(desired_rotation_) - chest_yaw);
+    // Farther off, the body is still coming round (a strafe that flips the facing): twisting
+    // now could pick the other way round from the body's own turn.
+    goal = std::abs(error) <= kChestTwistReach ? std::clamp(error, -kMaxChestTwist, kMaxChestTwist)
+                                               : 0.0f;
+  }
+  critical_spring_update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
+  const bool both = roles.spine >= 0 && roles.chest >= 0;
+  for (const int joint : {roles.spine, roles.chest}) {
+    if (joint < 0) continue;
+    // A turn about the world's vertical, expressed in the joint's parent frame.
+    const glm::quat parent =
+        forward_kinematics_joint(parents, locals_, db_->skeleton.parent(joint)).rotation;
+    const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
+    Transform& local = locals_[static_cast<size_t>(joint)];
+    local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
+  }
 }
 
 // adjust_root() relative to the origin.

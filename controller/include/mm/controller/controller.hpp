@@ -384,6 +384,7 @@ class Controller {
   void limit_turn_rate(const glm::quat& before, float dt);
   float body_yaw() const;
   void limit_body_turn(float dt);
+  void turn_chest_to_facing(float dt);
   void predict();
   bool should_search() const;
   void build_query();
@@ -519,6 +520,11 @@ class Controller {
   // The body's facing after the last update (see body_max_turn_rate), unknown after a placement.
   float body_yaw_ = 0.0f;
   bool body_yaw_known_ = false;
+  // Strafing (the strafe button held, the stick pushed), and the chest's twist toward the
+  // facing (radians about the vertical) with its rate.
+  bool strafing_ = false;
+  float chest_twist_ = 0.0f;
+  float chest_twist_velocity_ = 0.0f;
 
   ControllerDebug debug_;
 };
