@@ -964,6 +964,7 @@ void Controller::finish_pose() {
                            body_blend_.time < 0.5f * settings_.dead_blend_time;
   for (size_t side = 0; side < 2; ++side) {
     const bool label = db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
+    early_blend_down_[side] = early_blend && blend_source_contact_[side];
     shown_contact_[side] = label && (!early_blend || blend_source_contact_[side]);
     debug_.contact[side] = shown_contact_[side];
   }
@@ -991,9 +992,8 @@ void Controller::foot_lock(float dt) {
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
-    const bool was_locked = feet_[side].locked;
     const glm::vec3 target = foot_target(side, animated, settling, dt);
-    hold_heading(side, was_locked, dt);
+    hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
     debug_.ik_target[side] = target;
@@ -1071,21 +1071,26 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
 
 // A planted foot does not swivel on the ground: while locked it keeps the heading it landed
 // with, whatever the body above it does (the leg twists instead), and once released it eases
-// back onto the animation's heading. A lock begins with the heading shown at that moment, so
+// back onto the animation's heading. A hold begins with the heading shown at that moment, so
 // the foot never jumps. Legs without a toe have no heading to hold.
-void Controller::hold_heading(int side, bool was_locked, float dt) {
+void Controller::hold_heading(int side, float dt) {
   FootLock& f = feet_[side];
   if (leg_joints_[side][3] < 0) {
     f.heading_offset = f.heading_offset_velocity = 0.0f;
     return;
   }
   const float animated = foot_heading(side);
-  if (f.locked) {
-    if (!was_locked) f.heading = wrap_angle(animated + f.heading_offset);
+  // A foot down in the pose a dead blend started from keeps its heading while the fade is
+  // under half way, even when its toe is let go: the fade would swivel it on the ground.
+  const bool hold = f.locked || early_blend_down_[side];
+  if (hold) {
+    if (!f.heading_held) f.heading = wrap_angle(animated + f.heading_offset);
+    f.heading_held = true;
     f.heading_offset = wrap_angle(f.heading - animated);
     f.heading_offset_velocity = 0.0f;
     return;
   }
+  f.heading_held = false;
   critical_spring_update(f.heading_offset, f.heading_offset_velocity, 0.0f,
                          settings_.foot_lock_release_halflife, dt);
 }

@@ -414,7 +414,7 @@ class Controller {
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
-  void hold_heading(int side, bool was_locked, float dt);
+  void hold_heading(int side, float dt);
   float foot_heading(int side) const;
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
@@ -480,6 +480,8 @@ class Controller {
   // The contacts of the pose shown (finish_pose), and of the pose a dead blend started from.
   bool shown_contact_[2] = {false, false};
   bool blend_source_contact_[2] = {false, false};
+  // Down in the pose a dead blend started from, while the blend is under half way.
+  bool early_blend_down_[2] = {false, false};
   // Per-joint buffers, sized at create().
   std::vector<Transform> sampled_;  // the playing animation (root in world space)
   std::vector<glm::vec3> sampled_velocities_;
@@ -513,6 +515,7 @@ class Controller {
     float heading = 0.0f;
     float heading_offset = 0.0f;
     float heading_offset_velocity = 0.0f;
+    bool heading_held = false;  // on the last update
   };
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
