@@ -371,7 +371,10 @@ void Controller::desired_motion(const ControllerInput& input) {
   const glm::quat camera = yaw_rotation(yaw);
   const glm::vec3 move_world = stick_to_world(move, camera);
 
-  if (input.strafe) {
+  const bool facing_given = std::isfinite(input.facing_yaw);
+  if (facing_given) {
+    desired_rotation_ = yaw_rotation(wrap_angle(input.facing_yaw));
+  } else if (input.strafe) {
     if (glm::length(face) > 0.0f) {
       const glm::vec3 d = stick_to_world(face, camera);
       desired_rotation_ = yaw_rotation(std::atan2(d.x, d.z));
@@ -395,7 +398,7 @@ void Controller::desired_motion(const ControllerInput& input) {
   debug_.desired_velocity = desired_velocity_;
   debug_.desired_rotation = desired_rotation_;
   debug_.standing = released;
-  strafing_ = input.strafe && !released;
+  strafing_ = (input.strafe || facing_given) && !released;
 }
 
 uint64_t Controller::resolve_tag(std::string_view tag) const {
@@ -782,7 +785,11 @@ void Controller::synchronize(float dt) {
   if (settings_.simulation_yield_halflife > 0.0f) {
     glm::vec3 toward = root.translation - sim_position_;
     toward.y = 0.0f;
-    sim_position_ += toward * pull_fraction(settings_.simulation_yield_halflife, dt);
+    glm::vec3 step = toward * pull_fraction(settings_.simulation_yield_halflife, dt);
+    const float own_speed = std::hypot(displayed_velocity_.x, displayed_velocity_.z);
+    const float max_step = settings_.simulation_yield_max_velocity_ratio * own_speed * dt;
+    if (glm::length(step) > max_step) step *= max_step / glm::length(step);
+    sim_position_ += step;
   }
   // Pull the character toward the simulation, no faster than a share of its own motion.
   const glm::vec3 velocity = displayed_velocity_;

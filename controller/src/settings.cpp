@@ -51,6 +51,8 @@ constexpr FloatField kFloatFields[] = {
     {"dead_blend_decay_halflife", &ControllerSettings::dead_blend_decay_halflife, 0.0f, 10.0f},
     {"adjustment_halflife", &ControllerSettings::adjustment_halflife, 0.0f, 10.0f},
     {"simulation_yield_halflife", &ControllerSettings::simulation_yield_halflife, 0.0f, 100.0f},
+    {"simulation_yield_max_velocity_ratio",
+     &ControllerSettings::simulation_yield_max_velocity_ratio, 0.0f, 1000.0f},
     {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio, 0.0f,
      100.0f},
     {"adjustment_max_angular_velocity_ratio",

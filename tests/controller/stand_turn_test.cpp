@@ -42,10 +42,14 @@ float foot_yaw_to_hips(const Controller& c, int foot, int toe) {
   return wrap_angle(std::atan2(along.x, along.z) - hips_yaw(c));
 }
 
+// How a turn on the spot is asked for.
+enum class Request { RightStick, Api };
+
 // Stands for a second facing +Z, then asks for the facing `degrees` away (positive: toward +X)
 // and holds it for `seconds`.
 StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
-                           const ControllerSettings& settings = {}) {
+                           const ControllerSettings& settings = {},
+                           Request request = Request::RightStick) {
   Result<Controller> made = Controller::create(normal_controller_database(), settings);
   EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.message());
   Controller c = std::move(made).value();
@@ -55,10 +59,14 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
   const int settle_frames = static_cast<int>(std::lround(1.0f / dt));
   for (int i = 0; i < settle_frames; ++i) c.update(dt, ControllerInput{});
 
-  ControllerInput input;
-  input.strafe = true;
-  input.right_stick = push_toward(degrees).left_stick;
   const float goal = glm::radians(degrees);
+  ControllerInput input;
+  if (request == Request::Api) {
+    input.facing_yaw = goal;
+  } else {
+    input.strafe = true;
+    input.right_stick = push_toward(degrees).left_stick;
+  }
   StandTurn turn;
   float planted[2];
   float stance[2];
@@ -101,8 +109,9 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
   return turn;
 }
 
-void expect_natural_turn(float degrees, float dt, float settle_limit) {
-  const StandTurn turn = turn_on_the_spot(degrees, dt);
+void expect_natural_turn(float degrees, float dt, float settle_limit,
+                         Request request = Request::RightStick) {
+  const StandTurn turn = turn_on_the_spot(degrees, dt, 3.0f, {}, request);
   SCOPED_TRACE(testing::Message() << degrees << " degrees at dt " << dt);
   EXPECT_GT(turn.settle_seconds, 0.0f) << "never settled; final error " << turn.final_error_degrees;
   EXPECT_LE(turn.settle_seconds, settle_limit);
@@ -132,6 +141,12 @@ TEST(StandTurnTest, HalfTurnsBothWays) {
 TEST(StandTurnTest, FrameRateDoesNotChangeTheTurn) {
   expect_natural_turn(179.0f, 1.0f / 30.0f, 1.4f);
   expect_natural_turn(-90.0f, 1.0f / 144.0f, 1.0f);
+}
+
+// ControllerInput::facing_yaw asks for the same turn without the sticks.
+TEST(StandTurnTest, AFacingGivenThroughTheApiTurnsTheSameWay) {
+  expect_natural_turn(90.0f, 1.0f / 60.0f, 1.0f, Request::Api);
+  expect_natural_turn(-179.0f, 1.0f / 60.0f, 1.4f, Request::Api);
 }
 
 TEST(StandTurnTest, SettingsAreValidatedAndSetByName) {

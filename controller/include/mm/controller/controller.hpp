@@ -205,6 +205,11 @@ struct ControllerSettings {
   // With CharacterFollowsSimulation, the simulation object's position is also pulled toward the
   // character with this halflife (s; 0: never), so that the character is pulled less.
   float simulation_yield_halflife = 0.15f;
+  // The yield moves the simulation object no faster than this ratio of the character's own
+  // speed: a character that does not follow (asked for a motion the data lacks, such as a side
+  // step from standing) would otherwise hold the simulation back, and the pull (limited by the
+  // character's own speed too) would never start it.
+  float simulation_yield_max_velocity_ratio = 2.0f;
   // The pull's speed is at most this ratio of the character's own speed, so a standing
   // character is never slid; and its turning at most this ratio of the character's own turning.
   // Pulling the body along slides a planted foot, turning it only twists the leg.

@@ -6,6 +6,7 @@
 // is read in the camera's frame: +y pushes away from the camera (forward), +x to the camera's
 // right. Sticks outside the unit disc are scaled back onto it; non-finite values count as 0.
 
+#include <limits>
 #include <string_view>
 
 #include <glm/glm.hpp>
@@ -18,6 +19,10 @@ struct ControllerInput {
   float camera_yaw = 0.0f;      // radians about +Y; the camera looks along (sin, 0, cos)
   bool run = false;             // run speeds instead of walk speeds
   bool strafe = false;          // keep facing the right stick (or the current facing)
+  // A facing to take, as a world yaw (radians about +Y; the character's forward axis then
+  // points along (sin, 0, cos)), whatever the sticks say: standing, the character turns on the
+  // spot to it; moving, it keeps facing it as when strafing. Not finite (the default): none.
+  float facing_yaw = std::numeric_limits<float>::quiet_NaN();
   // Play clips carrying this tag (e.g. "wave"): a database tag equal to it, or whose first word
   // is it ("wave" matches "wave-both-hands" and "wave-left-hand"). Empty: locomotion. The view
   // is read during update() only; it need not outlive the call.
