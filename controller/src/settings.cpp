@@ -119,6 +119,16 @@ Error bad_value(std::string_view name, std::string_view value, const char* expec
                std::string(value) + "'"};
 }
 
+// An enum field from its name, the names listed in the enum's order.
+template <typename Enum, size_t N>
+Status parse_named(std::string_view name, std::string_view value,
+                   const std::string_view (&names)[N], const char* expected, Enum& out) {
+  const auto* found = std::find(std::begin(names), std::end(names), value);
+  if (found == std::end(names)) return bad_value(name, value, expected);
+  out = static_cast<Enum>(found - std::begin(names));
+  return Status::success();
+}
+
 }  // namespace
 
 Status ControllerSettings::validate() const {
@@ -192,24 +202,12 @@ Status set_controller_setting(ControllerSettings& settings, std::string_view nam
     return Status::success();
   }
   if (name == "transition_mode") {
-    const auto* found =
-        std::find(std::begin(kTransitionModeNames), std::end(kTransitionModeNames), value);
-    if (found == std::end(kTransitionModeNames)) {
-      return bad_value(name, value, "dead-blending or inertialization");
-    }
-    settings.transition_mode =
-        static_cast<TransitionMode>(found - std::begin(kTransitionModeNames));
-    return Status::success();
+    return parse_named(name, value, kTransitionModeNames, "dead-blending or inertialization",
+                       settings.transition_mode);
   }
   if (name == "interpolation") {
-    const auto* found =
-        std::find(std::begin(kInterpolationNames), std::end(kInterpolationNames), value);
-    if (found == std::end(kInterpolationNames)) {
-      return bad_value(name, value, "nlerp, slerp or sclerp");
-    }
-    settings.interpolation =
-        static_cast<InterpolationMethod>(found - std::begin(kInterpolationNames));
-    return Status::success();
+    return parse_named(name, value, kInterpolationNames, "nlerp, slerp or sclerp",
+                       settings.interpolation);
   }
   return Error{"unknown setting '" + std::string(name) + "'"};
 }

@@ -112,25 +112,28 @@ Output shown_animation(Animation& anim, float time) {
   return {anim.local, anim.velocities, anim.angular_velocities};
 }
 
+// A blend for the test's joints, started from `outgoing` at time t.
+DeadBlend started_from(Animation& outgoing, float t, float blend_time = kBlendTime) {
+  DeadBlend blend;
+  blend.resize(kJoints);
+  dead_blend_transition(blend, outgoing.at(t), blend_time);
+  return blend;
+}
+
 TEST(DeadBlending, ValueAndVelocityContinuousAtTheSwitch) {
   for (int trial = 0; trial < 5; ++trial) {
     Animation outgoing = Animation::random();
     Animation incoming = Animation::random();
-    DeadBlend blend;
-    blend.resize(kJoints);
     const float t = 0.4f;
     const Output shown = shown_animation(outgoing, t);
-    dead_blend_transition(blend, outgoing.at(t), kBlendTime);
-    expect_continuous(blend, incoming, t, shown);
+    expect_continuous(started_from(outgoing, t), incoming, t, shown);
   }
 }
 
 TEST(DeadBlending, TheReportedVelocitiesAreTheOutputsOwnMidBlend) {
   Animation outgoing = Animation::random();
   Animation incoming = Animation::random();
-  DeadBlend blend;
-  blend.resize(kJoints);
-  dead_blend_transition(blend, outgoing.at(0.0f), kBlendTime);
+  DeadBlend blend = started_from(outgoing, 0.0f);
   const float t = 0.2f;  // mid-blend, where the weight changes fastest
   std::array<Transform, kJoints> scratch;
   dead_blend_update(blend, incoming.at(t - kDelta), kBlendTime, kDecay, t - kDelta, scratch, {},
@@ -152,9 +155,7 @@ TEST(DeadBlending, ASwitchDuringABlendStartsFromWhatIsShown) {
   Animation a = Animation::random();
   Animation b = Animation::random();
   Animation c = Animation::random();
-  DeadBlend blend;
-  blend.resize(kJoints);
-  dead_blend_transition(blend, a.at(0.0f), kBlendTime);
+  DeadBlend blend = started_from(a, 0.0f);
   std::array<Transform, kJoints> scratch;
   float t = 0.0f;
   for (int f = 0; f < 12; ++f) {  // 0.2 s into the blend a -> b
@@ -170,9 +171,7 @@ TEST(DeadBlending, ASwitchDuringABlendStartsFromWhatIsShown) {
 TEST(DeadBlending, EndsOnTheIncomingAnimationAfterTheBlendTime) {
   Animation a = Animation::random();
   Animation b = Animation::random();
-  DeadBlend blend;
-  blend.resize(kJoints);
-  dead_blend_transition(blend, a.at(0.0f), kBlendTime);
+  DeadBlend blend = started_from(a, 0.0f);
   Output out;
   float t = 0.0f;
   bool differed_midway = false;
@@ -197,9 +196,7 @@ TEST(DeadBlending, EndsOnTheIncomingAnimationAfterTheBlendTime) {
 
 TEST(DeadBlending, TheSourceCoastsToRestWithItsVelocitiesExactlyZero) {
   Animation a = Animation::random();
-  DeadBlend blend;
-  blend.resize(kJoints);
-  dead_blend_transition(blend, a.at(0.0f), 100.0f);  // a blend long enough to watch the source
+  DeadBlend blend = started_from(a, 0.0f, 100.0f);  // a blend long enough to watch the source
   Animation still = Animation::random();
   std::array<Transform, kJoints> scratch;
   for (int f = 0; f < 600; ++f) {
@@ -217,11 +214,8 @@ TEST(DeadBlending, TheSourceCoastsToRestWithItsVelocitiesExactlyZero) {
 TEST(DeadBlending, TheSameSpanOfTimeGivesTheSamePoseHoweverItIsCut) {
   Animation a = Animation::random();
   Animation b = Animation::random();
-  DeadBlend once, often;
-  once.resize(kJoints);
-  often.resize(kJoints);
-  dead_blend_transition(once, a.at(0.0f), kBlendTime);
-  dead_blend_transition(often, a.at(0.0f), kBlendTime);
+  DeadBlend once = started_from(a, 0.0f);
+  DeadBlend often = started_from(a, 0.0f);
   Output one, many;
   dead_blend_update(once, b.at(0.3f), kBlendTime, kDecay, 0.3f, one.local, {}, {});
   for (int f = 0; f < 30; ++f) {
@@ -237,9 +231,7 @@ TEST(DeadBlending, TheSameSpanOfTimeGivesTheSamePoseHoweverItIsCut) {
 TEST(DeadBlending, BadTimesNeverPoisonTheState) {
   Animation a = Animation::random();
   Animation b = Animation::random();
-  DeadBlend blend;
-  blend.resize(kJoints);
-  dead_blend_transition(blend, a.at(0.0f), kBlendTime);
+  DeadBlend blend = started_from(a, 0.0f);
   Output out;
   for (const float dt : {std::nanf(""), -1.0f, INFINITY}) {
     dead_blend_update(blend, b.at(0.0f), kBlendTime, kDecay, dt, out.local, out.velocities,
