@@ -879,9 +879,10 @@ void Controller::limit_body_turn(float dt) {
 // Strafing, the chest faces the desired facing. The data has no side steps: a strafe plays
 // clips whose body faces more or less where it walks. A twist about the vertical, half in the
 // spine and half in the chest, turns the chest toward the facing; it follows its goal on a
-// spring slow enough to leave the gait's own shoulder swing, and eases out when the strafe
-// ends. (Skeletons without spine or chest roles, or without upper arms to measure the chest's
-// facing by, are left as they are.)
+// short spring (a slower one lagged the body coming round and overshot when it arrived, and
+// held the chest off the facing longer), and eases out when the strafe ends. (Skeletons without
+// spine or chest roles, or without upper arms to measure the chest's facing by, are left as they
+// are.)
 void Controller::turn_chest_to_facing(float dt) {
   const JointRoleIndices& roles = db_->roles;
   if (roles.left_upper_arm < 0 || roles.right_upper_arm < 0 ||
