@@ -1032,9 +1032,17 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   } else if (f.locked) {
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
+    // Standing, a step is due by where the idle clip itself puts the toe, not by where the blend
+    // into it has got to: waiting for the blend, the steps came late, long after the stop.
+    glm::vec3 settle_drag = drag;
+    if (settling) {
+      const std::vector<int>& leg = leg_joints_[side];
+      settle_drag = playing_position(leg[3] >= 0 ? leg[3] : leg[2]) - f.position;
+      settle_drag.y = 0.0f;
+    }
     const bool settle =
         settling && !feet_[1 - side].stepping &&
-        (glm::length(drag) > kSettleDistance || std::abs(f.heading_offset) > kSettleHeading);
+        (glm::length(settle_drag) > kSettleDistance || std::abs(f.heading_offset) > kSettleHeading);
     // Beyond the leg's reach (softened, see soft_reach) the held toe would be dragged along the
     // ground anyway.
     const std::vector<int>& leg = leg_joints_[side];
@@ -1075,6 +1083,18 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
     f.stepping = false;
   }
   return target;
+}
+
+// Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
+// displayed root.
+glm::vec3 Controller::playing_position(int joint) const {
+  constexpr int kMaxDepth = 64;
+  int chain[kMaxDepth];
+  int depth = 0;
+  for (int j = joint; j > 0 && depth < kMaxDepth; j = db_->skeleton.parent(j)) chain[depth++] = j;
+  Transform t = locals_[0];
+  for (int k = depth - 1; k >= 0; --k) t = compose(t, sampled_[static_cast<size_t>(chain[k])]);
+  return t.translation;
 }
 
 // A planted foot does not swivel on the ground: while locked it keeps the heading it landed

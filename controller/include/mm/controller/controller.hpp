@@ -420,6 +420,7 @@ class Controller {
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
   void hold_heading(int side, float dt);
+  glm::vec3 playing_position(int joint) const;
   float foot_heading(int side) const;
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
