@@ -27,6 +27,14 @@ constexpr float kRelockOffset = 0.01f;
 constexpr float kMaxChestTwist = 1.0f;
 constexpr float kChestTwistReach = 1.75f;
 constexpr float kChestTwistHalflife = 0.1f;
+// Slower than this (m/s), a strafe has no direction to warp the legs toward; moving farther than
+// this (radians) from the facing, it moves backward, with nothing to warp toward.
+constexpr float kWarpMinSpeed = 0.1f;
+constexpr float kWarpMaxTravel = 1.75f;
+// A facing farther than this (radians) from the last one is a new facing, reached when the root
+// comes within kWarpFacingReached of it.
+constexpr float kWarpRefacing = 0.35f;
+constexpr float kWarpFacingReached = 0.17f;
 // Standing, a held toe farther than this (m) from where the idle pose puts it steps there.
 constexpr float kSettleDistance = 0.08f;
 // Standing, a held foot turned farther than this (radians) from the idle pose's heading steps
@@ -300,7 +308,8 @@ void Controller::place(const glm::vec3& position, float yaw) {
   const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
   sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
   sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
-  sim_rotation_ = desired_rotation_ = rotation;
+  sim_rotation_ = desired_rotation_ = simulation_goal_rotation_ = warp_facing_ = rotation;
+  warp_facing_reached_ = true;
   desired_velocity_ = glm::vec3(0.0f);
   clear_transitions();
   for (FootLock& f : feet_) f = FootLock{};
@@ -399,6 +408,16 @@ void Controller::desired_motion(const ControllerInput& input) {
   debug_.desired_rotation = desired_rotation_;
   debug_.standing = released;
   strafing_ = (input.strafe || facing_given) && !released;
+  // A new facing is turned to before the legs warp away from it (see warped_facing).
+  if (quat_angle_between(desired_rotation_, warp_facing_) > kWarpRefacing) {
+    warp_facing_ = desired_rotation_;
+    warp_facing_reached_ = false;
+  }
+  if (clip_ >= 0 && std::abs(wrap_angle(quat_yaw(locals_[0].rotation) -
+                                        quat_yaw(desired_rotation_))) < kWarpFacingReached) {
+    warp_facing_reached_ = true;
+  }
+  simulation_goal_rotation_ = warped_facing();
 }
 
 uint64_t Controller::resolve_tag(std::string_view tag) const {
@@ -696,7 +715,7 @@ void Controller::simulate(float dt) {
     stand_turn(dt);
   } else {
     const glm::quat before = sim_rotation_;
-    critical_spring_update(sim_rotation_, sim_angular_velocity_, desired_rotation_,
+    critical_spring_update(sim_rotation_, sim_angular_velocity_, simulation_goal_rotation_,
                            settings_.simulation_rotation_halflife, dt);
     limit_turn_rate(before, dt);
   }
@@ -742,7 +761,8 @@ void Controller::predict() {
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
                            desired_velocity_, settings_.simulation_velocity_halflife,
                            trajectory_times_);
-  critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_, desired_rotation_,
+  critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
+                          stopping_ ? desired_rotation_ : simulation_goal_rotation_,
                           settings_.simulation_rotation_halflife, trajectory_times_);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
@@ -874,6 +894,24 @@ void Controller::limit_body_turn(float dt) {
   }
   body_yaw_ = yaw;
   body_yaw_known_ = true;
+}
+
+// Orientation warping. The data has no side steps: strafing, the simulation (and with it the
+// root and the legs, through the search) faces partly toward where it goes, by at most
+// strafe_warp_max, so that clips walking that way serve the move, while turn_chest_to_facing
+// turns the chest back to the facing. Moving backward there is nothing to warp toward (no data
+// walks backward either), so the facing stays. A new facing (a strafe that flips it) is turned
+// to first, the root within kWarpFacingReached of it, and only then do the legs warp away.
+glm::quat Controller::warped_facing() const {
+  const float limit = settings_.strafe_warp_max;
+  if (!strafing_ || !warp_facing_reached_ || !(limit > 0.0f) ||
+      glm::length(desired_velocity_) < kWarpMinSpeed) {
+    return desired_rotation_;
+  }
+  const float facing = quat_yaw(desired_rotation_);
+  const float off = wrap_angle(std::atan2(desired_velocity_.x, desired_velocity_.z) - facing);
+  if (std::abs(off) > kWarpMaxTravel) return desired_rotation_;
+  return yaw_rotation(facing + std::clamp(off, -limit, limit));
 }
 
 // Strafing, the chest faces the desired facing. The data has no side steps: a strafe plays

@@ -59,6 +59,7 @@ constexpr FloatField kFloatFields[] = {
      &ControllerSettings::adjustment_max_angular_velocity_ratio, 0.0f, 100.0f},
     {"clamp_max_distance", &ControllerSettings::clamp_max_distance, 0.0f, 1e3f},
     {"clamp_max_angle", &ControllerSettings::clamp_max_angle, 0.0f, 4.0f},
+    {"strafe_warp_max", &ControllerSettings::strafe_warp_max, 0.0f, 3.2f},
     {"stand_turn_max_rate", &ControllerSettings::stand_turn_max_rate, 0.1f, 100.0f},
     {"stand_turn_acceleration", &ControllerSettings::stand_turn_acceleration, 0.1f, 1000.0f},
     {"foot_unlock_radius", &ControllerSettings::foot_unlock_radius, 0.0f, 10.0f},

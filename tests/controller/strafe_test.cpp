@@ -34,15 +34,18 @@ TEST(StrafeTest, TheChestFacesTheFacingWhileRunningSideways) {
 }
 
 // A facing given through the API (ControllerInput::facing_yaw) while walking: the character
-// keeps facing it as when strafing, whatever the stick's direction; an absurd but finite yaw is
-// taken modulo a turn.
+// keeps facing it as when strafing, whatever the stick's direction (the chest on it, the legs
+// and root warped toward the travel by strafe_warp_max); an absurd but finite yaw is taken
+// modulo a turn.
 TEST(StrafeTest, AFacingGivenThroughTheApiIsKeptWhileWalking) {
   Controller c = test::make_controller();
   ControllerInput input = test::push_toward(90.0f);  // walk toward +X
   input.facing_yaw = 0.0f;                           // facing +Z
   const float dt = 1.0f / 60.0f;
   for (int i = 0; i < 240; ++i) c.update(dt, input);
-  EXPECT_LT(std::abs(wrap_angle(quat_yaw(c.root_transform().rotation))), glm::radians(30.0f));
+  const ControllerSettings defaults;
+  EXPECT_NEAR(wrap_angle(quat_yaw(c.root_transform().rotation)), defaults.strafe_warp_max,
+              glm::radians(15.0f));
   EXPECT_LT(std::abs(wrap_angle(test::chest_yaw(c))), glm::radians(10.0f));
   EXPECT_GT(c.root_transform().translation.x, 1.0f);  // and it went where the stick said
 
@@ -53,10 +56,12 @@ TEST(StrafeTest, AFacingGivenThroughTheApiIsKeptWhileWalking) {
   }
 }
 
-// Sideways from standing, with no side steps in the data: the character gets going. (The
-// simulation object, yielding to a character that did not follow at any speed, once held it
-// beside the character, and nothing moved.)
-float side_step_distance(const ControllerSettings& settings) {
+// Sideways from standing, with no side steps in the data and no orientation warping to serve
+// them from forward walks: the character still gets going. (The simulation object, yielding to
+// a character that did not follow at any speed, once held it beside the character, and nothing
+// moved.)
+float side_step_distance(ControllerSettings settings) {
+  settings.strafe_warp_max = 0.0f;
   Controller c = test::make_controller(settings);
   const float dt = 1.0f / 60.0f;
   for (int i = 0; i < 60; ++i) c.update(dt, ControllerInput{});
@@ -74,6 +79,27 @@ TEST(StrafeTest, ASideStepFromStandingGetsGoing) {
   ControllerSettings unbounded_yield;
   unbounded_yield.simulation_yield_max_velocity_ratio = 1000.0f;
   EXPECT_LT(side_step_distance(unbounded_yield), 0.5f);
+}
+
+// Orientation warping: the shipped strafes reach the new speed sooner and keep the root nearer
+// the simulation than without it, and reach it within 0.8 s.
+TEST(StrafeTest, OrientationWarpingServesStrafesFromForwardWalks) {
+  Result<InputScript> script =
+      load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input/strafe.txt");
+  ASSERT_TRUE(script.ok()) << script.message();
+  EvaluationMetrics metrics[2];
+  for (const bool warp : {true, false}) {
+    EvaluationOptions options;
+    if (!warp) options.settings.strafe_warp_max = 0.0f;
+    Result<EvaluationResult> run =
+        evaluate_script(test::normal_controller_database(), *script, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    metrics[warp ? 0 : 1] = run->metrics;
+  }
+  EXPECT_LE(metrics[0].speed_response_s, 0.8);
+  EXPECT_GT(metrics[1].speed_response_s, metrics[0].speed_response_s);
+  EXPECT_LT(metrics[0].root_sim_distance_cm_mean, metrics[1].root_sim_distance_cm_mean);
+  EXPECT_LT(metrics[0].strafe_chest_error_deg_mean, 5.0);  // the chest still on the facing
 }
 
 }  // namespace

@@ -219,6 +219,11 @@ struct ControllerSettings {
   float clamp_max_distance = 0.4f;
   float clamp_max_angle = 0.6f;
 
+  // ---- Strafing. The data has no side steps: while strafing, the simulation (and with it the
+  // legs) faces up to this far (radians) toward the travel direction, and the spine and chest
+  // twist back to the facing (0: no warping).
+  float strafe_warp_max = 0.6f;
+
   // ---- Turning on the spot. The data has no turns in place: while standing (stick released,
   // simulation slower than stop_speed) the simulation's facing turns toward the desired facing
   // no faster than stand_turn_max_rate, speeding up and slowing down at stand_turn_acceleration
@@ -390,6 +395,7 @@ class Controller {
   float body_yaw() const;
   void limit_body_turn(float dt);
   void turn_chest_to_facing(float dt);
+  glm::quat warped_facing() const;
   void predict();
   bool should_search() const;
   void build_query();
@@ -532,6 +538,11 @@ class Controller {
   // Strafing (the strafe button held, the stick pushed), and the chest's twist toward the
   // facing (radians about the vertical) with its rate.
   bool strafing_ = false;
+  // The facing the simulation turns to: the desired facing, warped toward the travel direction
+  // while strafing (warped_facing).
+  glm::quat simulation_goal_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::quat warp_facing_{1.0f, 0.0f, 0.0f, 0.0f};  // the facing the root last turned to
+  bool warp_facing_reached_ = true;
   float chest_twist_ = 0.0f;
   float chest_twist_velocity_ = 0.0f;
 
