@@ -120,14 +120,17 @@ glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, flo
   return hip_to_ankle * (reached / d);
 }
 
-// The root (joint 0) and the body (joints 1..) of a per-joint array: transitions treat them apart.
-template <typename T>
-std::span<T> root_of(std::vector<T>& joints) {
-  return std::span(joints).first(1);
+// The root (joint 0) and the body (joints 1..) of a pose and its velocities: transitions treat
+// them apart.
+PoseMotion root_part(const std::vector<Transform>& pose, const std::vector<glm::vec3>& velocities,
+                     const std::vector<glm::vec3>& angular_velocities) {
+  return {std::span(pose).first(1), std::span(velocities).first(1),
+          std::span(angular_velocities).first(1)};
 }
-template <typename T>
-std::span<T> body_of(std::vector<T>& joints) {
-  return std::span(joints).subspan(1);
+PoseMotion body_part(const std::vector<Transform>& pose, const std::vector<glm::vec3>& velocities,
+                     const std::vector<glm::vec3>& angular_velocities) {
+  return {std::span(pose).subspan(1), std::span(velocities).subspan(1),
+          std::span(angular_velocities).subspan(1)};
 }
 
 // Fraction of the remaining distance an exponential pull with this halflife closes in dt.
@@ -589,17 +592,14 @@ void Controller::transition_to(int frame) {
 
 // At a jump, the outgoing clip (sampled_) hands over to the incoming one (other_).
 void Controller::start_transition() {
-  inertialize_transition(
-      root_offsets_,
-      {root_of(sampled_), root_of(sampled_velocities_), root_of(sampled_angular_velocities_)},
-      {root_of(other_), root_of(other_velocities_), root_of(other_angular_velocities_)});
-  const PoseMotion outgoing{body_of(sampled_), body_of(sampled_velocities_),
-                            body_of(sampled_angular_velocities_)};
+  inertialize_transition(root_offsets_,
+                         root_part(sampled_, sampled_velocities_, sampled_angular_velocities_),
+                         root_part(other_, other_velocities_, other_angular_velocities_));
+  const PoseMotion outgoing = body_part(sampled_, sampled_velocities_, sampled_angular_velocities_);
   switch (settings_.transition_mode) {
     case TransitionMode::Inertialization:
-      inertialize_transition(
-          body_offsets_, outgoing,
-          {body_of(other_), body_of(other_velocities_), body_of(other_angular_velocities_)});
+      inertialize_transition(body_offsets_, outgoing,
+                             body_part(other_, other_velocities_, other_angular_velocities_));
       return;
     case TransitionMode::DeadBlending:
       dead_blend_transition(body_blend_, outgoing, settings_.dead_blend_time);
@@ -612,19 +612,19 @@ void Controller::start_transition() {
 // The playing clip (sampled_, at the new time) through the running transitions into locals_.
 void Controller::show_transitions(float dt) {
   const float halflife = settings_.inertialization_halflife;
-  inertialize_update(
-      root_offsets_,
-      {root_of(sampled_), root_of(sampled_velocities_), root_of(sampled_angular_velocities_)},
-      halflife, dt, root_of(locals_), {}, {});
-  const PoseMotion incoming{body_of(sampled_), body_of(sampled_velocities_),
-                            body_of(sampled_angular_velocities_)};
+  inertialize_update(root_offsets_,
+                     root_part(sampled_, sampled_velocities_, sampled_angular_velocities_),
+                     halflife, dt, std::span(locals_).first(1), {}, {});
+  const PoseMotion incoming = body_part(sampled_, sampled_velocities_, sampled_angular_velocities_);
   switch (settings_.transition_mode) {
     case TransitionMode::Inertialization:
-      inertialize_update(body_offsets_, incoming, halflife, dt, body_of(locals_), {}, {});
+      inertialize_update(body_offsets_, incoming, halflife, dt, std::span(locals_).subspan(1), {},
+                         {});
       return;
     case TransitionMode::DeadBlending:
       dead_blend_update(body_blend_, incoming, settings_.dead_blend_time,
-                        settings_.dead_blend_decay_halflife, dt, body_of(locals_), {}, {});
+                        settings_.dead_blend_decay_halflife, dt, std::span(locals_).subspan(1), {},
+                        {});
       return;
   }
 }
@@ -1005,15 +1005,18 @@ void Controller::finish_pose() {
   // While a dead blend is under half way, a foot is down only if it is in both poses: what
   // shows is mostly the pose the blend started from, whose foot may be swinging where the
   // incoming clip's is down, while the blend already carries a foot the incoming clip lifts.
-  const bool early_blend = settings_.transition_mode == TransitionMode::DeadBlending &&
-                           body_blend_.active &&
-                           body_blend_.time < 0.5f * settings_.dead_blend_time;
+  const bool early_blend = in_early_blend();
   for (size_t side = 0; side < 2; ++side) {
     const bool label = db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
-    early_blend_down_[side] = early_blend && blend_source_contact_[side];
     shown_contact_[side] = label && (!early_blend || blend_source_contact_[side]);
     debug_.contact[side] = shown_contact_[side];
   }
+}
+
+// A dead blend under half way: what shows is still mostly the pose it started from.
+bool Controller::in_early_blend() const {
+  return settings_.transition_mode == TransitionMode::DeadBlending && body_blend_.active &&
+         body_blend_.time < 0.5f * settings_.dead_blend_time;
 }
 
 // Foot locking. A foot whose playing frame says "contact" keeps its toe where it was when the
@@ -1029,8 +1032,7 @@ void Controller::foot_lock(float dt) {
   standing_reach_ +=
       ((settling ? 1.0f : 0.0f) - standing_reach_) * pull_fraction(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
-    const std::vector<int>& leg = leg_joints_[side];
-    const int effector = leg[3] >= 0 ? leg[3] : leg[2];
+    const int effector = leg_end(side);
     const glm::vec3 animated = globals_[static_cast<size_t>(effector)].translation;
     if (!settings_.ik_enabled || !settings_.foot_lock_enabled) {
       feet_[side] = FootLock{};
@@ -1074,8 +1076,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
     // into it has got to: waiting for the blend, the steps came late, long after the stop.
     glm::vec3 settle_drag = drag;
     if (settling) {
-      const std::vector<int>& leg = leg_joints_[side];
-      settle_drag = playing_position(leg[3] >= 0 ? leg[3] : leg[2]) - f.position;
+      settle_drag = playing_position(leg_end(side)) - f.position;
       settle_drag.y = 0.0f;
     }
     const bool settle =
@@ -1126,13 +1127,14 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
 // Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
 // displayed root.
 glm::vec3 Controller::playing_position(int joint) const {
-  constexpr int kMaxDepth = 64;
-  int chain[kMaxDepth];
-  int depth = 0;
-  for (int j = joint; j > 0 && depth < kMaxDepth; j = db_->skeleton.parent(j)) chain[depth++] = j;
-  Transform t = locals_[0];
-  for (int k = depth - 1; k >= 0; --k) t = compose(t, sampled_[static_cast<size_t>(chain[k])]);
-  return t.translation;
+  const Transform played = forward_kinematics_joint(db_->skeleton.parents(), sampled_, joint);
+  return transform_point(compose(locals_[0], inverse(sampled_[0])), played.translation);
+}
+
+// The end joint of a leg: its toe, or its foot when it has none.
+int Controller::leg_end(int side) const {
+  const std::vector<int>& leg = leg_joints_[side];
+  return leg[3] >= 0 ? leg[3] : leg[2];
 }
 
 // A planted foot does not swivel on the ground: while locked it keeps the heading it landed
@@ -1148,7 +1150,7 @@ void Controller::hold_heading(int side, float dt) {
   const float animated = foot_heading(side);
   // A foot down in the pose a dead blend started from keeps its heading while the fade is
   // under half way, even when its toe is let go: the fade would swivel it on the ground.
-  const bool hold = f.locked || early_blend_down_[side];
+  const bool hold = f.locked || (in_early_blend() && blend_source_contact_[side]);
   if (hold) {
     if (!f.heading_held) f.heading = wrap_angle(animated + f.heading_offset);
     f.heading_held = true;

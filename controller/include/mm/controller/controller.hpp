@@ -427,6 +427,8 @@ class Controller {
   glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
   void hold_heading(int side, float dt);
   glm::vec3 playing_position(int joint) const;
+  int leg_end(int side) const;
+  bool in_early_blend() const;
   float foot_heading(int side) const;
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
@@ -492,8 +494,6 @@ class Controller {
   // The contacts of the pose shown (finish_pose), and of the pose a dead blend started from.
   bool shown_contact_[2] = {false, false};
   bool blend_source_contact_[2] = {false, false};
-  // Down in the pose a dead blend started from, while the blend is under half way.
-  bool early_blend_down_[2] = {false, false};
   // Per-joint buffers, sized at create().
   std::vector<Transform> sampled_;  // the playing animation (root in world space)
   std::vector<glm::vec3> sampled_velocities_;
