@@ -512,7 +512,7 @@ namespace {
 std::string csv_header(const Database& db) {
   std::string h =
       "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,"
-      "desired_yaw_deg,transition,contact_l,contact_r";
+      "desired_yaw_deg,transition,contact_l,contact_r,clip,frame";
   for (const std::string& name : db.skeleton.names()) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
@@ -524,11 +524,11 @@ std::string csv_row(const EvaluationFrame& r) {
   char buffer[256];
   const glm::dvec3 sim = to_world(r.origin, r.sim_position);
   const glm::dvec3 root = to_world(r.origin, r.root_position);
-  std::snprintf(buffer, sizeof buffer, "%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%d,%d,%d",
-                r.t, sim.x, sim.z, glm::degrees(r.sim_yaw), root.x, root.z,
-                glm::degrees(r.root_yaw), r.desired_velocity.x, r.desired_velocity.z,
-                glm::degrees(r.desired_yaw), r.transition ? 1 : 0, r.contact[0] ? 1 : 0,
-                r.contact[1] ? 1 : 0);
+  std::snprintf(buffer, sizeof buffer,
+                "%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%d,%d,%d,%d,%d", r.t, sim.x,
+                sim.z, glm::degrees(r.sim_yaw), root.x, root.z, glm::degrees(r.root_yaw),
+                r.desired_velocity.x, r.desired_velocity.z, glm::degrees(r.desired_yaw),
+                r.transition ? 1 : 0, r.contact[0] ? 1 : 0, r.contact[1] ? 1 : 0, r.clip, r.frame);
   std::string row = buffer;
   for (const glm::vec3& joint : r.joints) {
     const glm::dvec3 p = to_world(r.origin, joint);
@@ -554,6 +554,8 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.desired_velocity = d.desired_velocity;
   r.desired_yaw = quat_yaw(d.desired_rotation);
   r.transition = d.transitioned;
+  r.clip = d.clip;
+  r.frame = d.frame;
   r.contact[0] = d.contact[0];
   r.contact[1] = d.contact[1];
   r.update_seconds = update_seconds;

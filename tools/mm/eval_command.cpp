@@ -63,9 +63,11 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "also write the metrics as JSON (one script: the keys at the top level; "
                  "several: a list under \"runs\")")
       ->type_name("FILE");
-  app.add_option("--dump", out.dump_path,
-                 "one CSV row per frame (one script only): t, simulation, root, desired motion, "
-                 "transition, contacts, then every joint's global position")
+  app.add_option(
+         "--dump", out.dump_path,
+         "one CSV row per frame (one script only): t, simulation, root, desired motion, "
+         "transition, contacts, the playing clip (index) and database frame, then every joint's "
+         "global position")
       ->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (const auto start = parse_number_pair(out.start)) {

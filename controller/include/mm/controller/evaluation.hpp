@@ -180,6 +180,8 @@ struct EvaluationFrame {
   float desired_yaw = 0.0f;
   bool transition = false;
   bool contact[2] = {false, false};  // left, right
+  int clip = -1;                     // playing: index into the database's clips
+  int frame = -1;                    // playing: the database frame
   double update_seconds = 0.0;
   bool searched = false;
   double search_seconds = 0.0;
