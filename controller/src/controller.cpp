@@ -28,7 +28,7 @@ constexpr float kMaxChestTwist = 1.0f;
 constexpr float kChestTwistReach = 1.75f;
 constexpr float kChestTwistHalflife = 0.1f;
 // Slower than this (m/s), a strafe has no direction to warp the legs toward; moving farther than
-// this (radians) from the facing, it moves backward, with nothing to warp toward.
+// this (radians) from the facing, it moves backward, and the legs warp toward straight back.
 constexpr float kWarpMinSpeed = 0.1f;
 constexpr float kWarpMaxTravel = 1.75f;
 // A facing farther than this (radians) from the last one is a new facing, reached when the root
@@ -807,7 +807,9 @@ void Controller::synchronize(float dt) {
     toward.y = 0.0f;
     glm::vec3 step = toward * pull_fraction(settings_.simulation_yield_halflife, dt);
     const float own_speed = std::hypot(displayed_velocity_.x, displayed_velocity_.z);
-    const float max_step = settings_.simulation_yield_max_velocity_ratio * own_speed * dt;
+    float max_speed = settings_.simulation_yield_max_velocity_ratio * own_speed;
+    if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
+    const float max_step = max_speed * dt;
     if (glm::length(step) > max_step) step *= max_step / glm::length(step);
     sim_position_ += step;
   }
@@ -899,9 +901,11 @@ void Controller::limit_body_turn(float dt) {
 // Orientation warping. The data has no side steps: strafing, the simulation (and with it the
 // root and the legs, through the search) faces partly toward where it goes, by at most
 // strafe_warp_max, so that clips walking that way serve the move, while turn_chest_to_facing
-// turns the chest back to the facing. Moving backward there is nothing to warp toward (no data
-// walks backward either), so the facing stays. A new facing (a strafe that flips it) is turned
-// to first, the root within kWarpFacingReached of it, and only then do the legs warp away.
+// turns the chest back to the facing. Moving backward and to one side, the legs turn the other
+// way, so that they go straight backward: the data never moves sideways and back at once, and
+// turned toward the travel the legs would have to turn more than half round. A new facing (a strafe
+// that flips it) is turned to first, the root within kWarpFacingReached of it, and only then do the
+// legs warp away.
 glm::quat Controller::warped_facing() const {
   const float limit = settings_.strafe_warp_max;
   if (!strafing_ || !warp_facing_reached_ || !(limit > 0.0f) ||
@@ -910,8 +914,8 @@ glm::quat Controller::warped_facing() const {
   }
   const float facing = quat_yaw(desired_rotation_);
   const float off = wrap_angle(std::atan2(desired_velocity_.x, desired_velocity_.z) - facing);
-  if (std::abs(off) > kWarpMaxTravel) return desired_rotation_;
-  return yaw_rotation(facing + std::clamp(off, -limit, limit));
+  const float warp = std::abs(off) > kWarpMaxTravel ? wrap_angle(off + glm::pi<float>()) : off;
+  return yaw_rotation(facing + std::clamp(warp, -limit, limit));
 }
 
 // Strafing, the chest faces the desired facing. The data has no side steps: a strafe plays

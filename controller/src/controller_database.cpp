@@ -71,8 +71,10 @@ ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_
   speeds.run_forward = speed_or(1, 0, std::max(speeds.run_forward, 2.0f * speeds.walk_forward));
   speeds.walk_sideways = speed_or(0, 1, 0.75f * speeds.walk_forward);
   speeds.walk_backward = speed_or(0, 2, 0.65f * speeds.walk_forward);
-  speeds.run_sideways = speed_or(1, 1, 0.75f * speeds.run_forward);
-  speeds.run_backward = speed_or(1, 2, 0.65f * speeds.run_forward);
+  // Runs sideways and backward, where the data has none, are warped forward runs and backward
+  // walks (see strafe_warp_max), which carry the character at about half the forward run.
+  speeds.run_sideways = speed_or(1, 1, 0.5f * speeds.run_forward);
+  speeds.run_backward = speed_or(1, 2, 0.5f * speeds.run_forward);
   return speeds;
 }
 
@@ -118,6 +120,9 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   if (!std::isfinite(options.clip_end_exclusion) || options.clip_end_exclusion < 0.0f) {
     return Error{"controller database: clip_end_exclusion must be >= 0 seconds"};
   }
+  if (!std::isfinite(options.idle_clip_end_exclusion) || options.idle_clip_end_exclusion < 0.0f) {
+    return Error{"controller database: idle_clip_end_exclusion must be >= 0 seconds"};
+  }
 
   std::shared_ptr<ControllerDatabase> out(new ControllerDatabase());
   out->database_ = std::move(database);
@@ -126,12 +131,18 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   out->idle_tags_ = tag_bit(db, kIdleTag);
 
   const int excluded = clamped_integer<int>(std::round(options.clip_end_exclusion / db.frame_time));
+  const int idle_excluded =
+      clamped_integer<int>(std::round(options.idle_clip_end_exclusion / db.frame_time));
   out->candidates_.assign(db.searchable.begin(), db.searchable.end());
   for (const ClipRange& clip : db.clips) {
     // The synthesized idle clip is one held pose: its end is as good as its start. Idle clips
     // of the data end like any take: jumping to their last frames would hold the last pose.
     if (is_idle_clip(db, clip)) continue;
-    for (int f = std::max(clip.start, clip.end - excluded); f < clip.end; ++f) {
+    int end_frames = excluded;
+    if ((clip.tags & out->idle_tags_) != 0) {
+      end_frames = std::max(excluded, std::min(idle_excluded, (clip.end - clip.start) / 2));
+    }
+    for (int f = std::max(clip.start, clip.end - end_frames); f < clip.end; ++f) {
       out->candidates_[static_cast<size_t>(f)] = 0;
     }
   }

@@ -53,6 +53,8 @@ constexpr FloatField kFloatFields[] = {
     {"simulation_yield_halflife", &ControllerSettings::simulation_yield_halflife, 0.0f, 100.0f},
     {"simulation_yield_max_velocity_ratio",
      &ControllerSettings::simulation_yield_max_velocity_ratio, 0.0f, 1000.0f},
+    {"simulation_yield_standing_speed", &ControllerSettings::simulation_yield_standing_speed, 0.0f,
+     100.0f},
     {"adjustment_max_velocity_ratio", &ControllerSettings::adjustment_max_velocity_ratio, 0.0f,
      100.0f},
     {"adjustment_max_angular_velocity_ratio",

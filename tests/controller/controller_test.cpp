@@ -490,21 +490,61 @@ TEST(ControllerTest, DifferentFrameRatesTrackTheSameTrajectory) {
   EXPECT_LT(glm::length(ends[2] - ends[1]), 0.35f);
 }
 
-// A database with real idle takes (ReActIdle, retargeted): a long stand plays them through,
-// breathing and swaying, and moves on at their ends instead of replaying their last moments.
-TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
-  const std::filesystem::path inputs[] = {
-      test::clip_path("dataset-2_walk_normal_001"), test::clip_path("dataset-2_walk_normal_002"),
-      test::mocap_dir() / "reactidle" / "genuine" / "008_genuine.bvh",
-      test::mocap_dir() / "reactidle" / "genuine" / "012_genuine.bvh"};
-  BuildOptions options;
-  options.bvh.scale = 0.0f;  // centimetres and metres
-  Result<Database> db = build_database(inputs, options);
-  ASSERT_TRUE(db) << db.message();
+// Two walks and two real idle takes (ReActIdle, retargeted), built once.
+std::shared_ptr<const Database> real_idle_database() {
+  static const std::shared_ptr<const Database> shared = [] {
+    const std::filesystem::path inputs[] = {
+        test::clip_path("dataset-2_walk_normal_001"), test::clip_path("dataset-2_walk_normal_002"),
+        test::mocap_dir() / "reactidle" / "genuine" / "008_genuine.bvh",
+        test::mocap_dir() / "reactidle" / "genuine" / "012_genuine.bvh"};
+    BuildOptions options;
+    options.bvh.scale = 0.0f;  // centimetres and metres
+    Result<Database> db = build_database(inputs, options);
+    EXPECT_TRUE(db) << (db ? "" : db.message());
+    return db ? std::make_shared<const Database>(std::move(db).value()) : nullptr;
+  }();
+  return shared;
+}
+
+// A controller on real_idle_database() (the test fails if it cannot be made).
+Result<Controller> make_on_real_idles(const ControllerDatabaseOptions& options = {}) {
   Result<std::shared_ptr<const ControllerDatabase>> shared =
-      ControllerDatabase::create(std::make_shared<const Database>(std::move(db).value()));
-  ASSERT_TRUE(shared) << shared.message();
-  Result<Controller> made = Controller::create(*shared, ControllerSettings{});
+      ControllerDatabase::create(real_idle_database(), options);
+  if (!shared) return Error{shared.message()};
+  return Controller::create(*shared, ControllerSettings{});
+}
+
+// The data's idle takes keep their last idle_clip_end_exclusion seconds (at most half of each)
+// out of the candidates, the synthesized held frame none.
+TEST(ControllerDatabaseTest, IdleTakesKeepTheirLastSecondsOut) {
+  Result<std::shared_ptr<const ControllerDatabase>> made =
+      ControllerDatabase::create(real_idle_database());
+  ASSERT_TRUE(made) << made.message();
+  const ControllerDatabase& shared = **made;
+  const Database& db = shared.database();
+  const int excluded =
+      static_cast<int>(std::lround(shared.options().idle_clip_end_exclusion / db.frame_time));
+  int takes = 0;
+  for (const ClipRange& clip : db.clips) {
+    if ((clip.tags & shared.idle_tags()) == 0 || clip.name == "idle") continue;
+    ++takes;
+    const int end_frames = std::min(excluded, (clip.end - clip.start) / 2);
+    for (int f = clip.end - end_frames; f < clip.end; ++f) {
+      EXPECT_FALSE(shared.candidates()[static_cast<size_t>(f)]) << clip.name << " " << f;
+    }
+    EXPECT_TRUE(shared.candidates()[static_cast<size_t>(clip.end - end_frames - 1)]) << clip.name;
+  }
+  EXPECT_GE(takes, 2);
+  ControllerDatabaseOptions negative;
+  negative.idle_clip_end_exclusion = -1.0f;
+  EXPECT_EQ(ControllerDatabase::create(real_idle_database(), negative).message(),
+            "controller database: idle_clip_end_exclusion must be >= 0 seconds");
+}
+
+// A database with real idle takes: a long stand plays them through, breathing and swaying, and
+// moves on at their ends instead of replaying their last moments.
+TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
+  Result<Controller> made = make_on_real_idles();
   ASSERT_TRUE(made) << made.message();
   Controller& c = *made;
   for (int i = 0; i < 120; ++i) c.update(kDt, push_toward(0.0f));

@@ -16,8 +16,8 @@ namespace mm {
 namespace {
 
 // Running strafes in every direction while facing forward, at every rate: the chest's facing
-// error (the evaluation's strafe_chest_error_deg_mean) stays small. The clips alone leave it
-// near 10 degrees.
+// error (the evaluation's strafe_chest_error_deg_mean) stays small (the clips alone leave it
+// near 10 degrees), the root stays with the simulation and the new speed is reached soon.
 TEST(StrafeTest, TheChestFacesTheFacingWhileRunningSideways) {
   Result<InputScript> script =
       load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input/strafe-run.txt");
@@ -30,7 +30,75 @@ TEST(StrafeTest, TheChestFacesTheFacingWhileRunningSideways) {
     ASSERT_TRUE(run.ok()) << run.message();
     EXPECT_GT(run->metrics.strafe_chest_error_deg_mean, 0.0) << "dt " << dt;  // measured at all
     EXPECT_LT(run->metrics.strafe_chest_error_deg_mean, 5.0) << "dt " << dt;
+    EXPECT_LE(run->metrics.root_sim_distance_cm_mean, 8.0) << "dt " << dt;
+    EXPECT_LE(run->metrics.speed_response_s, 0.8) << "dt " << dt;
   }
+}
+
+// Running backward and to one side while facing forward, the legs turn the other way from the
+// travel, toward straight backward, not toward the travel. The root then stays with the
+// simulation; with the legs unturned it trails by a quarter of a metre.
+struct BackDiagonal {
+  float root_distance = 0.0f;  // m, mean over the last 4 s
+  float sim_yaw = 0.0f;        // the simulation's facing at the end
+  float travel_yaw = 0.0f;     // the desired velocity's direction
+};
+
+BackDiagonal run_back_diagonal(const ControllerSettings& settings) {
+  Controller c = test::make_controller(settings);
+  const float dt = 1.0f / 60.0f;
+  ControllerInput input = test::push_toward(0.0f, true);
+  input.facing_yaw = 0.0f;  // facing +Z throughout
+  for (int i = 0; i < 120; ++i) c.update(dt, input);
+  input.left_stick = test::push_toward(135.0f, true).left_stick;  // back and to one side
+  BackDiagonal out;
+  for (int i = 0; i < 300; ++i) {
+    c.update(dt, input);
+    const glm::vec3 away = c.root_transform().translation - c.debug().simulation_position;
+    if (i >= 60) out.root_distance += std::hypot(away.x, away.z) / 240.0f;
+  }
+  out.sim_yaw = quat_yaw(c.debug().simulation_rotation);
+  out.travel_yaw = std::atan2(c.debug().desired_velocity.x, c.debug().desired_velocity.z);
+  return out;
+}
+
+TEST(StrafeTest, BackwardDiagonalsTurnTheLegsTowardStraightBack) {
+  const ControllerSettings defaults;
+  const BackDiagonal warped = run_back_diagonal(defaults);
+  ASSERT_GT(std::abs(warped.travel_yaw), glm::radians(120.0f));
+  const float straight_back = wrap_angle(warped.travel_yaw + glm::pi<float>());
+  EXPECT_NEAR(wrap_angle(warped.sim_yaw),
+              std::clamp(straight_back, -defaults.strafe_warp_max, defaults.strafe_warp_max),
+              glm::radians(2.0f));
+  EXPECT_LT(warped.root_distance, 0.05f);
+  ControllerSettings off;
+  off.strafe_warp_max = 0.0f;
+  const BackDiagonal unwarped = run_back_diagonal(off);
+  EXPECT_NEAR(wrap_angle(unwarped.sim_yaw), 0.0f, glm::radians(2.0f));
+  EXPECT_GT(unwarped.root_distance, 0.15f);
+}
+
+// Standing, the simulation object comes to where the character stopped. The data has no stops:
+// after a running strafe the character stands well away from where the simulation did, and a
+// standing character is never slid toward it.
+float distance_after_stopping(const ControllerSettings& settings) {
+  Controller c = test::make_controller(settings);
+  ControllerInput input = test::push_toward(180.0f, true);  // run backward
+  input.facing_yaw = 0.0f;
+  const float dt = 1.0f / 60.0f;
+  for (int i = 0; i < 120; ++i) c.update(dt, input);
+  for (int i = 0; i < 180; ++i) c.update(dt, ControllerInput{});
+  const glm::vec3 away = c.root_transform().translation - c.debug().simulation_position;
+  return std::hypot(away.x, away.z);
+}
+
+TEST(StrafeTest, StandingTheSimulationComesToTheCharacter) {
+  ControllerSettings held;
+  held.simulation_yield_standing_speed = 0.0f;
+  const float stays = distance_after_stopping(held);
+  const float closes = distance_after_stopping({});
+  EXPECT_GT(stays, 0.05f);
+  EXPECT_LT(closes, 0.01f);
 }
 
 // A facing given through the API (ControllerInput::facing_yaw) while walking: the character

@@ -78,6 +78,10 @@ struct ControllerDatabaseOptions {
   // feature times' own margin: clip ends stop mid-stride, and a transition there lands on a
   // take that is about to run out.
   float clip_end_exclusion = 1.0f;
+  // The same for the data's idle clips (seconds), at most half of each: a stand that starts
+  // near an idle clip's end soon jumps to another idle frame, whose stance the feet then step
+  // into.
+  float idle_clip_end_exclusion = 3.0f;
   // Options of the search structures.
   SearchOptions search;
 };
@@ -204,12 +208,17 @@ struct ControllerSettings {
   float adjustment_halflife = 0.1f;  // s: how fast the character is pulled to the simulation
   // With CharacterFollowsSimulation, the simulation object's position is also pulled toward the
   // character with this halflife (s; 0: never), so that the character is pulled less.
-  float simulation_yield_halflife = 0.15f;
+  float simulation_yield_halflife = 0.1f;
   // The yield moves the simulation object no faster than this ratio of the character's own
   // speed: a character that does not follow (asked for a motion the data lacks, such as a side
   // step from standing) would otherwise hold the simulation back, and the pull (limited by the
   // character's own speed too) would never start it.
   float simulation_yield_max_velocity_ratio = 2.0f;
+  // Standing (stick released, see stop_speed), the simulation object also comes to where the
+  // character stopped at up to this speed (m/s): the data has no stops, so a character rarely
+  // stops where the simulation does, and nothing else would ever close the gap (a standing
+  // character is never slid).
+  float simulation_yield_standing_speed = 0.5f;
   // The pull's speed is at most this ratio of the character's own speed, so a standing
   // character is never slid; and its turning at most this ratio of the character's own turning.
   // Pulling the body along slides a planted foot, turning it only twists the leg.
