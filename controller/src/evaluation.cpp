@@ -357,7 +357,8 @@ void EvaluationAccumulator::State::measure_feet(const EvaluationFrame& r) {
       skate_mean.add(speed_cm);
     }
     if (standing) stand_foot.add(speed_cm);
-    measure_pivot(r, side, moved / dt);
+    measure_pivot(r, side,
+                  glm::distance(toe, previous.joints[static_cast<size_t>(toes[side])]) / dt);
   }
   if (standing && frames > 0) {
     stand_root.add(100.0 * horizontal_distance(r.root_position, previous.root_position) / dt);

@@ -192,7 +192,8 @@ TEST(Evaluation, PercentilesOfASpreadOfValuesAreWithinTheDocumentedResolution) {
 TEST(Evaluation, FootPivotIsTheFootToToeYawRateOfALowSlowToe) {
   // Left: the toe planted at 3 cm while the foot swings around it at 30 deg/s (counted).
   // Right: the same swing at 90 deg/s, first with the toe at 10 cm (too high), then low but
-  // sliding at 0.5 m/s (too fast): never counted.
+  // sliding at 0.5 m/s (too fast), then low, in place, but bobbing up and down 2 cm a frame
+  // (1.2 m/s: too fast, not planted): never counted.
   FrameFeed run;
   const int frames = 120;
   for (int f = 0; f < frames; ++f) {
@@ -201,7 +202,13 @@ TEST(Evaluation, FootPivotIsTheFootToToeYawRateOfALowSlowToe) {
     pose.toe[0] = {0.1f, 0.03f, 0.2f};
     pose.foot_yaw[0] = 30.0f * t;
     pose.foot_yaw[1] = 90.0f * t;
-    pose.toe[1] = f < frames / 2 ? glm::vec3(-0.1f, 0.1f, 0.2f) : glm::vec3(0.5f * t, 0.02f, 0.2f);
+    if (f < frames / 3) {
+      pose.toe[1] = glm::vec3(-0.1f, 0.1f, 0.2f);
+    } else if (f < 2 * frames / 3) {
+      pose.toe[1] = glm::vec3(0.5f * t, 0.02f, 0.2f);
+    } else {
+      pose.toe[1] = glm::vec3(-0.1f, f % 2 == 0 ? 0.01f : 0.03f, 0.2f);
+    }
     run.add(pose);
   }
   const EvaluationMetrics m = run.metrics();

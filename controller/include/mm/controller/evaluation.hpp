@@ -50,8 +50,11 @@
 // - body_turn_rate_deg_s_p99 / _max: the hips' yaw rate, frame to frame, over the run (nearest
 //   rank percentile);
 // - foot_pivot_deg_s_mean: the yaw rate of the horizontal foot-to-toe vector on frames where
-//   that toe is below kPivotToeHeight and its horizontal speed below kPivotToeSpeed on this and
-//   the previous frame (so it starts at the third frame), over both feet; foot_pivot_frames
+//   that toe is below kPivotToeHeight and its 3-D speed below kPivotToeSpeed on this and the
+//   previous frame (so it starts at the third frame), over both feet. The 3-D speed, because a
+//   toe lifting off is not planted: at a run's push-off the foot passes through vertical with
+//   the toe still low, rising fast, and the yaw of its tiny horizontal part spins through half
+//   a turn in a frame or two; foot_pivot_frames
 //   counts the samples (a side without a foot and a toe role gives none);
 // - turning on the spot: an event starts on a frame where the desired speed is below
 //   kStandTurnSpeed now and kStandTurnLookback earlier and the desired facing differs by at
