@@ -402,6 +402,39 @@ Result<size_t> choose_reference_input(BuildState& state) {
   return *reference_index;
 }
 
+// The database's ground is y = 0. Data farther than this (m) above or below it stands on another
+// ground; nearer, it is left where it is: a foot's end is a joint, above the sole (Bandai's toe
+// joints stop 2.5 cm above their ground; an ankle, where a skeleton has nothing lower, stands
+// several centimetres up).
+constexpr float kGroundTolerance = 0.15f;
+
+// Phase 2a, after retargeting (every clip on the database skeleton): a clip whose feet never come
+// near y = 0 stands on another ground (ReActIdle's people stand 0.7 to 1 m below their root, which
+// is at y = 0, each as tall as they are) and is moved up or down as a whole to put its lowest
+// foot end (lowest_foot_end) on y = 0.
+void stand_on_ground(BuildState& state) {
+  int moved = 0;
+  float least = std::numeric_limits<float>::infinity(), most = 0.0f;
+  for (InputResult& result : state.results) {
+    if (!result.processed) continue;
+    for (Clip& clip : result.clips) {
+      const float lowest = lowest_foot_end(clip, result.roles);
+      if (!std::isfinite(lowest) || std::abs(lowest) <= kGroundTolerance) continue;
+      for (int f = 0; f < clip.frame_count; ++f) clip.pose(f)[0].translation.y -= lowest;
+      ++moved;
+      least = std::min(least, -lowest);
+      most = std::max(most, -lowest);
+    }
+  }
+  if (moved == 0) return;
+  char line[200];
+  std::snprintf(line, sizeof line,
+                "%d clip(s) whose feet never came within %.2f m of y = 0 moved by %+.3f to %+.3f m "
+                "to stand on it",
+                moved, kGroundTolerance, least, most);
+  state.rep.ground_summary = line;
+}
+
 // Phase 2a, after retargeting: idle takes of the data become their calm segments (idle.hpp).
 void split_idle_clips(BuildState& state) {
   int takes = 0;
@@ -697,6 +730,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
 
   const Result<size_t> reference = choose_reference_input(state);
   if (!reference) return Error{reference.message()};
+  stand_on_ground(state);
   split_idle_clips(state);
   if (Status s = start_database(state, *reference); !s) return Error{s.message()};
   if (Status s = lay_out_clips(state, *idle_frames); !s) return Error{s.message()};

@@ -48,14 +48,25 @@ float feet_distance(const Database& db, const std::vector<Transform>& global) {
   return std::hypot(a.x - b.x, a.z - b.z);
 }
 
-// Joint 0 turns about +Y only, so world heights are heights over the simulation root.
+// Joint 0 turns about +Y only, so world heights are heights over the simulation root. A lower
+// arm is an arm end only where the skeleton has no hands; its joint is the elbow, which hangs at
+// the waist, a little below halfway from the hips to the shoulder: it is measured from two thirds
+// of the way from the hips to its upper arm.
 float arm_end_height(const Database& db, const std::vector<int>& arm_ends,
                      const std::vector<Transform>& global) {
   float highest = -std::numeric_limits<float>::infinity();
   if (db.roles.hips < 0) return highest;
   const float hips = global[static_cast<size_t>(db.roles.hips)].translation.y;
+  const int elbows[2][2] = {{db.roles.left_lower_arm, db.roles.left_upper_arm},
+                            {db.roles.right_lower_arm, db.roles.right_upper_arm}};
   for (const int j : arm_ends) {
-    highest = std::max(highest, global[static_cast<size_t>(j)].translation.y - hips);
+    float base = hips;
+    for (const auto& [elbow, upper_arm] : elbows) {
+      if (j == elbow && upper_arm >= 0) {
+        base = hips + (2.0f / 3.0f) * (global[static_cast<size_t>(upper_arm)].translation.y - hips);
+      }
+    }
+    highest = std::max(highest, global[static_cast<size_t>(j)].translation.y - base);
   }
   return highest;
 }

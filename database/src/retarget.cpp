@@ -314,6 +314,22 @@ Result<RetargetSkeleton> describe_for_retargeting(const Clip& clip, const JointR
   return s;
 }
 
+float lowest_foot_end(const Clip& clip, const JointRoleIndices& roles) {
+  const int ends[2] = {roles.left_toe >= 0 ? roles.left_toe : roles.left_foot,
+                       roles.right_toe >= 0 ? roles.right_toe : roles.right_foot};
+  float lowest = std::numeric_limits<float>::infinity();
+  for (int f = 0; f < clip.frame_count; ++f) {
+    const std::vector<Transform> g = globals_of(clip.skeleton, clip.pose(f));
+    for (const int end : ends) {
+      if (end < 0) continue;
+      const glm::vec3 site =
+          clip.end_sites.empty() ? glm::vec3(0.0f) : clip.end_sites[static_cast<size_t>(end)];
+      lowest = std::min(lowest, transform_point(g[static_cast<size_t>(end)], site).y);
+    }
+  }
+  return lowest;
+}
+
 Result<Clip> retarget_clip(const Clip& source, const RetargetSkeleton& from,
                            const RetargetSkeleton& to, RetargetReport* report) {
   if (Status s = check_roles(from, "source"); !s) return Error{s.message()};

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 #include "database_helpers.hpp"
 #include "mm/database/builder.hpp"
@@ -440,6 +441,48 @@ TEST(BuilderMixedSkeletons, ATargetSkeletonIsTheDatabasesAndTakesItsRoles) {
   EXPECT_NE(db.message().find("target "), std::string::npos) << db.message();
   EXPECT_NE(db.message().find("rig.map:2: head=Skull: no joint named 'Skull'"), std::string::npos)
       << db.message();
+}
+
+// The database stands on y = 0. ReActIdle's people stand 0.7 to 1 m below their root (at y = 0);
+// on their skeleton, the take and a walk retargeted onto it (which stands on the take's ground)
+// are moved up, each to put its lowest foot end on y = 0. Bandai's clips, whose toes reach
+// 2.5 cm above y = 0, are left where they are.
+TEST(BuilderMixedSkeletons, DataOnAnotherGroundIsMovedToStandOnYZero) {
+  const fs::path inputs[] = {test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh",
+                             test::clip_path(kClips[0])};
+  BuildOptions options;
+  options.bvh.scale = 0.0f;  // centimetres and metres
+  BuildReport report;
+  Result<Database> db = build_database(inputs, options, &report);
+  ASSERT_TRUE(db) << db.message();
+  EXPECT_EQ(report.ground_summary.rfind("2 clip(s) whose feet never came within 0.15 m of y = 0 "
+                                        "moved by +0.",
+                                        0),
+            0u)
+      << report.ground_summary;
+  const size_t joints = static_cast<size_t>(db->joint_count());
+  std::vector<Transform> local(joints), global(joints);
+  for (const ClipRange& clip : db->clips) {
+    float lowest = std::numeric_limits<float>::infinity();
+    for (int f = clip.start; f < clip.end; ++f) {
+      for (size_t j = 0; j < joints; ++j) {
+        local[j].translation = db->local_positions[static_cast<size_t>(f) * joints + j];
+        local[j].rotation = db->local_rotations[static_cast<size_t>(f) * joints + j];
+      }
+      forward_kinematics(db->skeleton.parents(), local, global);
+      for (const int foot : {db->roles.left_foot, db->roles.right_foot}) {
+        lowest = std::min(lowest, global[static_cast<size_t>(foot)].translation.y);
+      }
+    }
+    // The ankles (this skeleton has no toes) stand a few centimetres above the ground.
+    EXPECT_GT(lowest, 0.0f) << clip.name;
+    EXPECT_LT(lowest, 0.15f) << clip.name;
+  }
+
+  const fs::path bandai[] = {test::clip_path(kClips[0])};
+  BuildReport untouched;
+  ASSERT_TRUE(build_database(bandai, BuildOptions{}, &untouched));
+  EXPECT_EQ(untouched.ground_summary, "");
 }
 
 // Real idle clips (ReActIdle, on another skeleton) are retargeted, cut into calm segments,

@@ -583,6 +583,33 @@ TEST(IdleBuild, SurvivesTheDatabaseFile) {
   EXPECT_EQ(find_calmest_standing_frame(*loaded), reported_source_frame(db, built().report));
 }
 
+// A database on the ReActIdle skeleton (first input, no hands: the lower arms are the arm ends)
+// finds its calmest standing frame: standing people's elbows hang at the waist, above the hips.
+TEST(IdleBuild, OnASkeletonWithoutHandsTheElbowsHangAtTheWaist) {
+  const fs::path take = test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh";
+  BuildOptions options;
+  options.bvh.scale = 0.0f;
+  BuildReport report;
+  Result<Database> db = build_database(std::span(&take, 1), options, &report);
+  ASSERT_TRUE(db) << db.message();
+  ASSERT_LT(db->roles.left_hand, 0);
+  const IdleSourceSearch search = search_idle_source(*db);
+  EXPECT_GT(search.arms_down, 0) << idle_search_failure(search);
+  ASSERT_GE(search.frame, 0);
+  EXPECT_LT(highest_arm_end_over_hips(*db, search.frame), 0.0f);
+  // The elbows themselves are above the hips, which a hand would not be.
+  const size_t joints = static_cast<size_t>(db->joint_count());
+  std::vector<Transform> local(joints), global(joints);
+  for (size_t j = 0; j < joints; ++j) {
+    local[j].translation = db->local_positions[static_cast<size_t>(search.frame) * joints + j];
+    local[j].rotation = db->local_rotations[static_cast<size_t>(search.frame) * joints + j];
+  }
+  forward_kinematics(db->skeleton.parents(), local, global);
+  const float hips = global[static_cast<size_t>(db->roles.hips)].translation.y;
+  EXPECT_GT(global[static_cast<size_t>(db->roles.left_lower_arm)].translation.y, hips);
+  EXPECT_GT(global[static_cast<size_t>(db->roles.right_lower_arm)].translation.y, hips);
+}
+
 // ---- Calm segments of idle takes --------------------------------------------------------------
 
 // A standing figure at 30 Hz for `seconds`: hips, two legs of upper leg, lower leg and foot; the

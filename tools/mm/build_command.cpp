@@ -218,6 +218,9 @@ void print_summary(const std::string& output, const Database& db, const BuildRep
   std::printf("wrote %s\n", output.c_str());
   for (const std::string& line : report.retargeted) std::printf("retargeted:  %s\n", line.c_str());
   if (!report.idle_summary.empty()) std::printf("idle takes:  %s\n", report.idle_summary.c_str());
+  if (!report.ground_summary.empty()) {
+    std::printf("ground:      %s\n", report.ground_summary.c_str());
+  }
   std::printf("input:       %d files, %s read, %d refused\n", report.inputs,
               format_bytes(report.bytes_read).c_str(), static_cast<int>(report.refused.size()));
   const std::string idle_source =

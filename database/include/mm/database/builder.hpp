@@ -122,6 +122,8 @@ struct BuildReport {
   std::vector<std::string> retargeted;
   // How the idle takes of the data were cut into calm segments; empty without idle takes.
   std::string idle_summary;
+  // Clips moved up or down to stand on y = 0, and how far; empty when every clip already did.
+  std::string ground_summary;
   std::vector<RefusedInput> refused;  // inputs left out (only with skip_bad)
 };
 

@@ -17,8 +17,10 @@
 //     IdleCriteria::max_feet_distance horizontally, by forward kinematics of the frame (side
 //     by side, not the double support of a stride);
 //   - the arms hang: every arm end (arm_end_joints: the hands, or the lower arms) is lower
-//     than the hips plus IdleCriteria::max_arm_end_over_hips. Without this the calmest frame
-//     of a gesture take can be a hand held still above the head at the top of the gesture.
+//     than the hips plus IdleCriteria::max_arm_end_over_hips (a lower arm's joint is the elbow,
+//     which hangs at the waist: it is measured from two thirds of the way from the hips to its
+//     upper arm). Without this the calmest frame of a gesture take can be a hand held still above
+//     the head at the top of the gesture.
 // The candidate with the least motion energy wins, the lowest frame on a tie:
 //   energy = sum over every joint but joint 0 of |local angular velocity|^2 (rad^2/s^2)
 //          + sum over the source roots (the children of joint 0) of |local velocity|^2
@@ -77,8 +79,9 @@ float horizontal_feet_distance(const Database& db, int frame);
 // would then pass for a raised hand), which leaves the check out.
 std::vector<int> arm_end_joints(const Skeleton& skeleton, const JointRoleIndices& roles);
 
-// How far in metres the highest arm end of one frame is above the hips (negative: below);
-// minus infinity when there are no arm ends.
+// How far in metres the highest arm end of one frame is above the hips (negative: below), a
+// lower arm above two thirds of the way from the hips to its upper arm; minus infinity when
+// there are no arm ends.
 float highest_arm_end_over_hips(const Database& db, int frame);
 
 // The calmest standing frame and the candidate counts. Reads the motion arrays, contacts,

@@ -69,4 +69,9 @@ Result<Clip> retarget_clip(const Clip& source, const RetargetSkeleton& from,
 // from the rest offsets (metres).
 float leg_length(const Skeleton& skeleton, const JointRoleIndices& roles);
 
+// The lowest height (metres) a foot's end reaches in any frame of `clip`: per side the toe's End
+// Site (the toe joint where it has none), or without a toe role the foot's End Site (or the foot
+// joint). Where a skeleton has its soles in the data, this is about where its ground is.
+float lowest_foot_end(const Clip& clip, const JointRoleIndices& roles);
+
 }  // namespace mm
