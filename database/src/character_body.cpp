@@ -97,13 +97,17 @@ Limbs find_limbs(const Skeleton& skeleton, const JointRoleIndices& roles) {
 }
 
 // The joints of an arm chain that play upper arm, lower arm and hand (and the clavicle before
-// them when the chain has one), or nothing for chains too short to tell.
+// them when the chain has one), or nothing for chains too short to tell. A chain that ends at a
+// lower arm role belongs to a skeleton without hands (ReActIdle's): it has no hand.
 struct ArmJoints {
   int clavicle = -1, upper = -1, lower = -1, hand = -1;
 };
-ArmJoints arm_joints(const std::vector<int>& chain) {
+ArmJoints arm_joints(const std::vector<int>& chain, const JointRoleIndices& roles) {
   ArmJoints a;
-  if (chain.size() >= 4) {
+  const size_t n = chain.size();
+  if (n >= 2 && (chain.back() == roles.left_lower_arm || chain.back() == roles.right_lower_arm)) {
+    a = {n >= 3 ? chain[n - 3] : -1, chain[n - 2], chain[n - 1], -1};
+  } else if (n >= 4) {
     a = {chain[0], chain[1], chain[2], chain[3]};
   } else if (chain.size() == 3) {
     a = {-1, chain[0], chain[1], chain[2]};
@@ -142,6 +146,17 @@ void aim(std::vector<Transform>& global, const Skeleton& skeleton, int joint, in
   if (glm::length(bone) < 1e-6f) return;
   rotate_subtree(global, skeleton, joint, rotation_between(glm::normalize(bone), dir, kForward),
                  from);
+}
+
+// The direction of a leaf bone (a lower arm without a hand), which has no child to point to: the
+// axis of its own frame that its parent's bone runs along in the parent's frame. Rigs keep one
+// convention for every bone (along local Y in Blender's, X in Bandai's), so this is its bone.
+glm::vec3 leaf_direction(std::span<const Transform> global, int parent, int joint) {
+  const Transform& p = global[static_cast<size_t>(parent)];
+  const Transform& j = global[static_cast<size_t>(joint)];
+  const glm::vec3 bone = j.translation - p.translation;
+  if (glm::length(bone) < 1e-6f) return -kUp;
+  return glm::normalize(j.rotation * (glm::inverse(p.rotation) * glm::normalize(bone)));
 }
 
 // Turns the pose about the vertical through the hips so that the right thigh -> left thigh
@@ -192,12 +207,19 @@ float side_of(const std::vector<Transform>& global, const JointRoleIndices& role
 void pose_arms(std::vector<Transform>& global, const Skeleton& skeleton,
                const JointRoleIndices& roles, const Limbs& limbs, float angle) {
   for (const std::vector<int>& chain : limbs.arms) {
-    const ArmJoints arm = arm_joints(chain);
+    const ArmJoints arm = arm_joints(chain, roles);
     if (arm.upper < 0) continue;
     const float side = side_of(global, roles, arm.upper);
     const glm::vec3 dir(side * std::cos(angle), -std::sin(angle), 0.0f);
     aim(global, skeleton, arm.upper, arm.lower, dir);
-    aim(global, skeleton, arm.lower, arm.hand, dir);
+    if (arm.hand >= 0) {
+      aim(global, skeleton, arm.lower, arm.hand, dir);
+    } else {
+      const glm::vec3& elbow = global[static_cast<size_t>(arm.lower)].translation;
+      rotate_subtree(global, skeleton, arm.lower,
+                     rotation_between(leaf_direction(global, arm.upper, arm.lower), dir, kForward),
+                     elbow);
+    }
   }
 }
 
@@ -352,12 +374,12 @@ std::vector<Part> classify(const Skeleton& skeleton, const JointRoleIndices& rol
   for (int j : limbs.spine) part[static_cast<size_t>(j)] = Part::Spine;
   if (roles.head >= 0) part[static_cast<size_t>(roles.head)] = Part::Head;
   for (const std::vector<int>& chain : limbs.arms) {
-    const ArmJoints a = arm_joints(chain);
+    const ArmJoints a = arm_joints(chain, roles);
     if (a.clavicle >= 0) part[static_cast<size_t>(a.clavicle)] = Part::Clavicle;
     if (a.upper < 0) continue;
     part[static_cast<size_t>(a.upper)] = Part::UpperArm;
     part[static_cast<size_t>(a.lower)] = Part::LowerArm;
-    part[static_cast<size_t>(a.hand)] = Part::Hand;
+    if (a.hand >= 0) part[static_cast<size_t>(a.hand)] = Part::Hand;
   }
   for (const std::vector<int>& chain : limbs.legs) {
     const LegJoints l = leg_joints(chain);
@@ -442,6 +464,14 @@ void add_joint(SegmentBuilder& b, const std::vector<Part>& part, const Limbs& li
     case Part::UpperArm:
       return to_child(Part::LowerArm, kUpperArm);
     case Part::LowerArm:
+      if (first_child_with(Part::Hand) < 0 && parent >= 0) {
+        // No hand (a skeleton without): the forearm as long as the upper arm, and a hand.
+        const glm::vec3 along = leaf_direction(b.global, parent, joint);
+        const float forearm = glm::distance(b.at(parent), b.at(joint));
+        b.add(joint, b.at(joint), b.at(joint) + along * forearm, kLowerArm);
+        b.add(joint, b.at(joint) + along * forearm,
+              b.at(joint) + along * (forearm + kHandLength * b.scale), kHand);
+      }
       return to_child(Part::Hand, kLowerArm);
     case Part::Hand:
       b.add_extension(joint, from_parent, kHandLength, kHand);

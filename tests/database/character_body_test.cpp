@@ -240,6 +240,41 @@ TEST(CharacterBody, AGenericSkeletonGetsABodyToo) {
   EXPECT_EQ(same[3].translation, rest[3].translation);
 }
 
+// A skeleton without hands (ReActIdle's: the lower arms are leaves, the wrist only an End Site)
+// still gets whole arms: the forearm, as long as the upper arm, and a hand, out and down with
+// the upper arm in the A-pose.
+TEST(CharacterBody, ASkeletonWithoutHandsGetsForearmsAndHands) {
+  const fs::path take = test::mocap_dir() / "reactidle" / "genuine" / "000_genuine.bvh";
+  BuildOptions build;
+  build.bvh.scale = 0.0f;
+  Result<Database> db = build_database(std::span(&take, 1), build);
+  ASSERT_TRUE(db.ok()) << db.message();
+  ASSERT_LT(db->roles.left_hand, 0);
+  const std::vector<Transform> pose = clip_frame(*db, db->clips[0], 0);
+  const std::vector<Transform> bind = make_bind_pose(db->skeleton, pose, db->roles);
+  std::vector<Transform> global(bind.size());
+  forward_kinematics(db->skeleton.parents(), bind, global);
+  const std::vector<BoneSegment> segments =
+      character_bone_segments(db->skeleton, global, db->roles, 0.0f);
+  for (const auto& [lower, upper] :
+       {std::pair{db->roles.left_lower_arm, db->roles.left_upper_arm},
+        std::pair{db->roles.right_lower_arm, db->roles.right_upper_arm}}) {
+    const glm::vec3 shoulder = global[static_cast<size_t>(upper)].translation;
+    const glm::vec3 elbow = global[static_cast<size_t>(lower)].translation;
+    float reach = 0.0f;
+    glm::vec3 tip(0.0f);
+    for (const BoneSegment& segment : segments) {
+      if (segment.joint != lower || glm::distance(segment.tail, elbow) <= reach) continue;
+      reach = glm::distance(segment.tail, elbow);
+      tip = segment.tail;
+    }
+    // Longer than the upper arm (forearm and hand), and on from the elbow as the upper arm goes.
+    EXPECT_GT(reach, glm::distance(shoulder, elbow)) << db->skeleton.name(lower);
+    EXPECT_GT(glm::dot(glm::normalize(tip - elbow), glm::normalize(elbow - shoulder)), 0.95f)
+        << db->skeleton.name(lower);
+  }
+}
+
 TEST(CharacterBody, RefusesWhatItCannotBuildByMessage) {
   std::vector<Transform> rest(2);
   rest[1].translation = {0.0f, 0.3f, 0.0f};

@@ -20,9 +20,11 @@
 //    from hips to head as two capsules side by side (a torso is wider than deep), the neck,
 //    the head an elongated sphere above the neck, clavicles, arms and legs tapering toward the
 //    hands and feet, a heel under each ankle; hands and toes, which are leaves without length
-//    in the Bandai skeleton, are given length along their parent bone. Joints the roles do not
-//    explain (fingers, tails, a skeleton without roles) get capsules to their children whose
-//    radius follows the bone's length. Joints above the hips get no geometry. Each segment
+//    in the Bandai skeleton, are given length along their parent bone, and a lower arm without
+//    a hand (ReActIdle's) a forearm as long as its upper arm and a hand, along the axis of its
+//    frame that the upper arm runs along in its own (the bind pose aims it likewise). Joints the
+//    roles do not explain (fingers, tails, a skeleton without roles) get capsules to their children
+//    whose radius follows the bone's length. Joints above the hips get no geometry. Each segment
 //    belongs to the joint it starts at.
 // 3. Mesh and weights: generate_body_mesh (runtime/body.hpp) and compute_bone_weights
 //    (runtime/bone_weights.hpp) with the caller's method, heat diffusion by default.
