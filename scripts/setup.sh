@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libglm-dev libtinygltf-dev libflann-dev nlohmann-json3-dev libstb-dev
+  libglm-dev libeigen3-dev libtinygltf-dev libflann-dev nlohmann-json3-dev libstb-dev
   libglfw3-dev libgl-dev libegl-dev libosmesa6-dev libgl1-mesa-dri xvfb xauth libimgui-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang clang-format libclang-rt-14-dev xz-utils

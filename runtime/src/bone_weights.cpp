@@ -10,6 +10,8 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/SparseCholesky>
+
 namespace mm {
 
 namespace {
@@ -96,16 +98,13 @@ Status require_positive(float value, const char* name) {
 }
 
 Status validate_options(const BoneWeightOptions& o) {
-  const std::pair<float, const char*> positives[] = {
-      {o.distance_power, "distance_power"},     {o.distance_softness, "distance_softness"},
-      {o.envelope_falloff, "envelope_falloff"}, {o.heat_constant, "heat_constant"},
-      {o.heat_tolerance, "heat_tolerance"},     {o.geodesic_falloff, "geodesic_falloff"}};
+  const std::pair<float, const char*> positives[] = {{o.distance_power, "distance_power"},
+                                                     {o.distance_softness, "distance_softness"},
+                                                     {o.envelope_falloff, "envelope_falloff"},
+                                                     {o.heat_constant, "heat_constant"},
+                                                     {o.geodesic_falloff, "geodesic_falloff"}};
   for (const auto& [value, name] : positives) {
     if (Status s = require_positive(value, name); !s) return s;
-  }
-  if (o.heat_max_iterations <= 0) {
-    return Error{"bone weights: option heat_max_iterations must be > 0 (got " +
-                 std::to_string(o.heat_max_iterations) + ")"};
   }
   // Below 1/4 the largest of four normalized weights (>= 1/4) is never dropped.
   if (!(o.min_weight >= 0.0f && o.min_weight < 0.25f)) {
@@ -336,12 +335,10 @@ RawWeights geodesic_weights(const Proximity& px, const EdgeGraph& graph,
 // ---------------------------------------------------------------------------------------------
 // Heat diffusion.
 
-// The symmetric matrix L + H on the edge graph: off-diagonal entries -1 / length^2 in the
-// graph's layout, and the diagonal.
+// The symmetric positive definite matrix L + H on the edge graph (off-diagonal entries
+// -1 / length^2, the diagonal their negated sum plus H), and H.
 struct HeatSystem {
-  const EdgeGraph* graph = nullptr;
-  std::vector<double> off_diagonal;
-  std::vector<double> diagonal;
+  Eigen::SparseMatrix<double> matrix;
   std::vector<double> heat;  // H
 };
 
@@ -349,93 +346,61 @@ HeatSystem build_heat_system(const EdgeGraph& graph, const Proximity& px,
                              const BoneWeightOptions& options) {
   const size_t n = px.nearest.size();
   HeatSystem sys;
-  sys.graph = &graph;
-  sys.off_diagonal.resize(graph.neighbors.size());
-  sys.diagonal.assign(n, 0.0);
   sys.heat.resize(n);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(n + graph.neighbors.size());
   for (size_t v = 0; v < n; ++v) {
     const double axis = std::max(px.nearest_axis[v], graph.length_floor);
     sys.heat[v] = static_cast<double>(options.heat_constant) / (axis * axis);
-    sys.diagonal[v] = sys.heat[v];
+    double diagonal = sys.heat[v];
+    const int row = static_cast<int>(v);
     for (uint32_t e = graph.offsets[v]; e < graph.offsets[v + 1]; ++e) {
       const double length = graph.lengths[e];
-      sys.off_diagonal[e] = -1.0 / (length * length);
-      sys.diagonal[v] += 1.0 / (length * length);
+      entries.emplace_back(row, static_cast<int>(graph.neighbors[e]), -1.0 / (length * length));
+      diagonal += 1.0 / (length * length);
     }
+    entries.emplace_back(row, row, diagonal);
   }
+  sys.matrix.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  sys.matrix.setFromTriplets(entries.begin(), entries.end());
   return sys;
 }
 
-void multiply(const HeatSystem& sys, const std::vector<double>& x, std::vector<double>& y) {
-  const EdgeGraph& g = *sys.graph;
-  for (size_t v = 0; v < x.size(); ++v) {
-    double sum = sys.diagonal[v] * x[v];
-    for (uint32_t e = g.offsets[v]; e < g.offsets[v + 1]; ++e) {
-      sum += sys.off_diagonal[e] * x[g.neighbors[e]];
-    }
-    y[v] = sum;
-  }
-}
-
-double dot(const std::vector<double>& a, const std::vector<double>& b) {
-  double sum = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) sum += a[i] * b[i];
-  return sum;
-}
-
-// Solves sys * x = b by Jacobi-preconditioned conjugate gradients from the x given; returns
-// the relative residual reached (<= tolerance on success).
-double conjugate_gradient(const HeatSystem& sys, const std::vector<double>& b,
-                          std::vector<double>& x, double tolerance, int max_iterations) {
-  const size_t n = b.size();
-  std::vector<double> r(n), z(n), p(n), q(n);
-  multiply(sys, x, q);
-  for (size_t i = 0; i < n; ++i) r[i] = b[i] - q[i];
-  for (size_t i = 0; i < n; ++i) z[i] = r[i] / sys.diagonal[i];
-  p = z;
-  double rz = dot(r, z);
-  const double b_norm = std::sqrt(dot(b, b));
-  double residual = std::sqrt(dot(r, r)) / b_norm;
-  for (int k = 0; k < max_iterations && residual > tolerance; ++k) {
-    multiply(sys, p, q);
-    const double alpha = rz / dot(p, q);
-    for (size_t i = 0; i < n; ++i) x[i] += alpha * p[i];
-    for (size_t i = 0; i < n; ++i) r[i] -= alpha * q[i];
-    for (size_t i = 0; i < n; ++i) z[i] = r[i] / sys.diagonal[i];
-    const double rz_next = dot(r, z);
-    const double beta = rz_next / rz;
-    rz = rz_next;
-    for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
-    residual = std::sqrt(dot(r, r)) / b_norm;
-  }
-  return residual;
-}
-
+// Every joint's system at once: L + H is factored once (sparse Cholesky, LDL^T) and solved for
+// the right-hand sides of all the joints that own a vertex together.
 Result<RawWeights> heat_weights(const Proximity& px, const EdgeGraph& graph,
                                 const JointTable& joints, const BoneWeightOptions& options) {
   const size_t jc = px.joint_count;
   const size_t n = px.nearest.size();
   const HeatSystem sys = build_heat_system(graph, px, options);
+  // Columns only for joints nearest to some vertex: the others' weights are exactly 0.
+  std::vector<int> column(jc, -1);
+  int columns = 0;
+  for (size_t v = 0; v < n; ++v) {
+    int& c = column[px.nearest[v]];
+    if (c < 0) c = columns++;
+  }
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), columns);
+  for (size_t v = 0; v < n; ++v) {
+    rhs(static_cast<Eigen::Index>(v), column[px.nearest[v]]) = sys.heat[v];
+  }
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(sys.matrix);
+  if (solver.info() != Eigen::Success) {
+    return Error{"bone weights: the heat diffusion system (L + H, " + std::to_string(n) +
+                 " vertices) could not be factored"};
+  }
+  const Eigen::MatrixXd solution = solver.solve(rhs);
   RawWeights raw(n * jc, 0.0f);
-  std::vector<double> b(n), x(n);
   for (size_t j = 0; j < jc; ++j) {
-    bool sourced = false;
+    if (column[j] < 0) continue;
     for (size_t v = 0; v < n; ++v) {
-      const bool owns = px.nearest[v] == j;
-      x[v] = owns ? 1.0 : 0.0;  // the warm start: the nearest-bone binding
-      b[v] = owns ? sys.heat[v] : 0.0;
-      sourced = sourced || owns;
+      const double w = solution(static_cast<Eigen::Index>(v), column[j]);
+      if (!std::isfinite(w)) {
+        return Error{"bone weights: heat diffusion for joint " + std::to_string(joints.ids[j]) +
+                     " gave a non-finite weight"};
+      }
+      raw[v * jc + j] = static_cast<float>(std::max(w, 0.0));
     }
-    if (!sourced) continue;  // no vertex is nearest to j: its weights are exactly 0
-    const double residual =
-        conjugate_gradient(sys, b, x, options.heat_tolerance, options.heat_max_iterations);
-    if (!(residual <= options.heat_tolerance)) {
-      return Error{"bone weights: heat diffusion for joint " + std::to_string(joints.ids[j]) +
-                   " did not converge in " + std::to_string(options.heat_max_iterations) +
-                   " iterations (relative residual " + std::to_string(residual) +
-                   "); raise heat_max_iterations or heat_tolerance"};
-    }
-    for (size_t v = 0; v < n; ++v) raw[v * jc + j] = static_cast<float>(std::max(x[v], 0.0));
   }
   return raw;
 }

@@ -25,13 +25,12 @@
 //   an even tessellation, so it matches H's units, and it was chosen over the cotangent
 //   Laplacian because its off-diagonal entries are never positive: L + H is then a symmetric
 //   M-matrix, so the solution stays in [0, 1] and sums to 1 over the joints (up to the solver's
-//   tolerance, whose tiny negative residue is clipped to 0),
+//   rounding, whose tiny negative residue is clipped to 0),
 //   whereas cotangent weights turn negative on obtuse triangles (and need triangle areas, which
 //   degenerate triangles lack). Every vertex is heated, so each connected component, even one
-//   far from every bone or a lone vertex, has a unique solution. Solved by Jacobi-preconditioned
-//   conjugate gradients in double precision, warm-started at p_j, until the residual is below
-//   heat_tolerance times the right-hand side; not converging within heat_max_iterations is an
-//   error, never a half-solved result.
+//   far from every bone or a lone vertex, has a unique solution. L + H is factored once by a
+//   sparse Cholesky (LDL^T, Eigen's SimplicialLDLT) in double precision and solved for every
+//   joint together.
 // - Geodesic: per joint, multi-source Dijkstra over the mesh's edges (Euclidean edge lengths)
 //   from every vertex whose nearest bone belongs to j (distance 0); w_j falls smoothly
 //   (smoothstep) from 1 at geodesic distance 0 to 0 at geodesic_falloff. Weights do not leak
@@ -78,8 +77,6 @@ struct BoneWeightOptions {
   float distance_softness = 0.05f;  // Distance: metres, > 0; how far apart two bones blend
   float envelope_falloff = 0.05f;   // Envelope: metres, > 0; width of the falloff outside
   float heat_constant = 1.0f;       // HeatDiffusion: > 0; larger holds weights nearer the bone
-  float heat_tolerance = 1e-6f;     // HeatDiffusion: > 0; relative residual to stop the solve
-  int heat_max_iterations = 5000;   // HeatDiffusion: > 0; conjugate-gradient iterations per joint
   float geodesic_falloff = 0.1f;    // Geodesic: metres, > 0; surface distance a weight reaches
   float min_weight = 0.01f;         // all: in [0, 0.25); smaller weights are dropped
 };
