@@ -1,10 +1,11 @@
-// Principal axes of the feature rows (a Jacobi eigen decomposition of their covariance), and
+// Principal axes of the feature rows (the eigen decomposition of their covariance, by Eigen), and
 // the exact re-ranking that keeps searches in the rotated space exact.
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <numeric>
+
+#include <Eigen/Eigenvalues>
 
 #include "detail.hpp"
 
@@ -88,56 +89,6 @@ float rotate_rows(const FeatureRotation& rotation, float* rows, int count, int d
   return max_norm;
 }
 
-namespace {
-
-// Eigen decomposition of the symmetric matrix `a` (n x n, destroyed) by cyclic Jacobi
-// rotations: on return the diagonal of `a` holds the eigenvalues and the columns of `v` the
-// eigenvectors. Plenty for n <= kMaxSearchDims at build time.
-void jacobi_eigen(size_t n, std::vector<double>& a, std::vector<double>& v) {
-  v.assign(n * n, 0.0);
-  for (size_t i = 0; i < n; ++i) v[i * n + i] = 1.0;
-  for (int sweep = 0; sweep < 64; ++sweep) {
-    double off = 0.0;
-    double diagonal = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      diagonal += a[i * n + i] * a[i * n + i];
-      for (size_t j = i + 1; j < n; ++j) off += a[i * n + j] * a[i * n + j];
-    }
-    if (off <= 1e-24 * diagonal || off == 0.0) return;
-    for (size_t p = 0; p < n; ++p) {
-      for (size_t q = p + 1; q < n; ++q) {
-        const double apq = a[p * n + q];
-        if (apq == 0.0) continue;
-        const double theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
-        const double t =
-            (theta >= 0.0 ? 1.0 : -1.0) / (std::fabs(theta) + std::sqrt(theta * theta + 1.0));
-        const double c = 1.0 / std::sqrt(t * t + 1.0);
-        const double s = t * c;
-        for (size_t k = 0; k < n; ++k) {
-          const double akp = a[k * n + p];
-          const double akq = a[k * n + q];
-          a[k * n + p] = c * akp - s * akq;
-          a[k * n + q] = s * akp + c * akq;
-        }
-        for (size_t k = 0; k < n; ++k) {
-          const double apk = a[p * n + k];
-          const double aqk = a[q * n + k];
-          a[p * n + k] = c * apk - s * aqk;
-          a[q * n + k] = s * apk + c * aqk;
-        }
-        for (size_t k = 0; k < n; ++k) {
-          const double vkp = v[k * n + p];
-          const double vkq = v[k * n + q];
-          v[k * n + p] = c * vkp - s * vkq;
-          v[k * n + q] = s * vkp + c * vkq;
-        }
-      }
-    }
-  }
-}
-
-}  // namespace
-
 FeatureRotation principal_axes(const float* rows, int row_count, int dims, int max_sample_rows) {
   FeatureRotation rotation;
   rotation.dims = dims;
@@ -145,7 +96,7 @@ FeatureRotation principal_axes(const float* rows, int row_count, int dims, int m
   const auto n = static_cast<size_t>(dims);
   const auto padded = static_cast<size_t>(rotation.padded_dims);
   std::vector<double> mean(n, 0.0);
-  std::vector<double> covariance(n * n, 0.0);
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(dims, dims);
   const int step = std::max(1, row_count / std::max(1, max_sample_rows));
   size_t samples = 0;
   for (int r = 0; r < row_count; r += step, ++samples) {
@@ -157,31 +108,23 @@ FeatureRotation principal_axes(const float* rows, int row_count, int dims, int m
   std::vector<double> centred(n);
   for (int r = 0; r < row_count; r += step) {
     for (size_t d = 0; d < n; ++d) centred[d] = rows[static_cast<size_t>(r) * n + d] - mean[d];
-    for (size_t a = 0; a < n; ++a) {
-      for (size_t b = a; b < n; ++b) covariance[a * n + b] += centred[a] * centred[b];
-    }
+    const Eigen::Map<const Eigen::VectorXd> c(centred.data(), dims);
+    covariance.selfadjointView<Eigen::Lower>().rankUpdate(c);
   }
-  for (size_t a = 0; a < n; ++a) {
-    for (size_t b = a; b < n; ++b) {
-      covariance[a * n + b] /= static_cast<double>(std::max<size_t>(samples, 1));
-      covariance[b * n + a] = covariance[a * n + b];
-    }
-  }
-  std::vector<double> vectors;
-  jacobi_eigen(n, covariance, vectors);
-  std::vector<size_t> order(n);
-  std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return covariance[a * n + a] > covariance[b * n + b];
-  });
+  covariance /= static_cast<double>(std::max<size_t>(samples, 1));
+  // Eigen's solver reads the lower triangle, which rankUpdate filled.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(covariance);
+  const Eigen::VectorXd& values = solver.eigenvalues();  // ascending
+  const Eigen::MatrixXd& vectors = solver.eigenvectors();
   rotation.mean.assign(mean.begin(), mean.end());
   rotation.axes.assign(n * padded, 0.0f);
   rotation.variance.assign(n, 0.0);
-  for (size_t k = 0; k < n; ++k) {
-    const size_t source = order[k];
-    rotation.variance[k] = std::max(0.0, covariance[source * n + source]);
+  for (size_t k = 0; k < n; ++k) {  // the largest variance first
+    const Eigen::Index source = dims - 1 - static_cast<Eigen::Index>(k);
+    rotation.variance[k] = std::max(0.0, values(source));
     for (size_t d = 0; d < n; ++d) {
-      rotation.axes[d * padded + k] = static_cast<float>(vectors[d * n + source]);
+      rotation.axes[d * padded + k] =
+          static_cast<float>(vectors(static_cast<Eigen::Index>(d), source));
     }
   }
   return rotation;
