@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "mm/runtime/constraints.hpp"
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/ik.hpp"
 #include "mm/runtime/pose.hpp"
@@ -54,13 +55,9 @@ constexpr float kLiftHalflife = 0.06f;
 constexpr float kStepReach = 1.03f;
 const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
 
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-bool finite(const glm::quat& q) {
-  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
-         glm::length(q) > 0.5f;
+// A rotation a game may hand in: finite and not far from unit length (it is normalized).
+bool usable_rotation(const glm::quat& q) {
+  return finite(q) && glm::length(q) > 0.5f;
 }
 
 glm::quat yaw_rotation(float yaw) {
@@ -959,7 +956,7 @@ void Controller::turn_chest_to_facing(float dt) {
 
 // adjust_root() relative to the origin.
 void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& rotation) {
-  if (!finite(position) || !finite(rotation) || clip_ < 0) return;
+  if (!finite(position) || !usable_rotation(rotation) || clip_ < 0) return;
   body_yaw_known_ = false;
   move_root(position, glm::normalize(rotation));
   // The feet go with the body: held toes would otherwise pull the legs back.

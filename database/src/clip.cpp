@@ -1,14 +1,11 @@
 #include "mm/database/clip.hpp"
+#include "mm/runtime/finite.hpp"
 
 #include <cmath>
 
 namespace mm {
 
-namespace {
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-}  // namespace
+namespace {}  // namespace
 
 Status Clip::validate() const {
   const std::string where = "clip '" + name + "': ";

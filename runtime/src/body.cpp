@@ -1,4 +1,5 @@
 #include "mm/runtime/body.hpp"
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
@@ -18,10 +19,6 @@ std::string number(double v) {
   std::ostringstream out;
   out << v;
   return out.str();
-}
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 // A tapered capsule with everything that does not depend on the query point computed once.

@@ -1,4 +1,5 @@
 #include "mm/runtime/bone_weights.hpp"
+#include "mm/runtime/finite.hpp"
 
 #include <algorithm>
 #include <array>
@@ -26,10 +27,6 @@ constexpr float kDominanceTolerance = 1e-6f;
 
 std::string str(size_t n) {
   return std::to_string(n);
-}
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 // ---------------------------------------------------------------------------------------------

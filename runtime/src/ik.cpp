@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
 
 namespace mm {
@@ -12,14 +13,6 @@ namespace {
 
 // Bones shorter than this (metres) cannot be bent meaningfully.
 constexpr float kMinBoneLength = 1e-6f;
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-bool finite(const glm::quat& q) {
-  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
-}
 
 // The unsigned angle between two vectors, accurate near 0 and pi (atan2 rather than acos).
 float angle_between(const glm::vec3& u, const glm::vec3& v) {

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
 
 namespace mm {
@@ -23,14 +24,6 @@ double settled(double value) {
 glm::vec3 settled(const glm::vec3& v) {
   auto component = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
   return {component(v.x), component(v.y), component(v.z)};
-}
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-bool finite(const glm::quat& q) {
-  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
 }
 
 double angular_frequency(float halflife) {

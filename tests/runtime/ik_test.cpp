@@ -65,9 +65,8 @@ struct Leg {
 };
 
 bool finite_result(const TwoBoneIkResult& r) {
-  return test::finite_quat(r.root_local) && test::finite_quat(r.mid_local) &&
-         test::finite_quat(r.root_global) && test::finite_quat(r.mid_global) &&
-         test::finite_vec3(r.mid_position) && test::finite_vec3(r.end_position);
+  return finite(r.root_local) && finite(r.mid_local) && finite(r.root_global) &&
+         finite(r.mid_global) && finite(r.mid_position) && finite(r.end_position);
 }
 
 // The distance of the knee from the plane through the hip spanned by `direction` and `pole`,

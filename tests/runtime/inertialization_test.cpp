@@ -359,7 +359,7 @@ TEST(RotationVectorJacobian, MatchesFiniteDifferenceAndInverts) {
   // At exactly pi the inverse is finite.
   const glm::vec3 at_pi =
       angular_velocity_to_rotation_vector_rate(glm::vec3(0.0f, glm::pi<float>(), 0.0f), r);
-  EXPECT_TRUE(test::finite_vec3(at_pi));
+  EXPECT_TRUE(finite(at_pi));
 }
 
 }  // namespace

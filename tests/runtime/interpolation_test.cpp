@@ -153,7 +153,7 @@ TEST(QuatSlerp, NearIdentityDoesNotDivideByZero) {
     const glm::quat b = glm::angleAxis(angle, kZ);
     for (float t : {0.0f, 0.25f, 0.5f, 1.0f}) {
       const glm::quat s = quat_slerp(a, b, t);
-      ASSERT_TRUE(test::finite_quat(s)) << angle << " " << t;
+      ASSERT_TRUE(finite(s)) << angle << " " << t;
       EXPECT_NEAR(glm::length(s), 1.0f, 1e-6f);
       // The angle still grows linearly: the z component is sin(t * angle / 2).
       EXPECT_NEAR(s.z, std::sin(0.5f * t * angle), 1e-6f * angle + 1e-30f);
@@ -181,7 +181,7 @@ TEST(QuatSlerp, AntipodalInputs) {
     for (int k = 0; k <= 10; ++k) {
       const float t = k / 10.0f;
       const glm::quat s = quat_slerp(a, b, t);
-      ASSERT_TRUE(test::finite_quat(s));
+      ASSERT_TRUE(finite(s));
       EXPECT_NEAR(glm::length(s), 1.0f, 1e-6f);
       EXPECT_NEAR(rotation_angle_between(a, s), t * kPi, 1e-4) << t;
     }
@@ -314,7 +314,7 @@ TEST(Sclerp, PureTranslationIsLinear) {
     for (int k = 0; k <= 10; ++k) {
       const float t = k / 10.0f;
       const Transform s = transform_sclerp(a, b, t);
-      ASSERT_TRUE(test::finite_vec3(s.translation));
+      ASSERT_TRUE(finite(s.translation));
       EXPECT_TRUE(near_vec3(s.translation, glm::mix(a.translation, b.translation, t), 1e-5f));
       EXPECT_TRUE(same_rotation(s.rotation, a.rotation, 1e-6f));
     }
@@ -334,7 +334,7 @@ TEST(Sclerp, AntipodalRotations) {
   const glm::vec3 center(1.0f, 0.0f, 0.0f);
   const Transform half_turn = screw_motion(kPi, center, 0.0f);
   const Transform s = transform_sclerp(Transform{}, half_turn, 0.5f);
-  ASSERT_TRUE(test::finite_quat(s.rotation));
+  ASSERT_TRUE(finite(s.rotation));
   EXPECT_NEAR(rotation_angle_between(glm::quat(1, 0, 0, 0), s.rotation), 0.5 * kPi, 1e-5);
   // Either quarter turn about that line is a valid midpoint; both keep the line fixed.
   EXPECT_TRUE(near_vec3(transform_point(s, center), center, 1e-5f));

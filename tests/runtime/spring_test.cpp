@@ -338,7 +338,7 @@ TEST(SpringCharacter, VelocityHalflifeAndConvergence) {
   spring_character_update(x, v, a, glm::vec3(0, 0, 4.0f), 0.25f, 0.25f);
   EXPECT_NEAR(v.z, 2.0f, 1e-5f);
   spring_character_update(x, v, a, glm::vec3(0, 0, 4.0f), 0.25f, 1e9f);
-  EXPECT_TRUE(test::finite_vec3(x));
+  EXPECT_TRUE(finite(x));
   EXPECT_EQ(v, glm::vec3(0, 0, 4.0f));
   EXPECT_EQ(a, glm::vec3(0.0f));
   // dt = 0 and a NaN desired velocity change nothing.

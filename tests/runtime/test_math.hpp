@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/transform.hpp"
 
 namespace mm::test {
@@ -73,14 +74,6 @@ inline ::testing::AssertionResult near_vec3(const glm::vec3& a, const glm::vec3&
   return ::testing::AssertionFailure()
          << "vectors differ by " << err << ": (" << a.x << ", " << a.y << ", " << a.z << ") vs ("
          << b.x << ", " << b.y << ", " << b.z << ")";
-}
-
-inline bool finite_quat(const glm::quat& q) {
-  return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
-}
-
-inline bool finite_vec3(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 // Whether no component is a subnormal float (whose arithmetic is slow on x86).

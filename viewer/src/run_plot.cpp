@@ -13,20 +13,11 @@
 // (and none has to pass this project's warnings).
 #include <stb_easy_font.h>
 #include <stb_image_write.h>
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 
 namespace mm::viewer {
 namespace {
-
-bool finite(float v) {
-  return std::isfinite(v);
-}
-bool finite(const glm::vec2& v) {
-  return finite(v.x) && finite(v.y);
-}
-bool finite(const glm::vec3& v) {
-  return finite(v.x) && finite(v.y) && finite(v.z);
-}
 
 // Options a caller can set to anything, brought into ranges the drawing relies on.
 RunPlotOptions sanitized(RunPlotOptions o) {

@@ -23,6 +23,7 @@
 
 #include "gltf_files.hpp"
 #include "mm/database/files.hpp"
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/pose.hpp"
 
@@ -39,13 +40,6 @@ constexpr size_t kMaxZeroAccessorElements = 1'000'000;
 
 // ---------------------------------------------------------------------------------------------
 // Small helpers
-
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-bool finite(const glm::quat& q) {
-  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
-}
 
 // A number as a person would write it in a message ("2.5", "1e+09"), not std::to_string's
 // "2.500000".
