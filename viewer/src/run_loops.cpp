@@ -83,7 +83,7 @@ void draw_frame(Stage& stage, Scene& scene, bool show_panel) {
       int width = 0, height = 0;
       stage.context->framebuffer_size(width, height);
       ImGui::GetIO().DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
-      ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+      ImGui::GetIO().DeltaTime = kDefaultRunDt;
     }
     ImGui::NewFrame();
     if (show_panel) draw_panel(scene, stage.panel);
@@ -150,7 +150,7 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
     std::fprintf(stderr, "mm-viewer: %s\n", script.message().c_str());
     return 1;
   }
-  const float dt = options.dt > 0.0f ? options.dt : 1.0f / 60.0f;
+  const float dt = options.dt > 0.0f ? options.dt : kDefaultRunDt;
   // The same bounds as mm eval (script.hpp): a run too long is refused before anything is
   // built for it.
   const Result<int> script_frames = scripted_run_frames(script->duration() + 2.0f, dt);

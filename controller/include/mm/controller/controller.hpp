@@ -441,10 +441,9 @@ class Controller {
   float foot_heading(int side) const;
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
   void restore_leg_lengths(int side);
-  void refresh_subtree(int joint);
-  float leg_length(int side) const;
-  float foot_length(int side) const;  // upper plus lower leg in the played pose (m)  // globals of
-                                      // a joint and its descendants from the locals
+  void refresh_subtree(int joint);    // globals of a joint and its descendants from the locals
+  float leg_length(int side) const;   // upper plus lower leg in the played pose (m)
+  float foot_length(int side) const;  // ankle to toe in the played pose (m; 0 without a toe)
   void finish_pose();
   void refresh_outputs(float dt);
   uint64_t resolve_tag(std::string_view tag) const;
@@ -463,9 +462,8 @@ class Controller {
     bool direction = false;
   };
   std::vector<TrajectoryColumn> trajectory_columns_;
-  std::vector<int> leg_joints_[2];
-  std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)  //
-                                    // upper leg, lower leg, foot, toe per side
+  std::vector<int> leg_joints_[2];  // upper leg, lower leg, foot, toe per side
+  std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)
 
   // Every position below is relative to this world position (local_origin.hpp).
   glm::dvec3 origin_{0.0};

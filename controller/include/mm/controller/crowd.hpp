@@ -34,7 +34,7 @@ inline constexpr float kCrowdWindowSeconds = 20.0f;
 struct CrowdOptions {
   int characters = 100;
   float seconds = 10.0f;  // of game time
-  float dt = 1.0f / 60.0f;
+  float dt = kDefaultRunDt;
   int threads = 1;  // >= 1; characters are split into contiguous slices
   ControllerSettings settings;
 };

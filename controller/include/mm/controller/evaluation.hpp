@@ -218,7 +218,7 @@ class EvaluationAccumulator {
 
 struct EvaluationOptions {
   // Seconds per update, in [kMinRunDt, kMaxRunDt] (script.hpp).
-  float dt = 1.0f / 60.0f;
+  float dt = kDefaultRunDt;
   // Seconds to run; 0: the script's duration plus 2 s (so its last line is seen through). The
   // run may take at most kMaxRunFrames updates (script.hpp).
   float seconds = 0.0f;

@@ -38,6 +38,8 @@ namespace mm {
 inline constexpr float kMaxScriptSeconds = 8.0f * 3600.0f;
 inline constexpr float kMinRunDt = 1e-4f;
 inline constexpr float kMaxRunDt = 1.0f;
+// The time step of a run (mm eval, a crowd, the headless viewer) when none is given: 60 Hz.
+inline constexpr float kDefaultRunDt = 1.0f / 60.0f;
 inline constexpr int kMaxRunFrames = 1 << 22;
 
 // The number of updates a run of `seconds` at `dt` takes (ceil(seconds / dt) in float), or

@@ -14,7 +14,8 @@
 // gradient), and every grid edge the surface crosses gets a quad joining the four cells around
 // it, split into two triangles along its shorter diagonal. Surface nets rather than marching
 // cubes: no 256-case tables, about half the vertices for the same grid, and no sliver
-// triangles, which the cotangent Laplacian of heat-diffusion weights would suffer from.
+// triangles, whose very short edges would dominate the graph Laplacian (1 / length^2 per edge)
+// of the heat-diffusion weights (bone_weights.hpp).
 // Because the grid extends beyond the surface on every side, every crossed edge has its four
 // cells and the mesh is closed. A grid face whose four corners alternate inside/outside (the
 // surface grazing it) would make one edge shared by four triangles; such faces are resolved
