@@ -5,12 +5,12 @@
 
 #include <algorithm>
 #include <bit>
-#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <ostream>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -261,7 +261,7 @@ EvaluationAccumulator::~EvaluationAccumulator() = default;
 
 void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   State& s = *state_;
-  assert(frame.joints.size() == s.joint_count);
+  MM_ASSERT(frame.joints.size() == s.joint_count);
   s.follow_origin(frame);
   s.measure_plain(frame);
   s.update_held(frame);

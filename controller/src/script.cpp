@@ -4,7 +4,6 @@
 #include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -17,6 +16,7 @@
 #include <optional>
 #include <system_error>
 #include <utility>
+#include "mm/runtime/assert.hpp"
 
 namespace mm {
 
@@ -66,7 +66,7 @@ template <std::floating_point Float>
 std::string shortest(Float value) {
   char buffer[32];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  assert(ec == std::errc());
+  MM_ASSERT(ec == std::errc());
   (void)ec;
   return std::string(buffer, end);
 }
@@ -77,7 +77,7 @@ std::string fixed(float value) {
   char buffer[64];  // enough for any float of moderate size
   const auto [end, ec] =
       std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
-  assert(ec == std::errc());
+  MM_ASSERT(ec == std::errc());
   (void)ec;
   return std::string(buffer, end);
 }
@@ -92,7 +92,7 @@ void append_fixed(std::string& out, double value, int decimals) {
   char buffer[64];  // enough for any finite float in fixed notation
   const auto [end, ec] =
       std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed, decimals);
-  assert(ec == std::errc());
+  MM_ASSERT(ec == std::errc());
   (void)ec;
   std::string_view text(buffer, static_cast<size_t>(end - buffer));
   if (text.starts_with('-') && text.find_first_not_of("0.", 1) == std::string_view::npos) {
@@ -142,7 +142,7 @@ InputScript& InputScript::operator=(const InputScript& other) {
 }
 
 InputScript::InputScript(std::vector<ScriptEvent> events) : events_(std::move(events)) {
-  assert(
+  MM_ASSERT(
       std::is_sorted(events_.begin(), events_.end(),
                      [](const ScriptEvent& a, const ScriptEvent& b) { return a.time < b.time; }));
   repoint_tags();
@@ -337,7 +337,7 @@ std::string format_script_line(float time, const ControllerInput& input) {
   if (input.strafe) line += " strafe";
   if (!input.tag.empty()) {
     // A tag outside the tag characters would not parse back; tags come from the program.
-    assert(std::all_of(input.tag.begin(), input.tag.end(), is_tag_char));
+    MM_ASSERT(std::all_of(input.tag.begin(), input.tag.end(), is_tag_char));
     line += " tag=";
     line += input.tag;
   }

@@ -1,8 +1,8 @@
 #include "mm/database/feature_extraction.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -83,11 +83,12 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
   const int frames = clip.frame_count;
   const int dims = schema.dims();
   const size_t values = static_cast<size_t>(frames) * joints;
-  assert(channel_bones.size() == schema.channels.size());
-  assert(clip.local_positions.size() == values && clip.local_rotations.size() == values);
-  assert(clip.local_velocities.size() == values && clip.local_angular_velocities.size() == values);
-  assert(raw.size() == static_cast<size_t>(frames) * dims);
-  assert(searchable.size() == static_cast<size_t>(frames));
+  MM_ASSERT(channel_bones.size() == schema.channels.size());
+  MM_ASSERT(clip.local_positions.size() == values && clip.local_rotations.size() == values);
+  MM_ASSERT(clip.local_velocities.size() == values &&
+            clip.local_angular_velocities.size() == values);
+  MM_ASSERT(raw.size() == static_cast<size_t>(frames) * dims);
+  MM_ASSERT(searchable.size() == static_cast<size_t>(frames));
   (void)values;
 
   scratch.global_positions.resize(joints);
@@ -202,7 +203,7 @@ FeatureNormalization compute_feature_normalization(const FeatureSchema& schema,
   out.scale.assign(dims, 1.0f);
   if (dims == 0) return out;
   const size_t rows = raw.size() / dims;
-  assert(searchable.size() == rows);
+  MM_ASSERT(searchable.size() == rows);
 
   size_t counted = 0;
   for (size_t r = 0; r < rows; ++r) counted += searchable[r] ? 1 : 0;
@@ -253,7 +254,7 @@ FeatureNormalization compute_feature_normalization(const FeatureSchema& schema,
 void normalize_features(std::span<float> rows, std::span<const float> offset,
                         std::span<const float> scale) {
   const size_t dims = offset.size();
-  assert(scale.size() == dims && dims > 0 && rows.size() % dims == 0);
+  MM_ASSERT(scale.size() == dims && dims > 0 && rows.size() % dims == 0);
   for (size_t i = 0; i < rows.size(); i += dims) {
     for (size_t c = 0; c < dims; ++c) rows[i + c] = (rows[i + c] - offset[c]) / scale[c];
   }
@@ -262,7 +263,7 @@ void normalize_features(std::span<float> rows, std::span<const float> offset,
 void denormalize_features(std::span<float> rows, std::span<const float> offset,
                           std::span<const float> scale) {
   const size_t dims = offset.size();
-  assert(scale.size() == dims && dims > 0 && rows.size() % dims == 0);
+  MM_ASSERT(scale.size() == dims && dims > 0 && rows.size() % dims == 0);
   for (size_t i = 0; i < rows.size(); i += dims) {
     for (size_t c = 0; c < dims; ++c) rows[i + c] = rows[i + c] * scale[c] + offset[c];
   }

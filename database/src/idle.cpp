@@ -1,12 +1,12 @@
 #include "mm/database/idle.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <iterator>
 #include <limits>
 #include <vector>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/pose.hpp"
@@ -199,9 +199,9 @@ std::string idle_search_failure(const IdleSourceSearch& search, const IdleCriter
 }
 
 void fill_idle_clip(Database& db, const ClipRange& range, int source_frame) {
-  assert(source_frame >= 0 && source_frame < db.frame_count);
-  assert(source_frame < range.start || source_frame >= range.end);
-  assert(range.start >= 0 && range.end <= db.frame_count);
+  MM_ASSERT(source_frame >= 0 && source_frame < db.frame_count);
+  MM_ASSERT(source_frame < range.start || source_frame >= range.end);
+  MM_ASSERT(range.start >= 0 && range.end <= db.frame_count);
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t source = static_cast<size_t>(source_frame) * joints;
   for (int f = range.start; f < range.end; ++f) {

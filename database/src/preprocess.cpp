@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <cmath>
 #include <cstring>
+#include "mm/runtime/assert.hpp"
 
 #if defined(__SSE2__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -560,7 +560,7 @@ void majority_filter(std::span<const uint8_t> in, int width, int stride, int off
 
 std::vector<glm::quat> mirror_corrections(const Skeleton& skeleton,
                                           std::span<const int> joint_map) {
-  assert(static_cast<int>(joint_map.size()) == skeleton.joint_count());
+  MM_ASSERT(static_cast<int>(joint_map.size()) == skeleton.joint_count());
   RestMirror m = start_rest_mirror(skeleton, joint_map);
   fit_branching_joints(m);
   carry_up_chains(m, joint_map);
@@ -573,7 +573,7 @@ std::vector<glm::quat> mirror_corrections(const Skeleton& skeleton,
 
 Clip mirror_clip(const Clip& clip, std::span<const int> joint_map) {
   const int joints = clip.joint_count();
-  assert(static_cast<int>(joint_map.size()) == joints);
+  MM_ASSERT(static_cast<int>(joint_map.size()) == joints);
   Clip out;
   out.name = clip.name + "_mirror";
   out.source_path = clip.source_path;
@@ -664,9 +664,9 @@ bool compute_local_velocities(std::span<const glm::vec3> positions,
                               std::span<glm::vec3> angular_velocities) {
   const size_t joints = static_cast<size_t>(joint_count);
   const size_t frames = frame_count > 0 ? static_cast<size_t>(frame_count) : 0;
-  assert(positions.size() == frames * joints);
-  assert(rotations.size() == positions.size() && velocities.size() == positions.size() &&
-         angular_velocities.size() == positions.size());
+  MM_ASSERT(positions.size() == frames * joints);
+  MM_ASSERT(rotations.size() == positions.size() && velocities.size() == positions.size() &&
+            angular_velocities.size() == positions.size());
   const FrameDifferences clip{positions, rotations, velocities, angular_velocities};
   if (frames < 2) {
     std::fill(velocities.begin(), velocities.end(), glm::vec3(0.0f));

@@ -1,8 +1,8 @@
 #include "mm/runtime/constraints.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 namespace mm {
 
@@ -36,8 +36,8 @@ void relax_distance_constraints(std::span<glm::vec3> points,
                                 std::span<const DistanceConstraint> constraints, int iterations) {
   for (int iteration = 0; iteration < iterations; ++iteration) {
     for (const DistanceConstraint& c : constraints) {
-      assert(c.a >= 0 && static_cast<size_t>(c.a) < points.size());
-      assert(c.b >= 0 && static_cast<size_t>(c.b) < points.size());
+      MM_ASSERT(c.a >= 0 && static_cast<size_t>(c.a) < points.size());
+      MM_ASSERT(c.b >= 0 && static_cast<size_t>(c.b) < points.size());
       if (c.a == c.b) continue;  // a point cannot keep a distance from itself
       relax_distance_constraint(points[c.a], points[c.b], c.rest_length, c.weight_a, c.weight_b);
     }
@@ -48,8 +48,8 @@ float max_distance_constraint_error(std::span<const glm::vec3> points,
                                     std::span<const DistanceConstraint> constraints) {
   float worst = 0.0f;
   for (const DistanceConstraint& c : constraints) {
-    assert(c.a >= 0 && static_cast<size_t>(c.a) < points.size());
-    assert(c.b >= 0 && static_cast<size_t>(c.b) < points.size());
+    MM_ASSERT(c.a >= 0 && static_cast<size_t>(c.a) < points.size());
+    MM_ASSERT(c.b >= 0 && static_cast<size_t>(c.b) < points.size());
     worst = std::max(worst, std::abs(glm::distance(points[c.a], points[c.b]) - c.rest_length));
   }
   return worst;

@@ -1,8 +1,8 @@
 #include "mm/runtime/dead_blending.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/spring.hpp"
@@ -90,7 +90,7 @@ JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incom
 }  // namespace
 
 void DeadBlend::resize(int joint_count) {
-  assert(joint_count >= 0);
+  MM_ASSERT(joint_count >= 0);
   const size_t n = static_cast<size_t>(joint_count);
   source.assign(n, Transform{});
   source_velocities.assign(n, glm::vec3(0.0f));
@@ -105,9 +105,9 @@ void DeadBlend::clear() {
 
 void dead_blend_transition(DeadBlend& blend, const PoseMotion& outgoing, float blend_time) {
   const size_t n = blend.source.size();
-  assert(outgoing.local.size() == n);
-  assert(outgoing.velocities.empty() || outgoing.velocities.size() == n);
-  assert(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
+  MM_ASSERT(outgoing.local.size() == n);
+  MM_ASSERT(outgoing.velocities.empty() || outgoing.velocities.size() == n);
+  MM_ASSERT(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
   const Weight w = blend.active ? weight_at(blend.time, usable_length(blend_time)) : Weight{};
   for (size_t i = 0; i < n; ++i) {
     if (w.value < 1.0f) {
@@ -130,11 +130,11 @@ void dead_blend_update(DeadBlend& blend, const PoseMotion& incoming, float blend
                        std::span<glm::vec3> out_velocities,
                        std::span<glm::vec3> out_angular_velocities) {
   const size_t n = blend.source.size();
-  assert(incoming.local.size() == n && out_local.size() == n);
-  assert(incoming.velocities.empty() || incoming.velocities.size() == n);
-  assert(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
-  assert(out_velocities.empty() || out_velocities.size() == n);
-  assert(out_angular_velocities.empty() || out_angular_velocities.size() == n);
+  MM_ASSERT(incoming.local.size() == n && out_local.size() == n);
+  MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
+  MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
+  MM_ASSERT(out_velocities.empty() || out_velocities.size() == n);
+  MM_ASSERT(out_angular_velocities.empty() || out_angular_velocities.size() == n);
   if (!(dt >= 0.0f) || !std::isfinite(dt)) dt = 0.0f;
   Weight w;
   if (blend.active) {

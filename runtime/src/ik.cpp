@@ -1,8 +1,8 @@
 #include "mm/runtime/ik.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -129,9 +129,9 @@ TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transf
                                   std::span<Transform> global, int root, int mid, int end,
                                   const glm::vec3& target, const glm::vec3& pole,
                                   float extension_epsilon) {
-  assert(parents.size() == local.size() && parents.size() == global.size());
-  assert(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
-  assert(parents[mid] == root && parents[end] == mid);
+  MM_ASSERT(parents.size() == local.size() && parents.size() == global.size());
+  MM_ASSERT(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
+  MM_ASSERT(parents[mid] == root && parents[end] == mid);
   TwoBoneIkInput in;
   in.root = global[root];
   in.mid = global[mid];

@@ -1,7 +1,7 @@
 #include "mm/runtime/inertialization.hpp"
 
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/spring.hpp"
@@ -17,7 +17,7 @@ glm::vec3 at_or_zero(std::span<const glm::vec3> values, size_t i) {
 }  // namespace
 
 void InertializationOffsets::resize(int joint_count) {
-  assert(joint_count >= 0);
+  MM_ASSERT(joint_count >= 0);
   const size_t n = static_cast<size_t>(joint_count);
   rotations.assign(n, glm::vec3(0.0f));
   rotation_rates.assign(n, glm::vec3(0.0f));
@@ -97,11 +97,11 @@ void inertialize_rotation_transition(glm::vec3& offset, glm::vec3& offset_rate,
 void inertialize_transition(InertializationOffsets& offsets, const PoseMotion& outgoing,
                             const PoseMotion& incoming) {
   const size_t n = offsets.rotations.size();
-  assert(outgoing.local.size() == n && incoming.local.size() == n);
-  assert(outgoing.velocities.empty() || outgoing.velocities.size() == n);
-  assert(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
-  assert(incoming.velocities.empty() || incoming.velocities.size() == n);
-  assert(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
+  MM_ASSERT(outgoing.local.size() == n && incoming.local.size() == n);
+  MM_ASSERT(outgoing.velocities.empty() || outgoing.velocities.size() == n);
+  MM_ASSERT(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
+  MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
+  MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
   for (size_t i = 0; i < n; ++i) {
     inertialize_position_transition(
         offsets.positions[i], offsets.velocities[i], outgoing.local[i].translation,
@@ -119,11 +119,11 @@ void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incom
                         std::span<glm::vec3> out_velocities,
                         std::span<glm::vec3> out_angular_velocities) {
   const size_t n = offsets.rotations.size();
-  assert(incoming.local.size() == n && out_local.size() == n);
-  assert(incoming.velocities.empty() || incoming.velocities.size() == n);
-  assert(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
-  assert(out_velocities.empty() || out_velocities.size() == n);
-  assert(out_angular_velocities.empty() || out_angular_velocities.size() == n);
+  MM_ASSERT(incoming.local.size() == n && out_local.size() == n);
+  MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
+  MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
+  MM_ASSERT(out_velocities.empty() || out_velocities.size() == n);
+  MM_ASSERT(out_angular_velocities.empty() || out_angular_velocities.size() == n);
   const glm::vec3 zero(0.0f);
   const CriticalSpringStep step = critical_spring_step(halflife, dt);
   for (size_t i = 0; i < n; ++i) {

@@ -1,8 +1,8 @@
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include <glm/gtc/constants.hpp>
 
@@ -260,9 +260,9 @@ Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
 
 void sample_pose(std::span<const Transform> frames, int joint_count, float frame_time, float time,
                  InterpolationMethod method, WrapMode wrap, std::span<Transform> out) {
-  assert(joint_count > 0 && frame_time > 0.0f);
-  assert(!frames.empty() && frames.size() % static_cast<size_t>(joint_count) == 0);
-  assert(out.size() == static_cast<size_t>(joint_count));
+  MM_ASSERT(joint_count > 0 && frame_time > 0.0f);
+  MM_ASSERT(!frames.empty() && frames.size() % static_cast<size_t>(joint_count) == 0);
+  MM_ASSERT(out.size() == static_cast<size_t>(joint_count));
   const size_t joints = static_cast<size_t>(joint_count);
   const long frame_count = static_cast<long>(frames.size() / joints);
 

@@ -1,23 +1,23 @@
 #include "mm/runtime/pose.hpp"
 
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 namespace mm {
 
 void forward_kinematics(std::span<const int> parents, std::span<const Transform> local,
                         std::span<Transform> global) {
-  assert(local.size() == parents.size() && global.size() == parents.size());
+  MM_ASSERT(local.size() == parents.size() && global.size() == parents.size());
   for (size_t i = 0; i < parents.size(); ++i) {
     const int p = parents[i];
-    assert(p < static_cast<int>(i));
+    MM_ASSERT(p < static_cast<int>(i));
     global[i] = p < 0 ? local[i] : compose(global[p], local[i]);
   }
 }
 
 Transform forward_kinematics_joint(std::span<const int> parents, std::span<const Transform> local,
                                    int joint) {
-  assert(joint >= 0 && static_cast<size_t>(joint) < parents.size());
+  MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < parents.size());
   Transform t = local[joint];
   for (int p = parents[joint]; p >= 0; p = parents[p]) t = compose(local[p], t);
   return t;
@@ -25,7 +25,7 @@ Transform forward_kinematics_joint(std::span<const int> parents, std::span<const
 
 void bone_lengths(std::span<const int> parents, std::span<const Transform> global,
                   std::span<float> lengths) {
-  assert(global.size() == parents.size() && lengths.size() == parents.size());
+  MM_ASSERT(global.size() == parents.size() && lengths.size() == parents.size());
   for (size_t i = 0; i < parents.size(); ++i) {
     const int p = parents[i];
     lengths[i] = p < 0 ? glm::length(global[i].translation)

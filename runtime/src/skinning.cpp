@@ -1,7 +1,7 @@
 #include "mm/runtime/skinning.hpp"
 
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 namespace mm {
 
@@ -25,10 +25,10 @@ void for_each_skinned_vertex(std::span<const glm::vec3> rest_positions,
                              std::span<const VertexInfluences> influences,
                              std::span<glm::vec3> out_positions, std::span<glm::vec3> out_normals,
                              SkinVertex skin_vertex) {
-  assert(influences.size() == rest_positions.size());
-  assert(out_positions.size() == rest_positions.size());
-  assert(rest_normals.empty() || rest_normals.size() == rest_positions.size());
-  assert(rest_normals.empty() || out_normals.size() == rest_positions.size());
+  MM_ASSERT(influences.size() == rest_positions.size());
+  MM_ASSERT(out_positions.size() == rest_positions.size());
+  MM_ASSERT(rest_normals.empty() || rest_normals.size() == rest_positions.size());
+  MM_ASSERT(rest_normals.empty() || out_normals.size() == rest_positions.size());
   for (size_t v = 0; v < rest_positions.size(); ++v) {
     glm::vec4 w;
     if (normalized_weights(influences[v].weights, w)) {
@@ -49,13 +49,13 @@ glm::vec3 unit_or(const glm::vec3& v, const glm::vec3& fallback) {
 
 void inverse_bind_transforms(std::span<const Transform> bind_global,
                              std::span<Transform> inverse_bind) {
-  assert(bind_global.size() == inverse_bind.size());
+  MM_ASSERT(bind_global.size() == inverse_bind.size());
   for (size_t i = 0; i < bind_global.size(); ++i) inverse_bind[i] = inverse(bind_global[i]);
 }
 
 void skinning_matrices(std::span<const Transform> global, std::span<const Transform> inverse_bind,
                        std::span<glm::mat4> skin) {
-  assert(global.size() == inverse_bind.size() && global.size() == skin.size());
+  MM_ASSERT(global.size() == inverse_bind.size() && global.size() == skin.size());
   for (size_t i = 0; i < global.size(); ++i) {
     skin[i] = to_matrix(global[i]) * to_matrix(inverse_bind[i]);
   }
@@ -64,7 +64,7 @@ void skinning_matrices(std::span<const Transform> global, std::span<const Transf
 void skinning_matrices(std::span<const Transform> global,
                        std::span<const glm::mat4> inverse_bind_matrices,
                        std::span<glm::mat4> skin) {
-  assert(global.size() == inverse_bind_matrices.size() && global.size() == skin.size());
+  MM_ASSERT(global.size() == inverse_bind_matrices.size() && global.size() == skin.size());
   for (size_t i = 0; i < global.size(); ++i) {
     skin[i] = to_matrix(global[i]) * inverse_bind_matrices[i];
   }
@@ -72,7 +72,7 @@ void skinning_matrices(std::span<const Transform> global,
 
 void skinning_dual_quats(std::span<const Transform> global, std::span<const Transform> inverse_bind,
                          std::span<DualQuat> skin) {
-  assert(global.size() == inverse_bind.size() && global.size() == skin.size());
+  MM_ASSERT(global.size() == inverse_bind.size() && global.size() == skin.size());
   for (size_t i = 0; i < global.size(); ++i) {
     skin[i] = dual_quat_normalize(dual_quat_from_transform(global[i]) *
                                   dual_quat_from_transform(inverse_bind[i]));
@@ -89,7 +89,7 @@ void skin_linear_blend(std::span<const glm::mat4> skin, std::span<const glm::vec
     for (int k = 0; k < 4; ++k) {
       if (w[k] == 0.0f) continue;
       const int joint = influences[v].joints[k];
-      assert(joint >= 0 && static_cast<size_t>(joint) < skin.size());
+      MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < skin.size());
       m += w[k] * skin[joint];
     }
     out_positions[v] = glm::vec3(m * glm::vec4(rest_positions[v], 1.0f));
@@ -122,7 +122,7 @@ void skin_dual_quaternion(std::span<const DualQuat> skin, std::span<const glm::v
     for (int k = 0; k < 4; ++k) {
       if (w[k] == 0.0f) continue;
       const int joint = influences[v].joints[k];
-      assert(joint >= 0 && static_cast<size_t>(joint) < skin.size());
+      MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < skin.size());
       const DualQuat& q = skin[joint];
       const float signed_weight = glm::dot(q.real, pivot_real) < 0.0f ? -w[k] : w[k];
       blend = blend + signed_weight * q;

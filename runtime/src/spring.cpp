@@ -1,8 +1,8 @@
 #include "mm/runtime/spring.hpp"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+#include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -176,8 +176,8 @@ void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, co
 void critical_spring_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
                              const glm::vec3& x, const glm::vec3& v, const glm::vec3& goal,
                              float halflife, std::span<const float> times) {
-  assert(positions.empty() || positions.size() == times.size());
-  assert(velocities.empty() || velocities.size() == times.size());
+  MM_ASSERT(positions.empty() || positions.size() == times.size());
+  MM_ASSERT(velocities.empty() || velocities.size() == times.size());
   const bool frozen = !std::isfinite(halflife) || !finite(goal);
   const double w = angular_frequency(halflife);
   for (size_t i = 0; i < times.size(); ++i) {
@@ -193,8 +193,8 @@ void critical_spring_predict(std::span<glm::quat> rotations,
                              std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
                              const glm::vec3& angular_velocity, const glm::quat& goal,
                              float halflife, std::span<const float> times) {
-  assert(rotations.empty() || rotations.size() == times.size());
-  assert(angular_velocities.empty() || angular_velocities.size() == times.size());
+  MM_ASSERT(rotations.empty() || rotations.size() == times.size());
+  MM_ASSERT(angular_velocities.empty() || angular_velocities.size() == times.size());
   const bool frozen = !std::isfinite(halflife) || !finite(goal);
   const double w = angular_frequency(halflife);
   const glm::vec3 error0 =
@@ -226,9 +226,9 @@ void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec
                               const glm::vec3& velocity, const glm::vec3& acceleration,
                               const glm::vec3& desired_velocity, float halflife,
                               std::span<const float> times) {
-  assert(positions.empty() || positions.size() == times.size());
-  assert(velocities.empty() || velocities.size() == times.size());
-  assert(accelerations.empty() || accelerations.size() == times.size());
+  MM_ASSERT(positions.empty() || positions.size() == times.size());
+  MM_ASSERT(velocities.empty() || velocities.size() == times.size());
+  MM_ASSERT(accelerations.empty() || accelerations.size() == times.size());
   const bool frozen = !std::isfinite(halflife) || !finite(desired_velocity);
   const double w = angular_frequency(halflife);
   for (size_t i = 0; i < times.size(); ++i) {

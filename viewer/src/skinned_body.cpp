@@ -1,7 +1,7 @@
 #include "skinned_body.hpp"
 
-#include <cassert>
 #include <utility>
+#include "mm/runtime/assert.hpp"
 
 namespace mm::viewer {
 
@@ -32,12 +32,12 @@ SkinnedBody::SkinnedBody(SkinnedMesh mesh) : mesh_(std::move(mesh)) {
 }
 
 void SkinnedBody::set_influences(std::vector<VertexInfluences> influences) {
-  assert(influences.size() == mesh_.mesh.positions.size());
+  MM_ASSERT(influences.size() == mesh_.mesh.positions.size());
   mesh_.influences = std::move(influences);
 }
 
 void SkinnedBody::pose(std::span<const Transform> global, SkinningMethod method) {
-  assert(global.size() == inverse_bind_.size());
+  MM_ASSERT(global.size() == inverse_bind_.size());
   const std::span<const glm::vec3> rest_normals =
       mesh_.mesh.normals.size() == mesh_.mesh.positions.size()
           ? std::span<const glm::vec3>(mesh_.mesh.normals)

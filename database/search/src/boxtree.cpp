@@ -462,7 +462,7 @@ class BoxTreeSearcher final : public Searcher {
 
   SearchResult search(std::span<const float> query,
                       const SearchConstraints& constraints) const override {
-    assert(static_cast<int>(query.size()) == set_.dims);
+    MM_ASSERT(static_cast<int>(query.size()) == set_.dims);
     const QueryPlan plan = plan_query(set_, query.data(), constraints);
     if (!(plan.bound > 0.0f) || trees_.empty()) {
       return finish_query(set_, plan, query.data(), -1, constraints);

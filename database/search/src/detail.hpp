@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "mm/runtime/assert.hpp"
 #include "mm/search/kernels.hpp"
 #include "mm/search/search.hpp"
 

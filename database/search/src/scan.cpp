@@ -45,7 +45,7 @@ class BlockedScanSearcher final : public Searcher {
 
   SearchResult search(std::span<const float> query,
                       const SearchConstraints& constraints) const override {
-    assert(static_cast<int>(query.size()) == set_.dims);
+    MM_ASSERT(static_cast<int>(query.size()) == set_.dims);
     QueryPlan plan = plan_query(set_, query.data(), constraints);
     // Distances are never negative: with a bound <= 0 nothing can beat the continuation.
     if (!(plan.bound > 0.0f)) return finish_query(set_, plan, query.data(), -1, constraints);

@@ -230,8 +230,8 @@ void SearchBatchRunner::run(const Searcher& searcher, std::span<const float> que
                             std::span<const SearchConstraints> constraints,
                             std::span<SearchResult> results) {
   const size_t dims = static_cast<size_t>(searcher.dims());
-  assert(queries.size() == results.size() * dims);
-  assert(constraints.size() == 1 || constraints.size() == results.size());
+  MM_ASSERT(queries.size() == results.size() * dims);
+  MM_ASSERT(constraints.size() == 1 || constraints.size() == results.size());
   (void)dims;
   if (results.empty()) return;
   State& s = *state_;

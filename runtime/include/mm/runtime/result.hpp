@@ -2,10 +2,10 @@
 // Cold-path error handling: import, build and load return a Result carrying either a value or
 // a message a user can act on. Hot paths (update, search) never return errors; they assert.
 
-#include <cassert>
 #include <string>
 #include <utility>
 #include <variant>
+#include "mm/runtime/assert.hpp"
 
 namespace mm {
 
@@ -26,15 +26,15 @@ class [[nodiscard]] Result {
   explicit operator bool() const { return ok(); }
 
   T& value() & {
-    assert(ok());
+    MM_ASSERT(ok());
     return std::get<0>(state_);
   }
   const T& value() const& {
-    assert(ok());
+    MM_ASSERT(ok());
     return std::get<0>(state_);
   }
   T&& value() && {
-    assert(ok());
+    MM_ASSERT(ok());
     return std::get<0>(std::move(state_));
   }
   T* operator->() { return &value(); }
@@ -43,7 +43,7 @@ class [[nodiscard]] Result {
   const T& operator*() const { return value(); }
 
   const Error& error() const {
-    assert(!ok());
+    MM_ASSERT(!ok());
     return std::get<1>(state_);
   }
   const std::string& message() const { return error().message; }
