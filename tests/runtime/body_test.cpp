@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -78,6 +79,40 @@ TEST(BodySignedDistance, TheSmoothUnionFillsTheCreaseAndLeavesFarPointsAlone) {
   const glm::vec3 along(0.8f, 0.3f, 0.0f);
   EXPECT_FLOAT_EQ(body_signed_distance(cross, 0.08f, along),
                   body_signed_distance(cross, 0.0f, along));
+}
+
+// The union skips capsules that cannot change it (body.cpp); it must equal the plain fold of
+// the smooth minimum over every capsule, in segment order, inside the body, on it and around it.
+TEST(BodySignedDistance, EqualsTheFoldOverEveryCapsule) {
+  std::vector<BoneSegment> body;
+  for (int i = 0; i < 12; ++i) {  // a fan of limbs of different tapers, some overlapping
+    const float angle = 0.5f * static_cast<float>(i);
+    const glm::vec3 head(0.1f * std::cos(angle), 0.05f * static_cast<float>(i), 0.0f);
+    const glm::vec3 tail = head + glm::vec3(0.4f * std::cos(angle), 0.1f, 0.4f * std::sin(angle));
+    body.push_back(segment(head, tail, 0.06f + 0.005f * static_cast<float>(i), 0.03f));
+  }
+  const float blend = 0.05f;
+  int inside = 0, checked = 0;
+  for (int x = -12; x <= 12; ++x) {
+    for (int y = -4; y <= 16; ++y) {
+      for (int z = -12; z <= 12; ++z) {
+        const glm::vec3 p(0.05f * static_cast<float>(x), 0.05f * static_cast<float>(y),
+                          0.05f * static_cast<float>(z));
+        float fold = tapered_capsule_distance(body[0], p);
+        for (size_t k = 1; k < body.size(); ++k) {
+          const float d = tapered_capsule_distance(body[k], p);
+          const float h = std::max(blend - std::abs(fold - d), 0.0f) / blend;
+          fold = std::min(fold, d) - h * h * blend * 0.25f;
+        }
+        ASSERT_NEAR(body_signed_distance(body, blend, p), fold, 1e-6f)
+            << p.x << " " << p.y << " " << p.z;
+        inside += fold < 0.0f ? 1 : 0;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(inside, 100);  // points inside the body were checked too
+  EXPECT_GT(checked - inside, 1000);
 }
 
 TEST(BodyMesh, ACapsuleBecomesAClosedOutwardMeshOnItsSurface) {
