@@ -29,6 +29,14 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// printf into a string: the build report's lines and messages.
+template <class... Args>
+std::string formatted(const char* format, Args... args) {
+  char buffer[320];
+  std::snprintf(buffer, sizeof buffer, format, args...);
+  return buffer;
+}
+
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -159,14 +167,12 @@ Result<int> idle_frame_count(const BuildOptions& options) {
   const FeatureFrameMargins margins = feature_frame_margins(options.schema, 1.0f / options.rate);
   const int least = margins.before + margins.after + 1;
   if (frames < least) {
-    char buffer[320];
-    std::snprintf(buffer, sizeof buffer,
-                  "build: an idle clip of %g s is %d frames at %g Hz, but the feature times need "
-                  "at least %d frames (%.3g s) for one of them to be searchable; ask for at "
-                  "least that, or 0 for no idle clip",
-                  static_cast<double>(seconds), frames, static_cast<double>(options.rate), least,
-                  least / static_cast<double>(options.rate));
-    return Error{buffer};
+    return Error{formatted(
+        "build: an idle clip of %g s is %d frames at %g Hz, but the feature times need at least "
+        "%d frames (%.3g s) for one of them to be searchable; ask for at least that, or 0 for no "
+        "idle clip",
+        static_cast<double>(seconds), frames, static_cast<double>(options.rate), least,
+        least / static_cast<double>(options.rate))};
   }
   return frames;
 }
@@ -427,12 +433,11 @@ void stand_on_ground(BuildState& state) {
     }
   }
   if (moved == 0) return;
-  char line[200];
-  std::snprintf(line, sizeof line,
-                "%d clip(s) whose feet never came within %.2f m of y = 0 moved by %+.3f to %+.3f m "
-                "to stand on it",
-                moved, kGroundTolerance, least, most);
-  state.rep.ground_summary = line;
+  state.rep.ground_summary = formatted(
+      "%d clip(s) whose feet never came within %.2f m of y = 0 moved by %+.3f to %+.3f m to stand "
+      "on it",
+      moved, static_cast<double>(kGroundTolerance), static_cast<double>(least),
+      static_cast<double>(most));
 }
 
 // Phase 2a, after retargeting: idle takes of the data become their calm segments (idle.hpp).
@@ -459,12 +464,9 @@ void split_idle_clips(BuildState& state) {
     result.clips = std::move(clips);
   }
   if (takes == 0) return;
-  char line[160];
-  std::snprintf(line, sizeof line,
-                "%d idle takes: %zu calm segments kept (%.0f s of %.0f s; feet planted, facing "
-                "steady)",
-                takes, segments, kept, total);
-  state.rep.idle_summary = line;
+  state.rep.idle_summary = formatted(
+      "%d idle takes: %zu calm segments kept (%.0f s of %.0f s; feet planted, facing steady)",
+      takes, segments, kept, total);
 }
 
 // Phase 2b: the database skeleton (simulation root + the reference's joints), its roles, the
