@@ -8,7 +8,7 @@
 #include <string>
 
 #include "mm/controller/controller.hpp"
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/bone_weights.hpp"
 
 namespace mm::cli {
 

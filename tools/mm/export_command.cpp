@@ -8,11 +8,11 @@
 
 #include "command.hpp"
 #include "command_line.hpp"
-#include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
+#include "mm/offline/character_body.hpp"
 #include "motion_files.hpp"
 #include "shared_options.hpp"
 

@@ -4,11 +4,11 @@
 #include <filesystem>
 #include <utility>
 
-#include "mm/database/character_body.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/io/bvh.hpp"
 #include "mm/database/io/gltf.hpp"
+#include "mm/offline/character_body.hpp"
 #include "number_parsing.hpp"
 
 namespace mm::cli {

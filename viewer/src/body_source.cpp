@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "mm/database/character_body.hpp"
+#include "mm/offline/character_body.hpp"
 
 namespace mm::viewer {
 namespace {

@@ -10,7 +10,7 @@
 #include "debug_drawing.hpp"
 #include "gl_context.hpp"
 #include "mm/controller/controller.hpp"
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/bone_weights.hpp"
 #include "orbit_camera.hpp"
 #include "renderer.hpp"
 #include "run_plot.hpp"

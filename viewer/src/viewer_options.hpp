@@ -6,7 +6,7 @@
 
 #include "debug_drawing.hpp"
 #include "mm/controller/controller.hpp"
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/bone_weights.hpp"
 #include "skinned_body.hpp"
 
 namespace mm::viewer {

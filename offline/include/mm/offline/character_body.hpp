@@ -36,8 +36,8 @@
 #include <vector>
 
 #include "mm/database/database.hpp"
-#include "mm/runtime/body.hpp"
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/body.hpp"
+#include "mm/offline/bone_weights.hpp"
 #include "mm/runtime/mesh.hpp"
 #include "mm/runtime/result.hpp"
 #include "mm/runtime/skeleton.hpp"

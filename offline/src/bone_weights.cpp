@@ -1,4 +1,4 @@
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/bone_weights.hpp"
 #include "mm/runtime/finite.hpp"
 
 #include <algorithm>

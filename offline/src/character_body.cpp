@@ -1,4 +1,4 @@
-#include "mm/database/character_body.hpp"
+#include "mm/offline/character_body.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,4 +1,4 @@
-#include "mm/runtime/body.hpp"
+#include "mm/offline/body.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 

@@ -10,7 +10,7 @@
 
 #include <glm/gtc/constants.hpp>
 
-#include "mm/runtime/bone_weights.hpp"
+#include "mm/offline/bone_weights.hpp"
 
 namespace mm {
 namespace {

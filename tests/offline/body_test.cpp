@@ -9,7 +9,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "mesh_checks.hpp"
-#include "mm/runtime/body.hpp"
+#include "mm/offline/body.hpp"
 
 namespace mm {
 namespace {

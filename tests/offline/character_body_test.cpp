@@ -11,8 +11,8 @@
 
 #include "mesh_checks.hpp"
 #include "mm/database/builder.hpp"
-#include "mm/database/character_body.hpp"
 #include "mm/database/io/gltf.hpp"
+#include "mm/offline/character_body.hpp"
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
 #include "test_support.hpp"
