@@ -759,8 +759,8 @@ void Controller::predict() {
                            desired_velocity_, settings_.simulation_velocity_halflife,
                            trajectory_times_);
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
-                          stopping_ ? desired_rotation_ : simulation_goal_rotation_,
-                          settings_.simulation_rotation_halflife, trajectory_times_);
+                          simulation_goal_rotation_, settings_.simulation_rotation_halflife,
+                          trajectory_times_);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
   const float yaw = quat_yaw(sim_rotation_);
