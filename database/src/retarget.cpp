@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string_view>
 
 #include <glm/gtc/quaternion.hpp>
@@ -134,11 +135,18 @@ bool stands(const RetargetSkeleton& s, const std::vector<Transform>& global) {
   return trunk_up(s, global).y > 0.7f;
 }
 
-float lowest_toe(const JointRoleIndices& roles, const std::vector<Transform>& global) {
+// The lowest of the two toes (the feet where there are no toes) in a posed skeleton, or of their
+// End Sites when `end_sites` (one offset per joint) is given.
+float lowest_toe(const JointRoleIndices& roles, const std::vector<Transform>& global,
+                 std::span<const glm::vec3> end_sites = {}) {
   float lowest = std::numeric_limits<float>::infinity();
   const int toes[2] = {roles.left_toe >= 0 ? roles.left_toe : roles.left_foot,
                        roles.right_toe >= 0 ? roles.right_toe : roles.right_foot};
-  for (const int toe : toes) lowest = std::min(lowest, position(global, toe).y);
+  for (const int toe : toes) {
+    const glm::vec3 site =
+        end_sites.empty() ? glm::vec3(0.0f) : end_sites[static_cast<size_t>(toe)];
+    lowest = std::min(lowest, transform_point(global[static_cast<size_t>(toe)], site).y);
+  }
   return lowest;
 }
 
@@ -315,17 +323,10 @@ Result<RetargetSkeleton> describe_for_retargeting(const Clip& clip, const JointR
 }
 
 float lowest_foot_end(const Clip& clip, const JointRoleIndices& roles) {
-  const int ends[2] = {roles.left_toe >= 0 ? roles.left_toe : roles.left_foot,
-                       roles.right_toe >= 0 ? roles.right_toe : roles.right_foot};
   float lowest = std::numeric_limits<float>::infinity();
   for (int f = 0; f < clip.frame_count; ++f) {
-    const std::vector<Transform> g = globals_of(clip.skeleton, clip.pose(f));
-    for (const int end : ends) {
-      if (end < 0) continue;
-      const glm::vec3 site =
-          clip.end_sites.empty() ? glm::vec3(0.0f) : clip.end_sites[static_cast<size_t>(end)];
-      lowest = std::min(lowest, transform_point(g[static_cast<size_t>(end)], site).y);
-    }
+    lowest = std::min(lowest,
+                      lowest_toe(roles, globals_of(clip.skeleton, clip.pose(f)), clip.end_sites));
   }
   return lowest;
 }
