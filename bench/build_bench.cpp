@@ -26,9 +26,9 @@
 #include <thread>
 #include <vector>
 
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/io/bvh.hpp"
+#include "mm/offline/builder.hpp"
+#include "mm/offline/bvh.hpp"
 
 namespace {
 

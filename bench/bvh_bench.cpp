@@ -31,7 +31,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/database/files.hpp"
-#include "mm/database/io/bvh.hpp"
+#include "mm/offline/bvh.hpp"
 
 namespace {
 

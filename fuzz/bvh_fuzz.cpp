@@ -17,7 +17,7 @@
 #include <string>
 #include <string_view>
 
-#include "mm/database/io/bvh.hpp"
+#include "mm/offline/bvh.hpp"
 
 namespace {
 

@@ -25,7 +25,7 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/preprocess.hpp"
+#include "mm/offline/preprocess.hpp"
 
 namespace {
 

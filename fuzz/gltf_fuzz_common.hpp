@@ -18,7 +18,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "fuzz_checks.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm::fuzz {

@@ -1,4 +1,4 @@
-// libFuzzer target for the tag manifest (database/include/mm/database/tags.hpp). Whatever the
+// libFuzzer target for the tag manifest (database/include/mm/offline/tags.hpp). Whatever the
 // text, parse_tag_manifest must return, and:
 // - a refusal reads "fuzz.tags:<line>: <what was expected>";
 // - an accepted manifest's rules each have a glob, at least one tag of letters, digits and
@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "fuzz_checks.hpp"
-#include "mm/database/tags.hpp"
+#include "mm/offline/tags.hpp"
 
 namespace {
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "mm/database/sampling.hpp"
 #include "mm/runtime/constraints.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
@@ -14,7 +15,6 @@
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
-#include "playback.hpp"
 
 namespace mm {
 
@@ -656,8 +656,8 @@ Controller::PlaybackPoint Controller::playback_point() const {
 // and velocities (no velocity kink where one frame interval meets the next), or the chosen
 // two-point interpolation.
 Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const {
-  return detail::sample_database_joint(*db_, at.frame0, at.frame1, at.weight, joint,
-                                       settings_.cubic_playback, settings_.interpolation);
+  return sample_database_joint(*db_, at.frame0, at.frame1, at.weight, joint,
+                               settings_.cubic_playback, settings_.interpolation);
 }
 
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root

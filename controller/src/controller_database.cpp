@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "mm/controller/controller.hpp"
-#include "mm/database/idle.hpp"
+#include "mm/database/database.hpp"
 #include "mm/database/search_input.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 

@@ -14,8 +14,12 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <system_error>
 #include <utility>
+
+#include <glm/gtc/constants.hpp>
+
 #include "mm/runtime/assert.hpp"
 
 namespace mm {
@@ -32,7 +36,7 @@ bool is_separator(char c) {
   return c == ' ' || c == '\t';
 }
 
-// The same character set as database tags (mm/database/tags.hpp), so that a script can request
+// The same character set as database tags (mm/offline/tags.hpp), so that a script can request
 // any tag a database can carry.
 bool is_tag_char(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
@@ -347,6 +351,45 @@ std::string format_script_line(float time, const ControllerInput& input) {
     append_fixed(line, degrees, 1);
   }
   return line;
+}
+
+namespace {
+
+// A float in [0, 1) from the generator's raw bits (std::uniform_real_distribution differs
+// between standard libraries; this does not).
+float unit(std::mt19937& rng) {
+  return static_cast<float>(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+}  // namespace
+
+InputScript varied_input_script(uint32_t seed, float seconds) {
+  std::mt19937 rng(seed * 2654435761u + 12345u);
+  std::vector<ScriptEvent> events;
+  float t = 0.0f;
+  int line = 1;
+  while (t < seconds) {
+    ScriptEvent e;
+    e.time = t;
+    e.line = line++;
+    const float kind = unit(rng);
+    const float angle = unit(rng) * glm::two_pi<float>();
+    if (kind < 0.15f) {
+      e.input.left_stick = glm::vec2(0.0f);  // stand
+    } else {
+      e.input.left_stick = glm::vec2(std::sin(angle), std::cos(angle));
+    }
+    e.input.run = unit(rng) < 0.3f;
+    e.input.strafe = unit(rng) < 0.1f;
+    if (e.input.strafe) {
+      const float facing = unit(rng) * glm::two_pi<float>();
+      e.input.right_stick = glm::vec2(std::sin(facing), std::cos(facing));
+    }
+    e.input.camera_yaw = unit(rng) < 0.2f ? (unit(rng) - 0.5f) * glm::pi<float>() : 0.0f;
+    events.push_back(e);
+    t += 0.5f + 2.5f * unit(rng);
+  }
+  return InputScript(std::move(events));
 }
 
 }  // namespace mm

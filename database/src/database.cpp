@@ -180,6 +180,19 @@ uint64_t Database::tag_mask(std::span<const std::string> names) const {
   return mask;
 }
 
+bool is_idle_clip(const Database& db, const ClipRange& clip) {
+  const std::string tag = kIdleTag;
+  return clip.name == kIdleClipName && !clip.mirrored &&
+         (clip.tags & db.tag_mask(std::span(&tag, 1))) != 0;
+}
+
+int find_idle_clip(const Database& db) {
+  for (size_t c = db.clips.size(); c-- > 0;) {
+    if (is_idle_clip(db, db.clips[c])) return static_cast<int>(c);
+  }
+  return -1;
+}
+
 Status validate_clip_ranges(std::span<const ClipRange> clips, int frame_count, size_t tag_count) {
   const uint64_t known_tags = tag_count >= 64 ? ~uint64_t{0} : (uint64_t{1} << tag_count) - 1;
   if (clips.empty()) return Error{"database: has frames but no clips"};

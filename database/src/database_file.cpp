@@ -24,8 +24,8 @@
 #include "cpu_features.hpp"
 #include "large_arrays.hpp"
 #include "mm/database/files.hpp"
-#include "mm/database/preprocess.hpp"
-#include "mm/runtime/workers.hpp"
+#include "mm/database/velocities.hpp"
+#include "mm/internal/workers.hpp"
 #include "validation.hpp"
 
 namespace mm {

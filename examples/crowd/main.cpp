@@ -30,7 +30,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/controller/controller.hpp"   // ControllerDatabase, Controller, ControllerInput
-#include "mm/controller/crowd.hpp"        // varied_input_script: made-up input for the demo
+#include "mm/controller/script.hpp"       // varied_input_script: made-up input for the demo
 #include "mm/database/database_file.hpp"  // load_database
 
 namespace {

@@ -11,8 +11,8 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtx/quaternion.hpp>
 
-#include "mm/database/idle.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/gltf.hpp"
+#include "mm/offline/idle.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm {

@@ -31,7 +31,7 @@
 #include <string_view>
 
 #include "detail.hpp"
-#include "mm/runtime/workers.hpp"
+#include "mm/internal/workers.hpp"
 
 namespace mm::search_detail {
 

@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "controller_support.hpp"
-#include "mm/controller/evaluation.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/programs/evaluation.hpp"
 
 namespace mm {
 namespace {

@@ -8,8 +8,8 @@
 
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
-#include "mm/controller/evaluation.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/programs/evaluation.hpp"
 #include "mm/runtime/interpolation.hpp"
 
 namespace mm {

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "database_helpers.hpp"
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/preprocess.hpp"
+#include "mm/offline/builder.hpp"
+#include "mm/offline/preprocess.hpp"
 #include "test_support.hpp"
 
 namespace mm {

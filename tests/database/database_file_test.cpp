@@ -11,7 +11,7 @@
 #include "database_helpers.hpp"
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/database/preprocess.hpp"
+#include "mm/database/velocities.hpp"
 #include "test_support.hpp"
 
 namespace mm {

@@ -39,15 +39,24 @@ endfunction()
 
 # ---- 1. install into a fresh prefix, so nothing left from an earlier run can make it pass.
 file(REMOVE_RECURSE "${prefix}" "${example_build}" "${database}")
-run_step(install "${CMAKE_COMMAND}" --install "${MM_BUILD_DIR}" --prefix "${prefix}")
+# What a game links alone: the example must configure and build against the game component with
+# nothing of the offline side (or the programs) present.
+run_step(install "${CMAKE_COMMAND}" --install "${MM_BUILD_DIR}" --prefix "${prefix}"
+         --component game)
 foreach(expected include/mm/controller/controller.hpp include/mm/database/database_file.hpp
-                 include/mm/runtime/spring.hpp bin/mm)
+                 include/mm/search/search.hpp include/mm/runtime/spring.hpp
+                 lib/cmake/mm/mmConfig.cmake lib/cmake/mm/mmTargets.cmake)
   if(NOT EXISTS "${prefix}/${expected}")
     message(FATAL_ERROR "install_example: step 'install' did not install ${expected}")
   endif()
 endforeach()
+file(GLOB_RECURSE game_files RELATIVE "${prefix}" "${prefix}/*")
+foreach(file IN LISTS game_files)
+  if(file MATCHES "offline|Offline|workers|evaluation|crowd\\.hpp|^bin/")
+    message(FATAL_ERROR "install_example: the game component installed ${file}")
+  endif()
+endforeach()
 
-# ---- 2. configure the example as an outside project.
 set(configure_args
     -S "${MM_EXAMPLE_SOURCE_DIR}" -B "${example_build}" -G "${MM_GENERATOR}"
     "-DCMAKE_CXX_COMPILER=${MM_CXX_COMPILER}"
@@ -79,6 +88,15 @@ set(example "${example_build}/mm-crowd-example")
 if(NOT EXISTS "${example}")
   message(FATAL_ERROR "install_example: step 'build' made no ${example}")
 endif()
+
+# The rest (the offline component and the programs): `mm build` makes the example's database,
+# and the offline component is found when asked for.
+run_step(install-rest "${CMAKE_COMMAND}" --install "${MM_BUILD_DIR}" --prefix "${prefix}")
+foreach(expected bin/mm include/mm/offline/builder.hpp lib/cmake/mm/mmOfflineTargets.cmake)
+  if(NOT EXISTS "${prefix}/${expected}")
+    message(FATAL_ERROR "install_example: step 'install-rest' did not install ${expected}")
+  endif()
+endforeach()
 
 # ---- 4. a small database from real data, made by the installed command line.
 set(clips dataset-2_walk_normal_001 dataset-2_walk_normal_002 dataset-2_walk_normal_003

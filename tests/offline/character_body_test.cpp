@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "mesh_checks.hpp"
-#include "mm/database/builder.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/builder.hpp"
 #include "mm/offline/character_body.hpp"
+#include "mm/offline/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
 #include "test_support.hpp"

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "mm/database/builder.hpp"
 #include "mm/database/search_input.hpp"
+#include "mm/offline/builder.hpp"
 #include "mm/search/search.hpp"
 #include "mm/search_baselines/baselines.hpp"
 #include "mm/search_baselines/synthetic.hpp"

@@ -14,8 +14,8 @@
 #include <string>
 #include <utility>
 
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/offline/builder.hpp"
 #include "test_support.hpp"
 
 namespace mm::test {

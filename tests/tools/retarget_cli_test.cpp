@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "mm/database/database_file.hpp"
-#include "mm/database/io/bvh.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/bvh.hpp"
+#include "mm/offline/gltf.hpp"
 #include "mm/runtime/pose.hpp"
 #include "run_tool.hpp"
 #include "test_support.hpp"

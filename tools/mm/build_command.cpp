@@ -11,16 +11,16 @@
 #include <vector>
 
 #include "command.hpp"
-#include "command_line.hpp"
 #include "database_summary.hpp"
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "mm/offline/builder.hpp"
+#include "mm/programs/command_line.hpp"
+#include "mm/programs/number_parsing.hpp"
+#include "mm/programs/progress_bar.hpp"
+#include "mm/programs/shared_options.hpp"
 #include "motion_files.hpp"
-#include "number_parsing.hpp"
-#include "progress_bar.hpp"
-#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {

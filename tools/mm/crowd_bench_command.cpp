@@ -13,10 +13,10 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "command_line.hpp"
-#include "mm/controller/crowd.hpp"
+#include "mm/programs/command_line.hpp"
+#include "mm/programs/crowd.hpp"
+#include "mm/programs/shared_options.hpp"
 #include "mm/runtime/float_to_integer.hpp"
-#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "mm/database/files.hpp"
-#include "mm/database/idle.hpp"
+#include "mm/offline/idle.hpp"
 
 namespace mm::cli {
 

@@ -1,5 +1,5 @@
 // `mm eval`: runs a controller on scripted input, headless, and prints its quality metrics
-// (definitions in controller/include/mm/controller/evaluation.hpp).
+// (definitions in controller/include/mm/programs/evaluation.hpp).
 
 #include <cstdio>
 #include <fstream>
@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "command_line.hpp"
-#include "mm/controller/evaluation.hpp"
-#include "number_parsing.hpp"
-#include "shared_options.hpp"
+#include "mm/programs/command_line.hpp"
+#include "mm/programs/evaluation.hpp"
+#include "mm/programs/number_parsing.hpp"
+#include "mm/programs/shared_options.hpp"
 
 namespace mm::cli {
 namespace {

@@ -7,14 +7,14 @@
 #include <vector>
 
 #include "command.hpp"
-#include "command_line.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
-#include "mm/database/io/bvh.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/bvh.hpp"
 #include "mm/offline/character_body.hpp"
+#include "mm/offline/gltf.hpp"
+#include "mm/programs/command_line.hpp"
+#include "mm/programs/shared_options.hpp"
 #include "motion_files.hpp"
-#include "shared_options.hpp"
 
 namespace mm::cli {
 namespace {

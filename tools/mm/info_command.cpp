@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "command.hpp"
-#include "command_line.hpp"
 #include "database_summary.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/programs/command_line.hpp"
 
 namespace mm::cli {
 namespace {

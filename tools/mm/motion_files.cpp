@@ -6,10 +6,10 @@
 
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
-#include "mm/database/io/bvh.hpp"
-#include "mm/database/io/gltf.hpp"
+#include "mm/offline/bvh.hpp"
 #include "mm/offline/character_body.hpp"
-#include "number_parsing.hpp"
+#include "mm/offline/gltf.hpp"
+#include "mm/programs/number_parsing.hpp"
 
 namespace mm::cli {
 namespace {

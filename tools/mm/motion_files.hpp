@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "mm/database/clip.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "mm/offline/clip.hpp"
 #include "mm/runtime/result.hpp"
 
 namespace mm::cli {

@@ -7,12 +7,12 @@
 #include <vector>
 
 #include "command.hpp"
-#include "command_line.hpp"
 #include "mm/database/files.hpp"
-#include "mm/database/io/bvh.hpp"
-#include "mm/database/io/gltf.hpp"
-#include "mm/database/preprocess.hpp"
-#include "mm/database/retarget.hpp"
+#include "mm/offline/bvh.hpp"
+#include "mm/offline/gltf.hpp"
+#include "mm/offline/preprocess.hpp"
+#include "mm/offline/retarget.hpp"
+#include "mm/programs/command_line.hpp"
 #include "motion_files.hpp"
 
 namespace mm::cli {

@@ -25,10 +25,10 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "command_line.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/search_input.hpp"
+#include "mm/programs/command_line.hpp"
 #include "mm/search/kernels.hpp"
 #include "mm/search/search.hpp"
 #include "mm/search_baselines/baselines.hpp"

@@ -6,9 +6,9 @@
 #include <functional>
 #include <string>
 
-#include "mm/database/builder.hpp"
 #include "mm/database/database_file.hpp"
-#include "progress_bar.hpp"
+#include "mm/offline/builder.hpp"
+#include "mm/programs/progress_bar.hpp"
 
 namespace mm::viewer {
 namespace fs = std::filesystem;

@@ -3,10 +3,10 @@
 #include <optional>
 #include <sstream>
 
-#include "command_line.hpp"
 #include "mm/controller/script.hpp"
-#include "number_parsing.hpp"
-#include "shared_options.hpp"
+#include "mm/programs/command_line.hpp"
+#include "mm/programs/number_parsing.hpp"
+#include "mm/programs/shared_options.hpp"
 
 namespace mm::viewer {
 namespace {

@@ -15,6 +15,7 @@
 // comment; blank lines are ignored. A malformed line is refused with its file name, line
 // number and what was expected.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -90,5 +91,10 @@ Result<InputScript> load_input_script(const std::filesystem::path& path);
 // One line of the format for this state (used to record live input); parsing it gives the
 // same state back to the printed precision.
 std::string format_script_line(float time, const ControllerInput& input);
+
+// A reproducible input script of `seconds` for character `seed`: every 0.5 to 3 s the stick
+// takes a new direction (sometimes released, sometimes running, sometimes strafing with the
+// camera turned). The same seed always gives the same script, on every platform.
+InputScript varied_input_script(uint32_t seed, float seconds);
 
 }  // namespace mm

@@ -108,6 +108,17 @@ struct Database {
   Status validate() const;
 };
 
+// The name and the tag of the idle clip the builder synthesizes (mm/offline/idle.hpp).
+inline constexpr const char* kIdleClipName = "idle";
+inline constexpr const char* kIdleTag = "idle";
+
+// True for that clip: named kIdleClipName, tagged kIdleTag, not mirrored. (A source file that
+// happens to be called "idle.bvh" carries no such tag.)
+bool is_idle_clip(const Database& db, const ClipRange& clip);
+
+// Index of the last clip is_idle_clip accepts, -1 when there is none.
+int find_idle_clip(const Database& db);
+
 // The clip checks of Database::validate() on their own: the clips are named, tile
 // [0, frame_count) in order and carry only the bits of `tag_count` tags. The file loader runs
 // them before it lays out the per-clip sections.

@@ -1,0 +1,668 @@
+// Scripted evaluation: run, hand every frame to the accumulator, measure (definitions in
+// evaluation.hpp).
+
+#include "mm/programs/evaluation.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <ostream>
+#include "mm/runtime/assert.hpp"
+
+#include "mm/database/sampling.hpp"
+#include "mm/runtime/float_to_integer.hpp"
+#include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/pose.hpp"
+
+namespace mm {
+
+namespace {
+
+float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
+  return std::hypot(a.x - b.x, a.z - b.z);
+}
+
+// The percentiles of a run in fixed memory, whatever its length: a histogram of the values by
+// their binary exponent and the first kMantissaBits bits of their mantissa, so a bin spans a
+// 2^-kMantissaBits fraction of its lower edge. A percentile is taken by nearest rank, as over
+// the sorted values, and reported as the middle of the bin that rank falls in, clamped to the
+// smallest and largest value seen: within 2^-(kMantissaBits + 1) (0.05 %) of the exact
+// nearest-rank value (exact when all the values are equal).
+// Values below 2^kLowestExponent (zero included) share one bin (absolute resolution
+// 2^kLowestExponent in the values' unit); values from 2^kHighestExponent up and infinity
+// share the last, reported as the largest value seen; NaN is not counted. The bins (about
+// 0.5 MB) are allocated by the first value.
+class PercentileHistogram {
+ public:
+  void add(double value) {
+    if (std::isnan(value)) return;
+    if (bins_.empty()) bins_.assign(kBinCount, 0);
+    ++bins_[bin_of(value)];
+    ++count_;
+    if (count_ == 1) min_ = max_ = value;
+    min_ = std::min(min_, value);
+    max_ = std::max(max_, value);
+  }
+
+  size_t count() const { return count_; }
+  double max() const { return count_ > 0 ? max_ : 0.0; }
+
+  // The p-th percentile (0..100) by nearest rank (see the class); 0 for no values.
+  double percentile(double p) const {
+    if (count_ == 0) return 0.0;
+    const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count_));
+    const size_t rank =
+        std::min(count_ - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
+    size_t below = 0;
+    for (size_t bin = 0; bin < kBinCount; ++bin) {
+      below += bins_[bin];
+      if (below > rank) return std::clamp(middle_of(bin), min_, max_);
+    }
+    return max_;
+  }
+
+ private:
+  static constexpr int kMantissaBits = 10;
+  static constexpr int kLowestExponent = -20;
+  static constexpr int kHighestExponent = 40;
+  static constexpr size_t kSubBins = size_t{1} << kMantissaBits;
+  // The bin below 2^kLowestExponent, kSubBins per octave, the bin from 2^kHighestExponent up.
+  static constexpr size_t kBinCount = 2 + (kHighestExponent - kLowestExponent) * kSubBins;
+
+  static size_t bin_of(double value) {
+    if (!(value < std::ldexp(1.0, kHighestExponent))) return kBinCount - 1;
+    if (value < std::ldexp(1.0, kLowestExponent)) return 0;
+    int exponent = 0;
+    const double mantissa = std::frexp(value, &exponent);  // value = mantissa * 2^exponent
+    // value in [2^(exponent - 1), 2^exponent); 2 * mantissa in [1, 2).
+    const size_t octave = clamped_integer<size_t>(exponent - 1 - kLowestExponent);
+    const size_t sub =
+        std::min(kSubBins - 1,
+                 clamped_integer<size_t>((2.0 * mantissa - 1.0) * static_cast<double>(kSubBins)));
+    return 1 + octave * kSubBins + sub;
+  }
+
+  double middle_of(size_t bin) const {
+    if (bin == 0) return std::ldexp(0.5, kLowestExponent);
+    if (bin == kBinCount - 1) return max_;
+    const size_t octave = (bin - 1) / kSubBins, sub = (bin - 1) % kSubBins;
+    return std::ldexp(1.0 + (static_cast<double>(sub) + 0.5) / static_cast<double>(kSubBins),
+                      static_cast<int>(octave) + kLowestExponent);
+  }
+
+  std::vector<uint64_t> bins_;
+  size_t count_ = 0;
+  double min_ = 0.0, max_ = 0.0;
+};
+
+// A mean kept as a sum and a count: 0 for no values.
+struct RunningMean {
+  double sum = 0.0;
+  int count = 0;
+  void add(double value) {
+    sum += value;
+    ++count;
+  }
+  double value() const { return count > 0 ? sum / count : 0.0; }
+};
+
+// The absolute angle between two yaws, in degrees, in [0, 180].
+double yaw_error_deg(float a, float b) {
+  return std::abs(glm::degrees(wrap_angle(a - b)));
+}
+
+// The yaw of a horizontal direction, or `fallback` when it has no horizontal length.
+float direction_yaw(const glm::vec3& v, float fallback) {
+  return std::hypot(v.x, v.z) > 1e-6f ? std::atan2(v.x, v.z) : fallback;
+}
+
+// Whole frames covering `seconds` at dt (at least one), so a settle time is compared as a
+// frame count without float drift.
+int frames_for(float seconds, float dt) {
+  return std::max(1, clamped_integer<int>(std::ceil(seconds / dt - 1e-3f)));
+}
+
+// Acceleration magnitudes (second differences) of every joint but joint 0 from three
+// consecutive frames' joint positions.
+void joint_accelerations(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                         std::span<const glm::vec3> c, float dt, PercentileHistogram& out) {
+  for (size_t j = 1; j < b.size(); ++j) {
+    out.add(glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt));
+  }
+}
+
+// How long a value has stayed within a tolerance of the value it was last held at.
+struct HeldValue {
+  glm::vec3 anchor{0.0f};
+  int frames = 0;
+  // `value` this frame, compared with `changed(anchor, value)`.
+  template <typename Changed>
+  void update(const glm::vec3& value, Changed changed) {
+    if (frames == 0 || changed(anchor, value)) {
+      anchor = value;
+      frames = 0;
+    }
+    ++frames;  // this frame counts, as the stand time does
+  }
+};
+
+// One turn on the spot being measured.
+struct StandTurn {
+  bool open = false;
+  int length = 0;         // frames so far
+  int settle_frame = -1;  // frames from the start to the first within the settle angle
+  double last_error_deg = 0.0;
+};
+
+// The sums the turn-on-the-spot metrics are made of.
+struct StandTurnSums {
+  int events = 0;
+  int unsettled = 0;
+  double response_s = 0.0;
+  double final_error_deg = 0.0;
+  double peak_rate_deg_s = 0.0;
+  void close(const StandTurn& turn, float dt) {
+    if (!turn.open) return;
+    ++events;
+    unsettled += turn.settle_frame < 0 ? 1 : 0;
+    response_s +=
+        (turn.settle_frame < 0 ? turn.length : turn.settle_frame) * static_cast<double>(dt);
+    final_error_deg += turn.last_error_deg;
+  }
+};
+
+// A response being timed: the frame it started on and its goal (-1: none open).
+struct ResponseEvent {
+  int start = -1;
+  float from = 0.0f;
+  float to = 0.0f;
+};
+
+}  // namespace
+
+// Everything the metrics need from earlier frames, and their running sums.
+struct EvaluationAccumulator::State {
+  JointRoleIndices roles;
+  size_t joint_count = 0;
+  float dt = 0.0f;
+  int toes[2] = {-1, -1};  // toe role, or the foot when the side has none
+  int lookback_frames = 1;
+  int stand_settle_frames = 1, idle_settle_frames = 1, strafe_settle_frames = 1;
+
+  int frames = 0;
+  EvaluationFrame previous;                  // its joints view `positions[1]`
+  std::vector<glm::vec3> positions[2];       // the frame before the previous, the previous
+  uint32_t transition_bits = 0;              // bit k: frame n-1-k transitioned
+  std::vector<float> desired_speed_history;  // ring over the look-back, by frame
+  std::vector<float> desired_yaw_history;
+
+  // Plain metrics.
+  PercentileHistogram skate, accelerations, hips_rates;
+  RunningMean skate_mean, distance, facing, updates, searches, stand_root, stand_foot;
+  double distance_max = 0.0;
+  int transitions = 0;
+  ResponseEvent speed_event, heading_event;
+  int speed_events = 0, heading_events = 0;
+  RunningMean speed_times, heading_times;
+
+  // Held values.
+  int standing_frames = 0;  // consecutive frames with desired speed zero
+  HeldValue facing_held, velocity_held;
+
+  // Body metrics.
+  float hips_yaw = 0.0f, chest_yaw = 0.0f;
+  float pivot_yaw[2] = {0.0f, 0.0f};
+  bool pivot_ok[2] = {false, false};  // the toe was low and slow on the previous frame
+  RunningMean pivot, strafe_chest, idle_head;
+  bool stand_turn_condition = false;  // held on the previous frame
+  StandTurn stand_turn;
+  StandTurnSums stand_turn_sums;
+  float toe_height_min = std::numeric_limits<float>::infinity();
+
+  bool has_pair(int left, int right) const { return left >= 0 && right >= 0; }
+  bool has_hips() const { return has_pair(roles.left_upper_leg, roles.right_upper_leg); }
+  bool has_chest() const { return has_pair(roles.left_upper_arm, roles.right_upper_arm); }
+
+  void follow_origin(const EvaluationFrame& r);
+  void measure_plain(const EvaluationFrame& r);
+  void measure_responses(const EvaluationFrame& r);
+  void update_held(const EvaluationFrame& r);
+  void measure_feet(const EvaluationFrame& r);
+  void measure_pivot(const EvaluationFrame& r, int side, float toe_speed);
+  float measure_hips(const EvaluationFrame& r);
+  void measure_stand_turn(const EvaluationFrame& r, float hips_rate);
+  void measure_chest_and_head(const EvaluationFrame& r);
+  void measure_transition_accel(const EvaluationFrame& r);
+  void remember(const EvaluationFrame& r);
+};
+
+EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size_t joint_count,
+                                             float dt)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.roles = roles;
+  s.joint_count = joint_count;
+  s.dt = dt;
+  s.toes[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
+  s.toes[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+  s.lookback_frames = std::max(1, clamped_integer<int>(std::round(kStandTurnLookback / dt)));
+  s.stand_settle_frames = frames_for(kStandSettleSeconds, dt);
+  s.idle_settle_frames = frames_for(kIdleSettleSeconds, dt);
+  s.strafe_settle_frames = frames_for(kStrafeSettleSeconds, dt);
+  for (std::vector<glm::vec3>& p : s.positions) p.assign(joint_count, glm::vec3(0.0f));
+  s.desired_speed_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
+  s.desired_yaw_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
+}
+
+EvaluationAccumulator::~EvaluationAccumulator() = default;
+
+void EvaluationAccumulator::add(const EvaluationFrame& frame) {
+  State& s = *state_;
+  MM_ASSERT(frame.joints.size() == s.joint_count);
+  s.follow_origin(frame);
+  s.measure_plain(frame);
+  s.update_held(frame);
+  s.measure_feet(frame);
+  const float hips_rate = s.measure_hips(frame);
+  s.measure_stand_turn(frame, hips_rate);
+  s.measure_chest_and_head(frame);
+  s.measure_transition_accel(frame);
+  s.remember(frame);
+}
+
+// The earlier frames' positions shifted into this frame's origin (a whole number of metres,
+// local_origin.hpp): positions near the character move by at most a float step there.
+void EvaluationAccumulator::State::follow_origin(const EvaluationFrame& r) {
+  if (frames == 0 || r.origin == previous.origin) return;
+  const glm::vec3 shift(r.origin - previous.origin);
+  for (std::vector<glm::vec3>& frame : positions) {
+    for (glm::vec3& p : frame) p -= shift;
+  }
+  previous.root_position -= shift;
+  previous.sim_position -= shift;
+  previous.origin = r.origin;
+}
+
+// Distance and facing to the simulation, timings, transitions, the responses.
+void EvaluationAccumulator::State::measure_plain(const EvaluationFrame& r) {
+  const double d = 100.0 * horizontal_distance(r.root_position, r.sim_position);
+  distance.add(d);
+  distance_max = std::max(distance_max, d);
+  facing.add(yaw_error_deg(r.root_yaw, r.sim_yaw));
+  updates.add(r.update_seconds * 1e6);
+  if (r.searched) searches.add(r.search_seconds * 1e6);
+  transitions += r.transition ? 1 : 0;
+  if (frames > 0) measure_responses(r);
+}
+
+// Speed: events where the desired speed jumps, done when the root speed is close to it.
+// Heading: events where the desired facing jumps, done when the root faces it.
+void EvaluationAccumulator::State::measure_responses(const EvaluationFrame& r) {
+  const float desired = glm::length(r.desired_velocity);
+  const float previous_desired = glm::length(previous.desired_velocity);
+  if (std::abs(desired - previous_desired) >= kSpeedEventChange) {
+    if (speed_event.start >= 0) ++speed_events;
+    speed_event = {frames, previous_desired, desired};
+  }
+  if (speed_event.start >= 0) {
+    const float speed = horizontal_distance(r.root_position, previous.root_position) / dt;
+    if (std::abs(speed - speed_event.to) <= 0.1f * std::abs(speed_event.to - speed_event.from)) {
+      speed_times.add((static_cast<double>(frames) - speed_event.start) * dt);
+      ++speed_events;
+      speed_event.start = -1;
+    }
+  }
+  if (std::abs(wrap_angle(r.desired_yaw - previous.desired_yaw)) >= kHeadingEventAngle) {
+    if (heading_event.start >= 0) ++heading_events;
+    heading_event.start = frames;
+  }
+  if (heading_event.start >= 0) {
+    // A turn that keeps going is followed to its end.
+    if (yaw_error_deg(r.root_yaw, r.desired_yaw) <= kSettleAngleDegrees) {
+      heading_times.add((static_cast<double>(frames) - heading_event.start) * dt);
+      ++heading_events;
+      heading_event.start = -1;
+    }
+  }
+}
+
+// How long the stick has been released and the desired facing and velocity held.
+void EvaluationAccumulator::State::update_held(const EvaluationFrame& r) {
+  standing_frames = glm::length(r.desired_velocity) == 0.0f ? standing_frames + 1 : 0;
+  const float facing_tolerance = glm::radians(kFacingToleranceDegrees);
+  facing_held.update(glm::vec3(r.desired_yaw, 0.0f, 0.0f), [&](glm::vec3 a, glm::vec3 b) {
+    return std::abs(wrap_angle(a.x - b.x)) > facing_tolerance;
+  });
+  velocity_held.update(r.desired_velocity, [](glm::vec3 a, glm::vec3 b) {
+    return glm::length(a - b) > kVelocityTolerance;
+  });
+}
+
+// Foot skating, standing feet, pivots, the lowest toe.
+void EvaluationAccumulator::State::measure_feet(const EvaluationFrame& r) {
+  const bool standing =
+      standing_frames >= stand_settle_frames && facing_held.frames >= stand_settle_frames;
+  for (int side = 0; side < 2; ++side) {
+    if (toes[side] < 0) continue;
+    const glm::vec3& toe = r.joints[static_cast<size_t>(toes[side])];
+    toe_height_min = std::min(toe_height_min, toe.y);
+    if (frames == 0) continue;
+    const float moved = horizontal_distance(toe, previous.joints[static_cast<size_t>(toes[side])]);
+    const double speed_cm = 100.0 * moved / dt;
+    if (r.contact[side] && previous.contact[side]) {
+      skate.add(speed_cm);
+      skate_mean.add(speed_cm);
+    }
+    if (standing) stand_foot.add(speed_cm);
+    measure_pivot(r, side,
+                  glm::distance(toe, previous.joints[static_cast<size_t>(toes[side])]) / dt);
+  }
+  if (standing && frames > 0) {
+    stand_root.add(100.0 * horizontal_distance(r.root_position, previous.root_position) / dt);
+  }
+}
+
+// The foot-to-toe vector's yaw rate while the toe is low and slow now and on the previous frame.
+void EvaluationAccumulator::State::measure_pivot(const EvaluationFrame& r, int side,
+                                                 float toe_speed) {
+  const int foot = side == 0 ? roles.left_foot : roles.right_foot;
+  const int toe = side == 0 ? roles.left_toe : roles.right_toe;
+  if (foot < 0 || toe < 0) return;
+  const glm::vec3& toe_position = r.joints[static_cast<size_t>(toe)];
+  const float yaw =
+      direction_yaw(toe_position - r.joints[static_cast<size_t>(foot)], pivot_yaw[side]);
+  const bool ok = toe_position.y < kPivotToeHeight && toe_speed < kPivotToeSpeed;
+  if (ok && pivot_ok[side]) pivot.add(yaw_error_deg(yaw, pivot_yaw[side]) / dt);
+  pivot_ok[side] = ok;
+  pivot_yaw[side] = yaw;
+}
+
+// The hips' yaw and its rate this frame (deg/s; 0 on the first frame or without hips).
+float EvaluationAccumulator::State::measure_hips(const EvaluationFrame& r) {
+  if (!has_hips()) return 0.0f;
+  const float yaw = pair_yaw(r.joints[static_cast<size_t>(roles.left_upper_leg)],
+                             r.joints[static_cast<size_t>(roles.right_upper_leg)], hips_yaw);
+  float rate = 0.0f;
+  if (frames > 0) {
+    rate = static_cast<float>(yaw_error_deg(yaw, hips_yaw) / dt);
+    hips_rates.add(rate);
+  }
+  hips_yaw = yaw;
+  return rate;
+}
+
+// Turning on the spot: start, follow and close events (see the header).
+void EvaluationAccumulator::State::measure_stand_turn(const EvaluationFrame& r, float hips_rate) {
+  const size_t ring = desired_speed_history.size();
+  const size_t now = static_cast<size_t>(frames) % ring;
+  const float speed = glm::length(r.desired_velocity);
+  desired_speed_history[now] = speed;
+  desired_yaw_history[now] = r.desired_yaw;
+  if (!has_hips()) return;
+  bool condition = false;
+  if (frames >= lookback_frames) {
+    const size_t then = static_cast<size_t>(frames - lookback_frames) % ring;
+    condition = speed < kStandTurnSpeed && desired_speed_history[then] < kStandTurnSpeed &&
+                yaw_error_deg(r.desired_yaw, desired_yaw_history[then]) >= kStandTurnAngleDegrees;
+  }
+  const bool starts = condition && !stand_turn_condition;
+  stand_turn_condition = condition;
+  if (starts || speed >= kStandTurnSpeed) {
+    stand_turn_sums.close(stand_turn, dt);
+    stand_turn = StandTurn{};
+    stand_turn.open = starts;
+  }
+  if (!stand_turn.open) return;
+  const double error = yaw_error_deg(hips_yaw, r.desired_yaw);
+  if (stand_turn.settle_frame < 0 && error <= kSettleAngleDegrees) {
+    stand_turn.settle_frame = stand_turn.length;
+  }
+  ++stand_turn.length;
+  stand_turn.last_error_deg = error;
+  stand_turn_sums.peak_rate_deg_s = std::max<double>(stand_turn_sums.peak_rate_deg_s, hips_rate);
+}
+
+// The chest's yaw error while strafing, the head's speed while idle.
+void EvaluationAccumulator::State::measure_chest_and_head(const EvaluationFrame& r) {
+  if (has_chest()) {
+    chest_yaw = pair_yaw(r.joints[static_cast<size_t>(roles.left_upper_arm)],
+                         r.joints[static_cast<size_t>(roles.right_upper_arm)], chest_yaw);
+    const float speed = glm::length(r.desired_velocity);
+    const bool strafing = speed >= kStrafeMinSpeed &&
+                          yaw_error_deg(direction_yaw(r.desired_velocity, r.desired_yaw),
+                                        r.desired_yaw) >= kStrafeMinAngleDegrees &&
+                          facing_held.frames >= strafe_settle_frames &&
+                          velocity_held.frames >= strafe_settle_frames;
+    if (strafing) strafe_chest.add(yaw_error_deg(chest_yaw, r.desired_yaw));
+  }
+  if (roles.head >= 0 && frames > 0 && standing_frames >= idle_settle_frames) {
+    const size_t head = static_cast<size_t>(roles.head);
+    idle_head.add(100.0 * glm::length(r.joints[head] - previous.joints[head]) / dt);
+  }
+}
+
+// Joint acceleration at the previous frame (it needs this one), counted once for every
+// transition among the 10 frames up to it.
+void EvaluationAccumulator::State::measure_transition_accel(const EvaluationFrame& r) {
+  if (frames >= 2) {
+    const int count = std::popcount(transition_bits & 0x3ffu);
+    for (int i = 0; i < count; ++i) {
+      joint_accelerations(positions[0], positions[1], r.joints, dt, accelerations);
+    }
+  }
+  transition_bits = (transition_bits << 1) | (r.transition ? 1u : 0u);
+}
+
+// This frame becomes the previous one: its scalars and a copy of its joints.
+void EvaluationAccumulator::State::remember(const EvaluationFrame& r) {
+  std::swap(positions[0], positions[1]);
+  std::copy(r.joints.begin(), r.joints.end(), positions[1].begin());
+  previous = r;
+  previous.joints = positions[1];
+  ++frames;
+}
+
+EvaluationMetrics EvaluationAccumulator::metrics() const {
+  const State& s = *state_;
+  EvaluationMetrics m;
+  m.frames = s.frames;
+  m.seconds = static_cast<double>(s.frames) * s.dt;
+  m.foot_skate_cm_s_mean = s.skate_mean.value();
+  m.foot_skate_cm_s_p95 = s.skate.percentile(95.0);
+  m.root_sim_distance_cm_mean = s.distance.value();
+  m.root_sim_distance_cm_max = s.distance_max;
+  m.facing_error_deg_mean = s.facing.value();
+  m.speed_events = s.speed_events + (s.speed_event.start >= 0 ? 1 : 0);
+  m.heading_events = s.heading_events + (s.heading_event.start >= 0 ? 1 : 0);
+  m.speed_events_reached = s.speed_times.count;
+  m.heading_events_reached = s.heading_times.count;
+  m.speed_response_s = s.speed_times.value();
+  m.heading_response_s = s.heading_times.value();
+  m.stand_root_speed_cm_s_mean = s.stand_root.value();
+  m.stand_foot_speed_cm_s_mean = s.stand_foot.value();
+  m.stand_frames = s.stand_root.count;
+  m.transitions_per_s = m.seconds > 0.0 ? s.transitions / m.seconds : 0.0;
+  m.search_us_mean = s.searches.value();
+  m.update_us_mean = s.updates.value();
+  m.transition_accel_p99 = s.accelerations.percentile(99.0);
+
+  m.body_turn_rate_deg_s_max = s.hips_rates.max();
+  m.body_turn_rate_deg_s_p99 = s.hips_rates.percentile(99.0);
+  m.foot_pivot_deg_s_mean = s.pivot.value();
+  m.foot_pivot_frames = s.pivot.count;
+  StandTurnSums turns = s.stand_turn_sums;
+  turns.close(s.stand_turn, s.dt);
+  m.stand_turns = turns.events;
+  m.stand_turn_unsettled = turns.unsettled;
+  m.stand_turn_response_s = turns.events > 0 ? turns.response_s / turns.events : 0.0;
+  m.stand_turn_final_error_deg_mean = turns.events > 0 ? turns.final_error_deg / turns.events : 0.0;
+  m.stand_turn_peak_rate_deg_s_max = turns.peak_rate_deg_s;
+  m.strafe_chest_error_deg_mean = s.strafe_chest.value();
+  m.strafe_chest_frames = s.strafe_chest.count;
+  m.idle_head_speed_cm_s_mean = s.idle_head.value();
+  m.idle_head_frames = s.idle_head.count;
+  m.toe_height_min_cm = std::isfinite(s.toe_height_min) ? 100.0 * s.toe_height_min : 0.0;
+  return m;
+}
+
+namespace {
+
+std::string csv_header(const Database& db) {
+  std::string h =
+      "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,"
+      "desired_yaw_deg,transition,contact_l,contact_r,clip,frame";
+  for (const std::string& name : db.skeleton.names()) {
+    h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
+  }
+  return h;
+}
+
+// Positions in the world: the frame's origin plus its relative positions, summed in double.
+std::string csv_row(const EvaluationFrame& r) {
+  char buffer[256];
+  const glm::dvec3 sim = to_world(r.origin, r.sim_position);
+  const glm::dvec3 root = to_world(r.origin, r.root_position);
+  std::snprintf(buffer, sizeof buffer,
+                "%.6f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%.6f,%.6f,%.4f,%d,%d,%d,%d,%d", r.t, sim.x,
+                sim.z, glm::degrees(r.sim_yaw), root.x, root.z, glm::degrees(r.root_yaw),
+                r.desired_velocity.x, r.desired_velocity.z, glm::degrees(r.desired_yaw),
+                r.transition ? 1 : 0, r.contact[0] ? 1 : 0, r.contact[1] ? 1 : 0, r.clip, r.frame);
+  std::string row = buffer;
+  for (const glm::vec3& joint : r.joints) {
+    const glm::dvec3 p = to_world(r.origin, joint);
+    std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", p.x, p.y, p.z);
+    row += buffer;
+  }
+  return row;
+}
+
+// The record of the update just made, relative to the controller's origin (as the debug state
+// is); `positions` receives the joints it views.
+EvaluationFrame frame_record(const Controller& controller, float t, double update_seconds,
+                             std::vector<glm::vec3>& positions) {
+  const ControllerDebug& d = controller.debug();
+  const std::span<const Transform> globals = controller.origin_transforms();
+  EvaluationFrame r;
+  r.t = t;
+  r.origin = controller.origin();
+  r.sim_position = d.simulation_position;
+  r.sim_yaw = quat_yaw(d.simulation_rotation);
+  r.root_position = globals[0].translation;
+  r.root_yaw = quat_yaw(globals[0].rotation);
+  r.desired_velocity = d.desired_velocity;
+  r.desired_yaw = quat_yaw(d.desired_rotation);
+  r.transition = d.transitioned;
+  r.clip = d.clip;
+  r.frame = d.frame;
+  r.contact[0] = d.contact[0];
+  r.contact[1] = d.contact[1];
+  r.update_seconds = update_seconds;
+  r.searched = d.searched;
+  r.search_seconds = d.search_seconds;
+  for (size_t j = 0; j < positions.size(); ++j) positions[j] = globals[j].translation;
+  r.joints = positions;
+  return r;
+}
+
+// The transition figures against the database's own acceleration at the same dt.
+void compare_with_database(const ControllerDatabase& database, const EvaluationOptions& options,
+                           EvaluationMetrics& m) {
+  const Database& db = database.database();
+  const uint64_t excluded = database.action_tags() | database.idle_tags();
+  m.database_accel_p99 = database_acceleration_p99(db, options.dt, excluded);
+  m.transition_accel_ratio =
+      m.database_accel_p99 > 0.0 ? m.transition_accel_p99 / m.database_accel_p99 : 0.0;
+  m.database_accel_p99_same_sampling =
+      options.settings.cubic_playback ? database_acceleration_p99(db, options.dt, excluded, true)
+                                      : m.database_accel_p99;
+  m.transition_accel_ratio_same_sampling =
+      m.database_accel_p99_same_sampling > 0.0
+          ? m.transition_accel_p99 / m.database_accel_p99_same_sampling
+          : 0.0;
+}
+
+}  // namespace
+
+double database_acceleration_p99(const Database& db, float dt, uint64_t excluded_tags, bool cubic) {
+  if (!(dt > 0.0f)) return 0.0;
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  PercentileHistogram accelerations;
+  std::vector<Transform> local(joints), global(joints);
+  // The joint positions of the last three steps, by step modulo 3: the second difference needs
+  // no more, so memory does not grow with the clips' length or a small dt.
+  std::vector<glm::vec3> recent[3];
+  for (std::vector<glm::vec3>& step : recent) step.assign(joints, glm::vec3(0.0f));
+  for (const ClipRange& clip : db.clips) {
+    if (clip.tags & excluded_tags) continue;
+    const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time;
+    const int64_t steps = clamped_integer<int64_t>(std::floor(duration / dt)) + 1;
+    if (steps < 3) continue;
+    for (int64_t s = 0; s < steps; ++s) {
+      const float x = static_cast<float>(s) * dt / db.frame_time;
+      const int i0 = std::min(clamped_integer<int>(std::floor(x)), clip.frame_count() - 1);
+      const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+      const float a = x - static_cast<float>(i0);
+      for (size_t j = 0; j < joints; ++j) {
+        local[j] = sample_database_joint(db, clip.start + i0, clip.start + i1, a, j, cubic,
+                                         InterpolationMethod::Nlerp);
+      }
+      forward_kinematics(db.skeleton.parents(), local, global);
+      std::vector<glm::vec3>& now = recent[s % 3];
+      for (size_t j = 0; j < joints; ++j) now[j] = global[j].translation;
+      if (s >= 2) {
+        joint_accelerations(recent[(s - 2) % 3], recent[(s - 1) % 3], now, dt, accelerations);
+      }
+    }
+  }
+  return accelerations.percentile(99.0);
+}
+
+Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabase> database,
+                                         const InputScript& script,
+                                         const EvaluationOptions& options) {
+  if (!std::isfinite(options.seconds) || options.seconds < 0.0f) {
+    return Error{"evaluation: seconds must be >= 0"};
+  }
+  if (!std::isfinite(options.start.x) || !std::isfinite(options.start.y)) {
+    return Error{"evaluation: the start position must be finite"};
+  }
+  const float dt = options.dt;
+  const float seconds = options.seconds > 0.0f ? options.seconds : script.duration() + 2.0f;
+  const Result<int> frame_count = scripted_run_frames(seconds, dt);
+  if (!frame_count) return Error{"evaluation: " + frame_count.message()};
+  if (!database) return Error{"evaluation: no database"};
+  Result<Controller> made = Controller::create(database, options.settings);
+  if (!made) return Error{made.message()};
+  Controller& controller = *made;
+  // A controller is created at the world origin; only a start elsewhere is a teleport, so a
+  // run from the origin is the same run it always was.
+  if (options.start != glm::dvec2(0.0)) {
+    controller.teleport_world(glm::dvec3(options.start.x, 0.0, options.start.y), 0.0f);
+  }
+  const Database& db = database->database();
+  const size_t joints = static_cast<size_t>(db.joint_count());
+
+  if (options.dump) *options.dump << csv_header(db) << "\n";
+  EvaluationAccumulator accumulator(db.roles, joints, dt);
+  std::vector<glm::vec3> positions(joints);
+  using Clock = std::chrono::steady_clock;
+  for (int f = 0; f < *frame_count; ++f) {
+    const float t = static_cast<float>(f + 1) * dt;
+    const ControllerInput input = script.at(t);
+    const Clock::time_point start = Clock::now();
+    controller.update(dt, input);
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    const EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
+    accumulator.add(frame);
+    if (options.dump) *options.dump << csv_row(frame) << "\n";
+  }
+  EvaluationResult result;
+  result.metrics = accumulator.metrics();
+  compare_with_database(*database, options, result.metrics);
+  return result;
+}
+
+}  // namespace mm

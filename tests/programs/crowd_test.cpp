@@ -1,0 +1,151 @@
+// Controllers on several threads over one shared database: the crowd run on 2 and 4 threads
+// against 1, and controllers created (their searchers built on first use) concurrently against
+// the same controllers made one after another. The suites' names end in "Threads": the
+// ThreadSanitizer pass of scripts/test.sh runs exactly those (tests/CMakeLists.txt).
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mm/controller/controller.hpp"
+#include "mm/offline/builder.hpp"
+#include "mm/programs/crowd.hpp"
+#include "test_support.hpp"
+
+namespace mm {
+namespace {
+
+constexpr float kDt = 1.0f / 60.0f;
+
+// A few walks, turns and runs: enough for the controller to move, small enough to build in
+// seconds under ThreadSanitizer.
+std::shared_ptr<const Database> small_database() {
+  static const std::shared_ptr<const Database> shared = [] {
+    std::vector<std::filesystem::path> inputs;
+    for (const char* stem : {"dataset-2_walk_normal_001", "dataset-2_walk_normal_002",
+                             "dataset-2_walk-turn-left_normal_001",
+                             "dataset-2_walk-turn-right_normal_001", "dataset-2_run_normal_001"}) {
+      inputs.push_back(test::clip_path(stem));
+    }
+    Result<Database> db = build_database(inputs, BuildOptions{});
+    EXPECT_TRUE(db.ok()) << (db.ok() ? "" : db.message());
+    return db.ok() ? std::make_shared<const Database>(std::move(db).value()) : nullptr;
+  }();
+  return shared;
+}
+
+// A controller database of its own, with no searcher built yet.
+std::shared_ptr<const ControllerDatabase> fresh_controller_database() {
+  Result<std::shared_ptr<const ControllerDatabase>> made =
+      ControllerDatabase::create(small_database());
+  EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.message());
+  return made.ok() ? *made : nullptr;
+}
+
+TEST(CrowdThreads, TwoAndFourThreadsGiveTheOneThreadCrowd) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 12;
+  options.seconds = 3.0f;
+  std::vector<glm::vec3> reference;
+  for (const int threads : {1, 2, 4}) {
+    options.threads = threads;
+    Result<CrowdResult> run = run_crowd(shared, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    EXPECT_EQ(run->threads, threads);
+    ASSERT_EQ(run->final_positions.size(), 12u);
+    // The run is shorter than one window: nothing to replay, one window.
+    EXPECT_TRUE(run->replay_final_positions.empty()) << threads << " threads";
+    EXPECT_EQ(run->update_us_first_window, run->update_us_last_window) << threads << " threads";
+    if (threads == 1) {
+      reference = run->final_positions;
+      continue;
+    }
+    for (size_t i = 0; i < reference.size(); ++i) {
+      EXPECT_EQ(run->final_positions[i], reference[i]) << threads << " threads, character " << i;
+    }
+  }
+  // The characters walked away from their grid cells (3 m apart), so the comparison is of
+  // motion, not of characters standing where they were put.
+  int moved = 0;
+  for (size_t i = 0; i < reference.size(); ++i) {
+    const glm::vec3 start(static_cast<float>(i % 32) * 3.0f, 0.0f, 0.0f);
+    moved += glm::distance(reference[i], start) > 0.5f;
+  }
+  EXPECT_GE(moved, 9);
+}
+
+TEST(CrowdThreads, TheReplayedFirstWindowEndsWhereTheRunsFirstWindowDid) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 4;
+  options.dt = 0.1f;  // coarse, to cover more than a window in few frames
+  options.threads = 2;
+  options.seconds = kCrowdWindowSeconds;
+  Result<CrowdResult> first_window = run_crowd(shared, options);
+  ASSERT_TRUE(first_window.ok()) << first_window.message();
+  options.seconds = kCrowdWindowSeconds + 5.0f;
+  Result<CrowdResult> longer = run_crowd(shared, options);
+  ASSERT_TRUE(longer.ok()) << longer.message();
+  EXPECT_EQ(longer->replay_final_positions, first_window->final_positions);
+  EXPECT_NE(longer->final_positions, first_window->final_positions);
+  EXPECT_GT(longer->update_us_first_window, 0.0);
+  EXPECT_GT(longer->update_us_last_window, 0.0);
+}
+
+// One character's run: created over `shared` with this search method, then three seconds of
+// its varied script. Returns its final global transforms (empty when create failed).
+std::vector<Transform> run_character(const std::shared_ptr<const ControllerDatabase>& shared,
+                                     const std::string& method, uint32_t seed) {
+  ControllerSettings settings;
+  settings.search_method = method;
+  Result<Controller> made = Controller::create(shared, settings);
+  if (!made.ok()) return {};
+  Controller& c = *made;
+  const InputScript script = varied_input_script(seed, 3.0f);
+  for (int f = 1; f <= 180; ++f) c.update(kDt, script.at(static_cast<float>(f) * kDt));
+  return {c.global_transforms().begin(), c.global_transforms().end()};
+}
+
+TEST(ControllerThreads, ConcurrentlyCreatedControllersMatchSequentialOnes) {
+  // Four characters, two of them on one method: the searchers are built on first use while
+  // other threads ask for the same one or another.
+  const std::array<std::string, 4> methods = {"boxtree", "kdtree", "brute-simd", "boxtree"};
+  const std::shared_ptr<const ControllerDatabase> sequential_database = fresh_controller_database();
+  ASSERT_NE(sequential_database, nullptr);
+  std::array<std::vector<Transform>, 4> sequential, concurrent;
+  for (size_t i = 0; i < methods.size(); ++i) {
+    sequential[i] = run_character(sequential_database, methods[i], static_cast<uint32_t>(i));
+    ASSERT_FALSE(sequential[i].empty()) << methods[i];
+  }
+
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < methods.size(); ++i) {
+    threads.emplace_back(
+        [&, i] { concurrent[i] = run_character(shared, methods[i], static_cast<uint32_t>(i)); });
+  }
+  for (std::thread& t : threads) t.join();
+
+  for (size_t i = 0; i < methods.size(); ++i) {
+    ASSERT_EQ(concurrent[i].size(), sequential[i].size()) << methods[i];
+    for (size_t j = 0; j < concurrent[i].size(); ++j) {
+      EXPECT_EQ(concurrent[i][j].translation, sequential[i][j].translation)
+          << "character " << i << ", joint " << j;
+      EXPECT_EQ(concurrent[i][j].rotation, sequential[i][j].rotation)
+          << "character " << i << ", joint " << j;
+    }
+  }
+  // Different scripts end in different places: each thread ran its own character.
+  EXPECT_NE(sequential[0][0].translation, sequential[3][0].translation);
+}
+
+}  // namespace
+}  // namespace mm
