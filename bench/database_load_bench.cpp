@@ -37,7 +37,7 @@ mm::Database make_synthetic_database() {
   std::mt19937 rng(1234);
   std::normal_distribution<float> normal(0.0f, 1.0f);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  mm::Database db;
+  mm::DatabaseContents db;
   std::vector<std::string> names;
   std::vector<int> parents;
   for (int j = 0; j < kJoints; ++j) {
@@ -74,7 +74,6 @@ mm::Database make_synthetic_database() {
     const int end = std::min(kFrames, start + kFramesPerClip);
     db.clips.push_back({"dataset-2_walk_normal_" + std::to_string(c), start, end,
                         uint64_t{1} << (c % 4), c % 2 == 1});
-    db.frame_clip.insert(db.frame_clip.end(), static_cast<size_t>(end - start), c);
   }
   db.schema = mm::FeatureSchema::default_schema();
   const int dims = db.schema.dims();
@@ -86,7 +85,7 @@ mm::Database make_synthetic_database() {
   }
   db.searchable.resize(kFrames);
   for (uint8_t& s : db.searchable) s = unit(rng) < 0.95f ? 1 : 0;
-  return db;
+  return mm::Database::create(db).value();
 }
 
 std::filesystem::path g_path;
@@ -124,9 +123,9 @@ void BM_LoadDatabase(benchmark::State& state) {
       state.SkipWithError(db.message().c_str());
       return;
     }
-    benchmark::DoNotOptimize(db->features.data());
+    benchmark::DoNotOptimize(db->features().data());
     state.PauseTiming();
-    db = mm::Database{};
+    db = mm::Error{"freed"};
     state.ResumeTiming();
   }
   state.SetBytesProcessed(static_cast<int64_t>(state.iterations() * g_file_size));

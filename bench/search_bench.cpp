@@ -16,6 +16,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,7 +33,7 @@ using namespace mm;
 
 // The rows every benchmark uses, loaded or generated once.
 struct BenchData {
-  Database database;                                    // when MM_BENCH_DB names a file
+  std::optional<Database> database;                     // when MM_BENCH_DB names a file
   std::unique_ptr<DatabaseSearchInput> database_input;  // its search views
   SyntheticSearchData synthetic;
   SearchInput input;
@@ -51,8 +52,8 @@ const BenchData& data() {
     if (path != nullptr && *path != '\0') {
       auto loaded = load_database(path);
       if (loaded) {
-        out.database = std::move(loaded).value();
-        out.database_input = std::make_unique<DatabaseSearchInput>(out.database);
+        out.database.emplace(std::move(loaded).value());
+        out.database_input = std::make_unique<DatabaseSearchInput>(*out.database);
         out.input = out.database_input->input;
         out.source = path;
       } else {

@@ -25,14 +25,14 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
-#include "mm/offline/preprocess.hpp"
+#include "mm/database/velocities.hpp"
 
 namespace {
 
 std::vector<std::byte> g_valid_file;
 
-mm::Database make_seed_database() {
-  mm::Database db;
+mm::DatabaseContents make_seed_database() {
+  mm::DatabaseContents db;
   std::vector<mm::Transform> rest(3);
   rest[1].translation = {0.0f, 0.9f, 0.0f};
   rest[2].translation = {0.1f, -0.8f, 0.0f};
@@ -65,7 +65,6 @@ mm::Database make_seed_database() {
   db.feature_offset = {0.0f, 0.1f, 0.2f, 0.3f, 0.4f};
   db.feature_scale = {1.0f, 2.0f, 0.5f, 1.5f, 3.0f};
   db.searchable = {1, 1, 0, 0, 1, 0};
-  db.frame_clip = {0, 0, 0, 0, 1, 1};
   // The velocities the file does not store, as load recomputes them (clip by clip).
   db.local_velocities.resize(db.local_positions.size());
   db.local_angular_velocities.resize(db.local_positions.size());
@@ -105,8 +104,8 @@ void try_load(std::span<const std::byte> bytes) {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
-  const mm::Database seed = make_seed_database();
-  if (!seed.validate().ok()) __builtin_trap();
+  const mm::DatabaseContents seed = make_seed_database();
+  if (!mm::validate_database(seed).ok()) __builtin_trap();
   g_valid_file = mm::serialize_database(seed);
   for (int i = 1; i < *argc; ++i) {
     const char* arg = (*argv)[i];

@@ -178,7 +178,7 @@ Result<Controller> Controller::create(std::shared_ptr<const ControllerDatabase> 
 
 // The trajectory channels' times and where their columns are.
 Status Controller::resolve_schema() {
-  const FeatureSchema& schema = db_->schema;
+  const FeatureSchema& schema = db_->schema();
   if (schema.channels.size() > static_cast<size_t>(kMaxDebugChannels)) {
     return Error{"controller: the schema has more than " + std::to_string(kMaxDebugChannels) +
                  " channels"};
@@ -214,21 +214,21 @@ Status Controller::resolve_schema() {
 // roots to fold (see sample_playback).
 Status Controller::resolve_joints() {
   const Database& db = *db_;
-  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
   for (int side = 0; side < 2; ++side) {
     const int foot = feet[side];
-    const int knee = db.skeleton.parent(foot);
-    const int hip = knee >= 0 ? db.skeleton.parent(knee) : -1;
+    const int knee = db.skeleton().parent(foot);
+    const int hip = knee >= 0 ? db.skeleton().parent(knee) : -1;
     if (hip <= 0) {
-      return Error{"controller: the foot '" + db.skeleton.name(foot) +
+      return Error{"controller: the foot '" + db.skeleton().name(foot) +
                    "' does not hang from a two-bone leg"};
     }
-    const int toe = toes[side] >= 0 && db.skeleton.parent(toes[side]) == foot ? toes[side] : -1;
+    const int toe = toes[side] >= 0 && db.skeleton().parent(toes[side]) == foot ? toes[side] : -1;
     leg_joints_[side] = {hip, knee, foot, toe};
   }
   for (int j = 1; j < db.joint_count(); ++j) {
-    if (db.skeleton.parent(j) == 0 && db.skeleton.subtree_size(j) > 1 && j != db.roles.hips) {
+    if (db.skeleton().parent(j) == 0 && db.skeleton().subtree_size(j) > 1 && j != db.roles().hips) {
       folded_joints_.push_back(j);
     }
   }
@@ -250,7 +250,7 @@ void Controller::size_buffers() {
   skinning_.assign(n, glm::mat4(1.0f));
   query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
   std::vector<Transform> bind(n), inverse_bind(n);
-  forward_kinematics(db.skeleton.parents(), db.skeleton.rest(), bind);
+  forward_kinematics(db.skeleton().parents(), db.skeleton().rest(), bind);
   inverse_bind_transforms(bind, inverse_bind);
   inverse_bind_.resize(n);
   for (size_t j = 0; j < n; ++j) inverse_bind_[j] = to_matrix(inverse_bind[j]);
@@ -260,7 +260,7 @@ void Controller::size_buffers() {
 void Controller::start_standing() {
   const std::span<const uint8_t> candidates = shared_->candidates();
   int start = -1;
-  for (const ClipRange& clip : db_->clips) {
+  for (const ClipRange& clip : db_->clips()) {
     if (!(clip.tags & shared_->idle_tags())) continue;
     for (int f = clip.start; f < clip.end && start < 0; ++f) {
       if (candidates[static_cast<size_t>(f)]) start = f;
@@ -423,8 +423,8 @@ void Controller::desired_motion(const ControllerInput& input) {
 uint64_t Controller::resolve_tag(std::string_view tag) const {
   if (tag.empty()) return 0;
   uint64_t bits = 0;
-  for (size_t i = 0; i < db_->tag_names.size(); ++i) {
-    const std::string& name = db_->tag_names[i];
+  for (size_t i = 0; i < db_->tag_names().size(); ++i) {
+    const std::string& name = db_->tag_names()[i];
     const bool word = name.size() > tag.size() && name.compare(0, tag.size(), tag) == 0 &&
                       name[tag.size()] == '-';
     if (name == tag || word) bits |= uint64_t{1} << i;
@@ -455,7 +455,7 @@ bool Controller::should_search() const {
 
 bool Controller::on_idle_clip() const {
   return stopping_ && clip_ >= 0 &&
-         (db_->clips[static_cast<size_t>(clip_)].tags & shared_->idle_tags()) != 0;
+         (db_->clips()[static_cast<size_t>(clip_)].tags & shared_->idle_tags()) != 0;
 }
 
 // Standing on an idle clip whose next frame may still be matched: nothing to search for.
@@ -470,8 +470,8 @@ void Controller::build_query() {
   const Database& db = *db_;
   const size_t dims = static_cast<size_t>(db.feature_dims());
   const PlaybackPoint at = playback_point();
-  const float* r0 = db.features.data() + static_cast<size_t>(at.frame0) * dims;
-  const float* r1 = db.features.data() + static_cast<size_t>(at.frame1) * dims;
+  const float* r0 = db.features().data() + static_cast<size_t>(at.frame0) * dims;
+  const float* r1 = db.features().data() + static_cast<size_t>(at.frame1) * dims;
   for (size_t c = 0; c < dims; ++c) query_[c] = r0[c] + at.weight * (r1[c] - r0[c]);
 
   const Transform& root = globals_[0];
@@ -484,8 +484,8 @@ void Controller::build_query() {
       v = inverse * (debug_.predicted_positions[t.time_index] - root.translation);
     }
     const size_t c = static_cast<size_t>(t.column);
-    query_[c] = (v.x - db.feature_offset[c]) / db.feature_scale[c];
-    query_[c + 1] = (v.z - db.feature_offset[c + 1]) / db.feature_scale[c + 1];
+    query_[c] = (v.x - db.feature_offset()[c]) / db.feature_scale()[c];
+    query_[c + 1] = (v.z - db.feature_offset()[c + 1]) / db.feature_scale()[c + 1];
   }
 }
 
@@ -513,7 +513,7 @@ SearchResult Controller::search_candidates() const {
   SearchConstraints constraints;
   constraints.current_frame = playback_point().frame0;
   const float window = on_idle_clip() ? settings_.idle_ignore_window : settings_.ignore_window;
-  constraints.window_frames = clamped_integer<int>(std::round(window / db.frame_time));
+  constraints.window_frames = clamped_integer<int>(std::round(window / db.frame_time()));
   constraints.transition_cost = settings_.transition_cost;
   if (tag_bits_ == 0) {
     if (stopping_) {
@@ -545,10 +545,10 @@ void Controller::record_search(const SearchResult& best) {
   debug_.query_dims = shown;
   std::copy(query_.begin(), query_.begin() + shown, debug_.last_query);
   if (best.frame < 0) return;
-  const float* row = db.features.data() + static_cast<size_t>(best.frame) * query_.size();
-  for (size_t ch = 0; ch < db.schema.channels.size(); ++ch) {
-    const int first = db.schema.offset(static_cast<int>(ch));
-    const int count = db.schema.channels[ch].dims();
+  const float* row = db.features().data() + static_cast<size_t>(best.frame) * query_.size();
+  for (size_t ch = 0; ch < db.schema().channels.size(); ++ch) {
+    const int first = db.schema().offset(static_cast<int>(ch));
+    const int count = db.schema().channels[ch].dims();
     float sum = 0.0f;
     for (int k = first; k < first + count; ++k) {
       const float d = query_[static_cast<size_t>(k)] - row[k];
@@ -563,18 +563,18 @@ void Controller::record_search(const SearchResult& best) {
 // transition source) with the database root of the new frame as the destination.
 void Controller::transition_to(int frame) {
   const Database& db = *db_;
-  const int clip = db.frame_clip[static_cast<size_t>(frame)];
-  const ClipRange& range = db.clips[static_cast<size_t>(clip)];
+  const int clip = db.frame_clip()[static_cast<size_t>(frame)];
+  const ClipRange& range = db.clips()[static_cast<size_t>(clip)];
   const bool had_clip = clip_ >= 0;
   if (had_clip) {
     transition_src_position_ = sampled_[0].translation;
     transition_src_rotation_ = sampled_[0].rotation;
   }
   const size_t k = static_cast<size_t>(frame) * static_cast<size_t>(db.joint_count());
-  transition_dst_position_ = db.local_positions[k];
-  transition_dst_rotation_ = db.local_rotations[k];
+  transition_dst_position_ = db.local_positions()[k];
+  transition_dst_rotation_ = db.local_rotations()[k];
   clip_ = clip;
-  clip_time_ = static_cast<float>(frame - range.start) * db.frame_time;
+  clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
   sample_playback(other_, other_velocities_, other_angular_velocities_);
   if (had_clip) {
     start_transition();
@@ -634,8 +634,8 @@ void Controller::clear_transitions() {
 
 // Seconds from the playing clip's first frame to its last.
 float Controller::clip_duration() const {
-  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
-  return static_cast<float>(clip.frame_count() - 1) * db_->frame_time;
+  const ClipRange& clip = db_->clips()[static_cast<size_t>(clip_)];
+  return static_cast<float>(clip.frame_count() - 1) * db_->frame_time();
 }
 
 void Controller::advance_playback(float dt) {
@@ -645,8 +645,8 @@ void Controller::advance_playback(float dt) {
 }
 
 Controller::PlaybackPoint Controller::playback_point() const {
-  const ClipRange& clip = db_->clips[static_cast<size_t>(clip_)];
-  const float x = clip_time_ / db_->frame_time;
+  const ClipRange& clip = db_->clips()[static_cast<size_t>(clip_)];
+  const float x = clip_time_ / db_->frame_time();
   const int i0 = std::clamp(clamped_integer<int>(std::floor(x)), 0, clip.frame_count() - 1);
   const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
   return {clip.start + i0, clip.start + i1, std::clamp(x - static_cast<float>(i0), 0.0f, 1.0f)};
@@ -672,9 +672,10 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
   for (size_t j = 0; j < joints; ++j) {
     local[j] = sample_joint(at, j);
-    velocities[j] = glm::mix(db.local_velocities[k0 + j], db.local_velocities[k1 + j], at.weight);
-    angular_velocities[j] = glm::mix(db.local_angular_velocities[k0 + j],
-                                     db.local_angular_velocities[k1 + j], at.weight);
+    velocities[j] =
+        glm::mix(db.local_velocities()[k0 + j], db.local_velocities()[k1 + j], at.weight);
+    angular_velocities[j] = glm::mix(db.local_angular_velocities()[k0 + j],
+                                     db.local_angular_velocities()[k1 + j], at.weight);
   }
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
@@ -684,9 +685,9 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
     const Transform folded = local[static_cast<size_t>(j)];
     const glm::vec3 v = velocities[static_cast<size_t>(j)];
     const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
-    const int end = j + db.skeleton.subtree_size(j);
+    const int end = j + db.skeleton().subtree_size(j);
     for (int c = j + 1; c < end; ++c) {
-      if (db.skeleton.parent(c) != j) continue;
+      if (db.skeleton().parent(c) != j) continue;
       const size_t k = static_cast<size_t>(c);
       const glm::vec3 offset = folded.rotation * local[k].translation;
       velocities[k] = v + glm::cross(w, offset) + folded.rotation * velocities[k];
@@ -870,7 +871,7 @@ void Controller::synchronize(float dt) {
 // The body's facing in the displayed pose: the yaw across the upper legs (pair_yaw), from the
 // local pose before forward kinematics.
 float Controller::body_yaw() const {
-  const std::span<const int> parents = db_->skeleton.parents();
+  const std::span<const int> parents = db_->skeleton().parents();
   const glm::vec3 left = forward_kinematics_joint(parents, locals_, leg_joints_[0][0]).translation;
   const glm::vec3 right = forward_kinematics_joint(parents, locals_, leg_joints_[1][0]).translation;
   return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
@@ -923,12 +924,12 @@ glm::quat Controller::warped_facing() const {
 // spine or chest roles, or without upper arms to measure the chest's facing by, are left as they
 // are.)
 void Controller::turn_chest_to_facing(float dt) {
-  const JointRoleIndices& roles = db_->roles;
+  const JointRoleIndices& roles = db_->roles();
   if (roles.left_upper_arm < 0 || roles.right_upper_arm < 0 ||
       (roles.spine < 0 && roles.chest < 0)) {
     return;
   }
-  const std::span<const int> parents = db_->skeleton.parents();
+  const std::span<const int> parents = db_->skeleton().parents();
   float goal = 0.0f;
   if (strafing_) {
     const float chest_yaw =
@@ -947,7 +948,7 @@ void Controller::turn_chest_to_facing(float dt) {
     if (joint < 0) continue;
     // A turn about the world's vertical, expressed in the joint's parent frame.
     const glm::quat parent =
-        forward_kinematics_joint(parents, locals_, db_->skeleton.parent(joint)).rotation;
+        forward_kinematics_joint(parents, locals_, db_->skeleton().parent(joint)).rotation;
     const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
     Transform& local = locals_[static_cast<size_t>(joint)];
     local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
@@ -994,11 +995,11 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
 }
 
 void Controller::finish_pose() {
-  forward_kinematics(db_->skeleton.parents(), locals_, globals_);
+  forward_kinematics(db_->skeleton().parents(), locals_, globals_);
   const Database& db = *db_;
-  const ClipRange& clip = db.clips[static_cast<size_t>(clip_)];
+  const ClipRange& clip = db.clips()[static_cast<size_t>(clip_)];
   const int frame =
-      std::clamp(clip.start + clamped_integer<int>(std::round(clip_time_ / db.frame_time)),
+      std::clamp(clip.start + clamped_integer<int>(std::round(clip_time_ / db.frame_time())),
                  clip.start, clip.end - 1);
   debug_.clip = clip_;
   debug_.frame = frame;
@@ -1008,7 +1009,7 @@ void Controller::finish_pose() {
   // incoming clip's is down, while the blend already carries a foot the incoming clip lifts.
   const bool early_blend = in_early_blend();
   for (size_t side = 0; side < 2; ++side) {
-    const bool label = db.contacts[static_cast<size_t>(frame) * 2 + side] != 0;
+    const bool label = db.contacts()[static_cast<size_t>(frame) * 2 + side] != 0;
     shown_contact_[side] = label && (!early_blend || blend_source_contact_[side]);
     debug_.contact[side] = shown_contact_[side];
   }
@@ -1128,7 +1129,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
 // Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
 // displayed root.
 glm::vec3 Controller::playing_position(int joint) const {
-  const Transform played = forward_kinematics_joint(db_->skeleton.parents(), sampled_, joint);
+  const Transform played = forward_kinematics_joint(db_->skeleton().parents(), sampled_, joint);
   return transform_point(compose(locals_[0], inverse(sampled_[0])), played.translation);
 }
 
@@ -1175,7 +1176,7 @@ float Controller::foot_heading(int side) const {
 // Two-bone IK of one leg toward a toe target, the foot turned to its held heading, then the
 // bone lengths restored.
 void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& target) {
-  const std::span<const int> parents = db_->skeleton.parents();
+  const std::span<const int> parents = db_->skeleton().parents();
   const std::vector<int>& leg = leg_joints_[side];
   const int hip = leg[0], knee = leg[1], foot = leg[2];
   // Reach: the ankle goes where the foot's rotation (animated, turned to the held heading)
@@ -1211,7 +1212,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
 void Controller::restore_leg_lengths(int side) {
   const std::vector<int>& leg = leg_joints_[side];
   const int count = leg[3] >= 0 ? 4 : 3;
-  const std::span<const int> parents = db_->skeleton.parents();
+  const std::span<const int> parents = db_->skeleton().parents();
   glm::vec3 points[4];
   DistanceConstraint constraints[3];
   for (int i = 0; i < count; ++i) points[i] = globals_[static_cast<size_t>(leg[i])].translation;
@@ -1255,8 +1256,8 @@ float Controller::leg_length(int side) const {
 }
 
 void Controller::refresh_subtree(int joint) {
-  const std::span<const int> parents = db_->skeleton.parents();
-  const int end = joint + db_->skeleton.subtree_size(joint);
+  const std::span<const int> parents = db_->skeleton().parents();
+  const int end = joint + db_->skeleton().subtree_size(joint);
   for (int j = joint; j < end; ++j) {
     const int p = parents[static_cast<size_t>(j)];
     globals_[static_cast<size_t>(j)] =

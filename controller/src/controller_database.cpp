@@ -17,8 +17,8 @@ namespace {
 
 // Bit mask of one tag name, 0 when the database does not have it.
 uint64_t tag_bit(const Database& db, std::string_view name) {
-  for (size_t i = 0; i < db.tag_names.size(); ++i) {
-    if (db.tag_names[i] == name) return uint64_t{1} << i;
+  for (size_t i = 0; i < db.tag_names().size(); ++i) {
+    if (db.tag_names()[i] == name) return uint64_t{1} << i;
   }
   return 0;
 }
@@ -38,15 +38,15 @@ ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_
   const int joints = db.joint_count();
   // Samples: [gait][direction], gait 0 walk, 1 run; direction 0 forward, 1 sideways, 2 backward.
   std::vector<float> samples[2][3];
-  for (const ClipRange& clip : db.clips) {
+  for (const ClipRange& clip : db.clips()) {
     if (clip.tags & excluded_tags) continue;
     const bool tagged_run = (clip.tags & run_tags) != 0;
     for (int f = clip.start; f < clip.end; ++f) {
       const size_t k = static_cast<size_t>(f) * static_cast<size_t>(joints);
-      const glm::vec3 v = db.local_velocities[k];
+      const glm::vec3 v = db.local_velocities()[k];
       const float speed = std::sqrt(v.x * v.x + v.z * v.z);
       if (speed < 0.3f) continue;
-      const glm::vec3 local = glm::conjugate(db.local_rotations[k]) * v;
+      const glm::vec3 local = glm::conjugate(db.local_rotations()[k]) * v;
       const float angle = std::abs(std::atan2(local.x, local.z));
       const int gait = run_tags ? (tagged_run ? 1 : 0) : (speed > 2.5f ? 1 : 0);
       int direction = -1;
@@ -82,15 +82,15 @@ ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_
 // along its chain of ancestors, joint 0 being relative to the ground.
 float lowest_height(const Database& db, int joint) {
   std::vector<int> chain;
-  for (int j = joint; j >= 0; j = db.skeleton.parent(j)) chain.push_back(j);
+  for (int j = joint; j >= 0; j = db.skeleton().parent(j)) chain.push_back(j);
   std::reverse(chain.begin(), chain.end());
   const size_t joints = static_cast<size_t>(db.joint_count());
   float lowest = std::numeric_limits<float>::infinity();
-  for (size_t f = 0; f < static_cast<size_t>(db.frame_count); ++f) {
+  for (size_t f = 0; f < static_cast<size_t>(db.frame_count()); ++f) {
     Transform global;
     for (const int j : chain) {
       const size_t k = f * joints + static_cast<size_t>(j);
-      global = compose(global, Transform{db.local_rotations[k], db.local_positions[k]});
+      global = compose(global, Transform{db.local_rotations()[k], db.local_positions()[k]});
     }
     lowest = std::min(lowest, global.translation.y);
   }
@@ -104,11 +104,11 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   if (!database) return Error{"controller database: no database given"};
   const Database& db = *database;
   if (Status s = db.validate(); !s) return Error{"controller database: " + s.message()};
-  if (db.roles.hips < 0 || db.roles.left_foot < 0 || db.roles.right_foot < 0) {
+  if (db.roles().hips < 0 || db.roles().left_foot < 0 || db.roles().right_foot < 0) {
     return Error{"controller database: the database has no hips or feet joint roles"};
   }
   bool has_trajectory = false;
-  for (const FeatureChannel& c : db.schema.channels) {
+  for (const FeatureChannel& c : db.schema().channels) {
     has_trajectory |=
         c.kind == FeatureKind::TrajectoryPosition || c.kind == FeatureKind::TrajectoryDirection;
   }
@@ -130,11 +130,12 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   out->action_tags_ = tag_bit(db, "action");
   out->idle_tags_ = tag_bit(db, kIdleTag);
 
-  const int excluded = clamped_integer<int>(std::round(options.clip_end_exclusion / db.frame_time));
+  const int excluded =
+      clamped_integer<int>(std::round(options.clip_end_exclusion / db.frame_time()));
   const int idle_excluded =
-      clamped_integer<int>(std::round(options.idle_clip_end_exclusion / db.frame_time));
-  out->candidates_.assign(db.searchable.begin(), db.searchable.end());
-  for (const ClipRange& clip : db.clips) {
+      clamped_integer<int>(std::round(options.idle_clip_end_exclusion / db.frame_time()));
+  out->candidates_.assign(db.searchable().begin(), db.searchable().end());
+  for (const ClipRange& clip : db.clips()) {
     // The synthesized idle clip is one held pose: its end is as good as its start. Idle clips
     // of the data end like any take: jumping to their last frames would hold the last pose.
     if (is_idle_clip(db, clip)) continue;
@@ -154,10 +155,10 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   }
   out->speeds_ = measure_speeds(db, out->action_tags_ | out->idle_tags_);
   // The same end joint per leg as the controller's foot IK (Controller::resolve_joints).
-  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
   for (int side = 0; side < 2; ++side) {
-    const bool toe = toes[side] >= 0 && db.skeleton.parent(toes[side]) == feet[side];
+    const bool toe = toes[side] >= 0 && db.skeleton().parent(toes[side]) == feet[side];
     out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
   }
   return std::shared_ptr<const ControllerDatabase>(std::move(out));

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <new>
 #include <string_view>
 #include <thread>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>
@@ -14,9 +16,15 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "mm/database/files.hpp"
+#include "mm/runtime/assert.hpp"
+
 namespace mm {
 
 namespace {
+
+// The per-frame arrays' block: cache-line aligned, and so is every array in it.
+constexpr size_t kBlockAlignment = 64;
 
 constexpr size_t kNotFound = static_cast<size_t>(-1);
 // Arrays are checked in blocks: a branch-free pass over a block vectorizes, and only a block
@@ -154,7 +162,7 @@ bool is_bone_kind(FeatureKind kind) {
          kind == FeatureKind::BoneDirection;
 }
 
-std::string frame_joint(const Database& db, size_t index) {
+std::string frame_joint(const DatabaseView& db, size_t index) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   const int joint = static_cast<int>(index % joints);
   return "[frame " + std::to_string(index / joints) + ", joint " + std::to_string(joint) + " '" +
@@ -169,7 +177,9 @@ Status check_size(std::string_view what, size_t actual, size_t expected, std::st
 
 }  // namespace
 
-uint64_t Database::tag_mask(std::span<const std::string> names) const {
+namespace {
+
+uint64_t mask_of(std::span<const std::string> tag_names, std::span<const std::string> names) {
   uint64_t mask = 0;
   const size_t usable = std::min<size_t>(tag_names.size(), 64);
   for (const std::string& name : names) {
@@ -180,13 +190,238 @@ uint64_t Database::tag_mask(std::span<const std::string> names) const {
   return mask;
 }
 
-bool is_idle_clip(const Database& db, const ClipRange& clip) {
+// Rounds a byte offset up to a cache line, where every per-frame array of the block starts.
+size_t aligned(size_t bytes) {
+  return (bytes + kBlockAlignment - 1) / kBlockAlignment * kBlockAlignment;
+}
+
+}  // namespace
+
+DatabaseView::DatabaseView(const Database& db)
+    : skeleton(db.skeleton()),
+      roles(db.roles()),
+      frame_time(db.frame_time()),
+      frame_count(db.frame_count()),
+      local_positions(db.local_positions()),
+      local_rotations(db.local_rotations()),
+      local_velocities(db.local_velocities()),
+      local_angular_velocities(db.local_angular_velocities()),
+      contacts(db.contacts()),
+      clips(db.clips()),
+      tag_names(db.tag_names()),
+      schema(db.schema()),
+      features(db.features()),
+      feature_offset(db.feature_offset()),
+      feature_scale(db.feature_scale()),
+      searchable(db.searchable()),
+      frame_clip(db.frame_clip()) {}
+
+DatabaseView::DatabaseView(const DatabaseContents& db)
+    : skeleton(db.skeleton),
+      roles(db.roles),
+      frame_time(db.frame_time),
+      frame_count(db.frame_count),
+      local_positions(db.local_positions),
+      local_rotations(db.local_rotations),
+      local_velocities(db.local_velocities),
+      local_angular_velocities(db.local_angular_velocities),
+      contacts(db.contacts),
+      clips(db.clips),
+      tag_names(db.tag_names),
+      schema(db.schema),
+      features(db.features),
+      feature_offset(db.feature_offset),
+      feature_scale(db.feature_scale),
+      searchable(db.searchable) {}
+
+DatabaseFill::DatabaseFill(DatabaseContents& db)
+    : skeleton(db.skeleton),
+      schema(db.schema),
+      frame_time(db.frame_time),
+      frame_count(db.frame_count),
+      local_positions(db.local_positions),
+      local_rotations(db.local_rotations),
+      local_velocities(db.local_velocities),
+      local_angular_velocities(db.local_angular_velocities),
+      contacts(db.contacts),
+      features(db.features),
+      searchable(db.searchable) {}
+
+DatabaseFill::DatabaseFill(const DatabaseView& read, std::span<glm::vec3> positions,
+                           std::span<glm::quat> rotations, std::span<glm::vec3> velocities,
+                           std::span<glm::vec3> angular_velocities,
+                           std::span<uint8_t> foot_contacts, std::span<float> feature_rows,
+                           std::span<uint8_t> searchable_frames)
+    : skeleton(read.skeleton),
+      schema(read.schema),
+      frame_time(read.frame_time),
+      frame_count(read.frame_count),
+      local_positions(positions),
+      local_rotations(rotations),
+      local_velocities(velocities),
+      local_angular_velocities(angular_velocities),
+      contacts(foot_contacts),
+      features(feature_rows),
+      searchable(searchable_frames) {}
+
+uint64_t DatabaseView::tag_mask(std::span<const std::string> names) const {
+  return mask_of(tag_names, names);
+}
+
+uint64_t Database::tag_mask(std::span<const std::string> names) const {
+  return mask_of(tag_names_, names);
+}
+
+void Database::FreeBlock::operator()(std::byte* block) const {
+  ::operator delete (block, std::align_val_t{kBlockAlignment});
+}
+
+Database::Database(Database&& other) noexcept {
+  *this = std::move(other);
+}
+
+Database& Database::operator=(Database&& other) noexcept {
+  if (this == &other) return *this;
+  skeleton_ = std::move(other.skeleton_);
+  roles_ = other.roles_;
+  frame_time_ = other.frame_time_;
+  frame_count_ = std::exchange(other.frame_count_, 0);
+  clips_ = std::move(other.clips_);
+  tag_names_ = std::move(other.tag_names_);
+  schema_ = std::move(other.schema_);
+  // The block moves with its owner, so the views into it stay valid; the source keeps none.
+  block_ = std::move(other.block_);
+  local_positions_ = std::exchange(other.local_positions_, {});
+  local_rotations_ = std::exchange(other.local_rotations_, {});
+  local_velocities_ = std::exchange(other.local_velocities_, {});
+  local_angular_velocities_ = std::exchange(other.local_angular_velocities_, {});
+  contacts_ = std::exchange(other.contacts_, {});
+  features_ = std::exchange(other.features_, {});
+  feature_offset_ = std::exchange(other.feature_offset_, {});
+  feature_scale_ = std::exchange(other.feature_scale_, {});
+  searchable_ = std::exchange(other.searchable_, {});
+  frame_clip_ = std::exchange(other.frame_clip_, {});
+  return *this;
+}
+
+void Database::allocate(size_t frames, size_t joints, size_t dims) {
+  const size_t samples = frames * joints;
+  // Widest elements first; each array starts on a cache line.
+  size_t bytes = 0;
+  const auto place = [&](size_t count, size_t size) {
+    const size_t at = bytes;
+    bytes = aligned(bytes + count * size);
+    return at;
+  };
+  const size_t rotations = place(samples, sizeof(glm::quat));
+  const size_t positions = place(samples, sizeof(glm::vec3));
+  const size_t velocities = place(samples, sizeof(glm::vec3));
+  const size_t angular = place(samples, sizeof(glm::vec3));
+  const size_t features = place(frames * dims, sizeof(float));
+  const size_t offset = place(dims, sizeof(float));
+  const size_t scale = place(dims, sizeof(float));
+  const size_t clip = place(frames, sizeof(int));
+  const size_t contacts = place(frames * 2, 1);
+  const size_t searchable = place(frames, 1);
+  block_.reset(static_cast<std::byte*>(
+      ::operator new (std::max<size_t>(bytes, 1), std::align_val_t{kBlockAlignment})));
+  advise_huge_pages(block_.get(), bytes);
+  std::byte* const base = block_.get();
+  const auto array = [&]<class T>(size_t at, size_t count, T*) {
+    return std::span<T>(reinterpret_cast<T*>(base + at), count);
+  };
+  local_rotations_ = array(rotations, samples, static_cast<glm::quat*>(nullptr));
+  local_positions_ = array(positions, samples, static_cast<glm::vec3*>(nullptr));
+  local_velocities_ = array(velocities, samples, static_cast<glm::vec3*>(nullptr));
+  local_angular_velocities_ = array(angular, samples, static_cast<glm::vec3*>(nullptr));
+  features_ = array(features, frames * dims, static_cast<float*>(nullptr));
+  feature_offset_ = array(offset, dims, static_cast<float*>(nullptr));
+  feature_scale_ = array(scale, dims, static_cast<float*>(nullptr));
+  frame_clip_ = array(clip, frames, static_cast<int*>(nullptr));
+  contacts_ = array(contacts, frames * 2, static_cast<uint8_t*>(nullptr));
+  searchable_ = array(searchable, frames, static_cast<uint8_t*>(nullptr));
+}
+
+void Database::keep_frames(size_t frames) {
+  MM_ASSERT(frames <= frame_clip_.size());
+  const size_t joints = local_positions_.size() / std::max<size_t>(frame_clip_.size(), 1);
+  const size_t dims = features_.size() / std::max<size_t>(frame_clip_.size(), 1);
+  frame_count_ = static_cast<int>(frames);
+  local_positions_ = local_positions_.first(frames * joints);
+  local_rotations_ = local_rotations_.first(frames * joints);
+  local_velocities_ = local_velocities_.first(frames * joints);
+  local_angular_velocities_ = local_angular_velocities_.first(frames * joints);
+  features_ = features_.first(frames * dims);
+  frame_clip_ = frame_clip_.first(frames);
+  contacts_ = contacts_.first(frames * 2);
+  searchable_ = searchable_.first(frames);
+}
+
+void Database::derive_frame_clip() {
+  for (size_t c = 0; c < clips_.size(); ++c) {
+    std::fill(frame_clip_.begin() + clips_[c].start, frame_clip_.begin() + clips_[c].end,
+              static_cast<int>(c));
+  }
+}
+
+Result<Database> Database::create(const DatabaseContents& contents) {
+  if (Status s = validate_database(contents); !s) return Error{s.message()};
+  Database db;
+  db.skeleton_ = contents.skeleton;
+  db.roles_ = contents.roles;
+  db.frame_time_ = contents.frame_time;
+  db.frame_count_ = contents.frame_count;
+  db.clips_ = contents.clips;
+  db.tag_names_ = contents.tag_names;
+  db.schema_ = contents.schema;
+  db.allocate(static_cast<size_t>(contents.frame_count),
+              static_cast<size_t>(contents.joint_count()),
+              static_cast<size_t>(contents.feature_dims()));
+  const auto copy = [](const auto& from, auto to) {
+    std::copy(from.begin(), from.end(), to.begin());
+  };
+  copy(contents.local_positions, db.local_positions_);
+  copy(contents.local_rotations, db.local_rotations_);
+  copy(contents.local_velocities, db.local_velocities_);
+  copy(contents.local_angular_velocities, db.local_angular_velocities_);
+  copy(contents.contacts, db.contacts_);
+  copy(contents.features, db.features_);
+  copy(contents.feature_offset, db.feature_offset_);
+  copy(contents.feature_scale, db.feature_scale_);
+  copy(contents.searchable, db.searchable_);
+  db.derive_frame_clip();
+  return db;
+}
+
+DatabaseContents Database::contents() const {
+  DatabaseContents out;
+  out.skeleton = skeleton_;
+  out.roles = roles_;
+  out.frame_time = frame_time_;
+  out.frame_count = frame_count_;
+  out.local_positions.assign(local_positions_.begin(), local_positions_.end());
+  out.local_rotations.assign(local_rotations_.begin(), local_rotations_.end());
+  out.local_velocities.assign(local_velocities_.begin(), local_velocities_.end());
+  out.local_angular_velocities.assign(local_angular_velocities_.begin(),
+                                      local_angular_velocities_.end());
+  out.contacts.assign(contacts_.begin(), contacts_.end());
+  out.clips = clips_;
+  out.tag_names = tag_names_;
+  out.schema = schema_;
+  out.features.assign(features_.begin(), features_.end());
+  out.feature_offset.assign(feature_offset_.begin(), feature_offset_.end());
+  out.feature_scale.assign(feature_scale_.begin(), feature_scale_.end());
+  out.searchable.assign(searchable_.begin(), searchable_.end());
+  return out;
+}
+
+bool is_idle_clip(const DatabaseView& db, const ClipRange& clip) {
   const std::string tag = kIdleTag;
   return clip.name == kIdleClipName && !clip.mirrored &&
          (clip.tags & db.tag_mask(std::span(&tag, 1))) != 0;
 }
 
-int find_idle_clip(const Database& db) {
+int find_idle_clip(const DatabaseView& db) {
   for (size_t c = db.clips.size(); c-- > 0;) {
     if (is_idle_clip(db, db.clips[c])) return static_cast<int>(c);
   }
@@ -229,7 +464,7 @@ Status validate_clip_ranges(std::span<const ClipRange> clips, int frame_count, s
 namespace {
 
 // The skeleton: structure, then rest transforms.
-Status check_skeleton(const Database& db) {
+Status check_skeleton(const DatabaseView& db) {
   const int joints = db.joint_count();
   if (joints <= 0) return Error{"database: the skeleton has no joints"};
   if (Status s =
@@ -251,7 +486,7 @@ Status check_skeleton(const Database& db) {
 }
 
 // Roles name existing joints or nothing.
-Status check_roles(const Database& db) {
+Status check_roles(const DatabaseView& db) {
   const int joints = db.joint_count();
   for (const JointRoleInfo& role : kJointRoles) {
     const int joint = db.roles.*role.index;
@@ -264,7 +499,7 @@ Status check_roles(const Database& db) {
 }
 
 // The per-frame, per-joint arrays and the contacts hold one value per frame (and joint).
-Status check_frame_arrays(const Database& db) {
+Status check_frame_arrays(const DatabaseView& db) {
   const int joints = db.joint_count();
   if (db.frame_count <= 0)
     return Error{"database: has no frames (frame_count " + std::to_string(db.frame_count) + ")"};
@@ -292,7 +527,7 @@ Status check_frame_arrays(const Database& db) {
 }
 
 // The schema, the bones its channels name, and the feature arrays' sizes.
-Status check_schema_and_features(const Database& db) {
+Status check_schema_and_features(const DatabaseView& db) {
   const size_t frames = static_cast<size_t>(db.frame_count);
   if (Status s = db.schema.validate(); !s) return Error{"database: schema: " + s.message()};
   for (size_t c = 0; c < db.schema.channels.size(); ++c) {
@@ -333,7 +568,7 @@ Status check_schema_and_features(const Database& db) {
 }
 
 // Tag names: at most 64, non-empty, distinct.
-Status check_tags(const Database& db) {
+Status check_tags(const DatabaseView& db) {
   if (db.tag_names.size() > 64) {
     return Error{"database: " + std::to_string(db.tag_names.size()) +
                  " tag names; at most 64 fit the 64-bit clip tag masks"};
@@ -351,40 +586,26 @@ Status check_tags(const Database& db) {
   return Status::success();
 }
 
-// Clips tile [0, frame_count) in order; frame_clip agrees with them.
-Status check_clips(const Database& db) {
-  const size_t frames = static_cast<size_t>(db.frame_count);
-  if (Status s = validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size()); !s) return s;
-  if (Status s = check_size("frame_clip", db.frame_clip.size(), frames, "one per frame"); !s)
-    return s;
-  for (size_t c = 0; c < db.clips.size(); ++c) {
-    for (int f = db.clips[c].start; f < db.clips[c].end; ++f) {
-      if (db.frame_clip[static_cast<size_t>(f)] != static_cast<int>(c)) {
-        return Error{"database: frame_clip[" + std::to_string(f) + "] is " +
-                     std::to_string(db.frame_clip[static_cast<size_t>(f)]) +
-                     ", but the frame is in clip " + std::to_string(c) + " '" + db.clips[c].name +
-                     "'"};
-      }
-    }
-  }
-  return Status::success();
+// Clips tile [0, frame_count) in order (frame_clip is derived from them).
+Status check_clips(const DatabaseView& db) {
+  return validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size());
 }
 
 // Values: the large arrays last, with the vectorized scans.
 // The per-frame joint arrays: finite unit rotations, finite positions and velocities.
-Status check_joint_values(const Database& db) {
+Status check_joint_values(const DatabaseView& db) {
   if (size_t i = first_non_unit(db.local_rotations); i != kNotFound) {
     const glm::quat& q = db.local_rotations[i];
     return Error{"database: local_rotations" + frame_joint(db, i) +
                  " is not a finite unit quaternion (squared length " +
                  std::to_string(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) + ")"};
   }
-  const std::pair<const char*, const FrameArray<glm::vec3>*> vector_arrays[] = {
-      {"local_positions", &db.local_positions},
-      {"local_velocities", &db.local_velocities},
-      {"local_angular_velocities", &db.local_angular_velocities}};
+  const std::pair<const char*, std::span<const glm::vec3>> vector_arrays[] = {
+      {"local_positions", db.local_positions},
+      {"local_velocities", db.local_velocities},
+      {"local_angular_velocities", db.local_angular_velocities}};
   for (const auto& [name, array] : vector_arrays) {
-    if (size_t i = first_non_finite(floats_of(*array)); i != kNotFound) {
+    if (size_t i = first_non_finite(floats_of(array)); i != kNotFound) {
       return Error{"database: " + std::string(name) + frame_joint(db, i / 3) + " is not finite"};
     }
   }
@@ -392,7 +613,7 @@ Status check_joint_values(const Database& db) {
 }
 
 // The other per-frame values: contacts and searchable flags, features and their normalization.
-Status check_other_values(const Database& db) {
+Status check_other_values(const DatabaseView& db) {
   const size_t dims = static_cast<size_t>(db.feature_dims());
   if (size_t i = first_non_boolean(db.contacts); i != kNotFound) {
     return Error{"database: contacts[frame " + std::to_string(i / 2) + ", " +
@@ -421,19 +642,23 @@ Status check_other_values(const Database& db) {
 
 }  // namespace
 
+Status validate_database(const DatabaseView& db) {
+  if (Status s = detail::validate_except_joint_values(db); !s) return s;
+  return check_joint_values(db);
+}
+
 Status Database::validate() const {
-  if (Status s = detail::validate_except_joint_values(*this); !s) return s;
-  return check_joint_values(*this);
+  return validate_database(*this);
 }
 
 namespace detail {
 
-Status validate_except_joint_values(const Database& db) {
+Status validate_except_joint_values(const DatabaseView& db) {
   if (!(db.frame_time > 0.0f) || !std::isfinite(db.frame_time)) {
     return Error{"database: frame_time " + std::to_string(db.frame_time) +
                  " s; expected a positive finite number of seconds"};
   }
-  for (Status (*check)(const Database&) :
+  for (Status (*check)(const DatabaseView&) :
        {check_skeleton, check_roles, check_frame_arrays, check_schema_and_features, check_tags,
         check_clips, check_other_values}) {
     if (Status s = check(db); !s) return s;

@@ -22,15 +22,18 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "cpu_features.hpp"
-#include "large_arrays.hpp"
 #include "mm/database/files.hpp"
 #include "mm/database/velocities.hpp"
+#include "mm/internal/database_assembly.hpp"
 #include "mm/internal/workers.hpp"
+#include "mm/runtime/assert.hpp"
 #include "validation.hpp"
 
 namespace mm {
 
 namespace {
+
+using LoadTarget = detail::DatabaseAssembly::Parts;
 
 // ---------------------------------------------------------------------------------------------
 // Checksum. Four lanes each consume one 8-byte word of every 32-byte block, so the four
@@ -92,8 +95,12 @@ class ByteWriter {
     pod(static_cast<uint32_t>(s.size()));
     raw(s.data(), s.size());
   }
-  template <class T, class Allocator>
-  void array(const std::vector<T, Allocator>& values) {
+  template <class T>
+  void array(const std::vector<T>& values) {
+    array(std::span<const T>(values));
+  }
+  template <class T>
+  void array(std::span<const T> values) {
     if (values.empty()) return;
     if constexpr (std::is_trivially_copyable_v<T>) {
       raw(values.data(), values.size() * sizeof(T));
@@ -381,7 +388,7 @@ void lay_out_positions(std::span<const ClipRange> clips, size_t joints, Position
   }
 }
 
-PositionLayout position_layout_of(const Database& db) {
+PositionLayout position_layout_of(const DatabaseView& db) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   PositionLayout layout;
   layout.constant.resize(db.clips.size() * joints);
@@ -697,12 +704,22 @@ std::span<const std::byte> section_bytes(std::span<const std::byte> file,
 }
 
 // Copies a fixed-size section whose length parse_header() already matched to the counts.
-template <class T, class Allocator>
+template <class T>
 void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
-                std::vector<T, Allocator>& out) {
+                std::vector<T>& out) {
   static_assert(std::is_trivially_copyable_v<T>);
   const std::span<const std::byte> bytes = section_bytes(file, info, s);
-  detail::resize_large(out, bytes.size() / sizeof(T));
+  out.resize(bytes.size() / sizeof(T));
+  if (!bytes.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
+}
+
+// The same into a database's array, which the header's counts sized to the section's length.
+template <class T>
+void copy_array(std::span<const std::byte> file, const DatabaseFileInfo& info, DatabaseSection s,
+                std::span<T> out) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  const std::span<const std::byte> bytes = section_bytes(file, info, s);
+  MM_ASSERT(bytes.size() == out.size_bytes());
   if (!bytes.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());
 }
 
@@ -868,7 +885,7 @@ struct LoadPlan {
 };
 
 Status read_small_sections(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                           std::string_view name, Database& db, LoadPlan& plan) {
+                           std::string_view name, LoadTarget& db, LoadPlan& plan) {
   if (Status s = read_schema(file, info, name, db.schema); !s) return s;
   if (db.schema.dims() != static_cast<int>(info.feature_dims)) {
     return Error{std::string(name) + ": section 'schema': its channels have " +
@@ -982,7 +999,7 @@ Status decode_rotations(std::span<const std::byte> file, const DatabaseFileInfo&
 // Positions, rotations and velocities of one clip, straight into the database's arrays.
 // `valid` tells whether they are all what validate() accepts (finite, unit rotations).
 Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                   const LoadPlan& plan, size_t c, std::string_view name, Database& db,
+                   const LoadPlan& plan, size_t c, std::string_view name, LoadTarget& db,
                    bool& valid) {
   const ClipRange& clip = db.clips[c];
   const size_t joints = info.joint_count;
@@ -1019,14 +1036,7 @@ struct DecodedFile {
 };
 
 DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo& info,
-                        const LoadPlan& plan, std::string_view name, int threads, Database& db) {
-  // Sized, not written: every value is written once, by the clip that owns it.
-  const size_t samples = size_t{info.frame_count} * info.joint_count;
-  detail::resize_large(db.local_rotations, samples);
-  detail::resize_large(db.local_positions, samples);
-  detail::resize_large(db.local_velocities, samples);
-  detail::resize_large(db.local_angular_velocities, samples);
-
+                        const LoadPlan& plan, std::string_view name, int threads, LoadTarget& db) {
   DecodedFile out;
   constexpr size_t kFirstClipJob = 2;
   std::vector<Status> status(db.clips.size());
@@ -1052,12 +1062,6 @@ DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo&
   const auto failed =
       std::find_if(status.begin(), status.end(), [](const Status& s) { return !s; });
   if (failed != status.end()) out.status = *failed;
-  // frame_clip is derived, not stored (the clips tile the frames: checked before decoding).
-  detail::resize_large(db.frame_clip, info.frame_count);
-  for (size_t c = 0; c < db.clips.size(); ++c) {
-    std::fill(db.frame_clip.begin() + db.clips[c].start, db.frame_clip.begin() + db.clips[c].end,
-              static_cast<int>(c));
-  }
   return out;
 }
 
@@ -1143,7 +1147,7 @@ uint64_t database_checksum(std::span<const std::byte> bytes) {
 namespace {
 
 // The header and the small sections of a version-3 file, written in place.
-void write_header(ByteWriter& w, const Database& db) {
+void write_header(ByteWriter& w, const DatabaseView& db) {
   w.raw(kDatabaseMagic.data(), kDatabaseMagic.size());
   w.pod(kDatabaseFormatVersion);
   w.pod(kDatabaseEndianMarker);
@@ -1173,7 +1177,7 @@ void write_schema(ByteWriter& w, const FeatureSchema& schema) {
   }
 }
 
-void write_clips(ByteWriter& w, const std::vector<ClipRange>& clips) {
+void write_clips(ByteWriter& w, std::span<const ClipRange> clips) {
   for (const ClipRange& c : clips) {
     w.pod(static_cast<int32_t>(c.start));
     w.pod(static_cast<int32_t>(c.end));
@@ -1184,7 +1188,7 @@ void write_clips(ByteWriter& w, const std::vector<ClipRange>& clips) {
   }
 }
 
-void write_positions(ByteWriter& w, const Database& db, const PositionLayout& layout,
+void write_positions(ByteWriter& w, const DatabaseView& db, const PositionLayout& layout,
                      bool constant) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t offset = w.extend(12 * (constant ? layout.constant_count : layout.varying_count));
@@ -1218,7 +1222,7 @@ void encode_rotations(std::span<const glm::quat> rotations, size_t begin, size_t
 }
 
 // The three rotation sections: components and codes sample by sample, then the exceptions.
-void write_rotations(ByteWriter& w, const Database& db,
+void write_rotations(ByteWriter& w, const DatabaseView& db,
                      std::array<DatabaseFileSection, kDatabaseSectionCount>& table) {
   const size_t samples = db.local_rotations.size();
   w.align16();
@@ -1251,7 +1255,7 @@ void write_rotations(ByteWriter& w, const Database& db,
 }
 
 // The bytes serialize_database() will write, to allocate them once.
-size_t expected_file_size(const Database& db, const PositionLayout& layout) {
+size_t expected_file_size(const DatabaseView& db, const PositionLayout& layout) {
   size_t bytes = kDatabaseHeaderSize + 16 * kDatabaseSectionCount + kChecksumSize;
   for (const std::string& s : db.skeleton.names()) bytes += s.size() + 4;
   for (const std::string& s : db.tag_names) bytes += s.size() + 4;
@@ -1270,7 +1274,7 @@ size_t expected_file_size(const Database& db, const PositionLayout& layout) {
 
 // True when the clips and the position array agree well enough to lay the positions out by
 // clip (Database::validate() checks far more).
-bool positions_fit_clips(const Database& db) {
+bool positions_fit_clips(const DatabaseView& db) {
   const size_t samples =
       static_cast<size_t>(std::max(db.frame_count, 0)) * static_cast<size_t>(db.joint_count());
   return db.local_positions.size() == samples && db.local_rotations.size() == samples &&
@@ -1279,7 +1283,7 @@ bool positions_fit_clips(const Database& db) {
 
 }  // namespace
 
-std::vector<std::byte> serialize_database(const Database& db) {
+std::vector<std::byte> serialize_database(const DatabaseView& db) {
   // An inconsistent database keeps its positions and rotations out of the file (load refuses it
   // then), rather than reading past its arrays.
   const bool fits = positions_fit_clips(db);
@@ -1368,12 +1372,14 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
   };
   const int threads = bytes.size() >= kParallelBytes ? 2 : 1;
 
-  Database db;
+  Database db = detail::DatabaseAssembly::empty();
+  LoadTarget parts = detail::DatabaseAssembly::parts(db);
   LoadPlan plan;
   Status phase1;
   Result<DatabaseFileInfo> header = parse_header(bytes, bytes.size(), name);
   try {
-    phase1 = header ? read_small_sections(bytes, *header, name, db, plan) : Error{header.message()};
+    phase1 =
+        header ? read_small_sections(bytes, *header, name, parts, plan) : Error{header.message()};
   } catch (const std::exception& e) {
     phase1 = Error{name + ": cannot load: " + e.what()};  // only allocation can throw
   }
@@ -1386,12 +1392,15 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
 
   DecodedFile decoded;
   try {
-    decoded = decode_file(bytes, *header, plan, name, threads, db);
+    detail::DatabaseAssembly::allocate(db, header->frame_count);
+    decoded = decode_file(bytes, *header, plan, name, threads, parts);
   } catch (const std::exception& e) {
     return Error{name + ": cannot load: " + e.what()};
   }
   if (decoded.checksum != stored) return checksum_error(decoded.checksum);
   if (!decoded.status) return Error{decoded.status.message()};
+  // frame_clip is derived, not stored (the clips tile the frames: checked before decoding).
+  detail::DatabaseAssembly::derive_frame_clip(db);
   // A bad joint value is reported by the full validation, which names the first one.
   const Status valid =
       decoded.joint_values_valid ? detail::validate_except_joint_values(db) : db.validate();
@@ -1399,8 +1408,8 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
   return db;
 }
 
-Status save_database(const Database& db, const std::filesystem::path& path) {
-  if (Status s = db.validate(); !s) {
+Status save_database(const DatabaseView& db, const std::filesystem::path& path) {
+  if (Status s = validate_database(db); !s) {
     return Error{"not saving '" + path.string() + "': " + s.message()};
   }
   const std::vector<std::byte> bytes = serialize_database(db);

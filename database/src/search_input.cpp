@@ -3,12 +3,12 @@
 namespace mm {
 
 DatabaseSearchInput::DatabaseSearchInput(const Database& database) {
-  clips.reserve(database.clips.size());
-  for (const ClipRange& clip : database.clips) clips.push_back({clip.start, clip.end, clip.tags});
-  input.features = database.features;
+  clips.reserve(database.clips().size());
+  for (const ClipRange& clip : database.clips()) clips.push_back({clip.start, clip.end, clip.tags});
+  input.features = database.features();
   input.dims = database.feature_dims();
-  input.searchable = database.searchable;
-  input.frame_clip = database.frame_clip;
+  input.searchable = database.searchable();
+  input.frame_clip = database.frame_clip();
   input.clips = clips;
 }
 

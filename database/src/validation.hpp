@@ -26,6 +26,6 @@ inline bool finite3(const glm::vec3& v) {
 
 // Everything validate() checks but the per-frame joint arrays; validate() is this and then
 // those arrays.
-Status validate_except_joint_values(const Database& db);
+Status validate_except_joint_values(const DatabaseView& db);
 
 }  // namespace mm::detail

@@ -14,6 +14,7 @@
 
 #include "mm/database/database_file.hpp"
 #include "mm/database/files.hpp"
+#include "mm/internal/database_assembly.hpp"
 #include "mm/internal/workers.hpp"
 #include "mm/offline/feature_extraction.hpp"
 #include "mm/offline/gltf.hpp"
@@ -129,7 +130,10 @@ Result<std::vector<Clip>> import_file(const fs::path& path, const BuildOptions& 
 }
 
 // Sets db.tag_names (sorted) and every clip's tag bits from its tag list (one per clip).
-Status assign_tags(Database& db, const std::vector<std::vector<std::string>>& clip_tag_lists) {
+using Assembly = detail::DatabaseAssembly;
+
+Status assign_tags(Assembly::Parts db,
+                   const std::vector<std::vector<std::string>>& clip_tag_lists) {
   std::set<std::string> tag_set;
   for (const std::vector<std::string>& tags : clip_tag_lists)
     tag_set.insert(tags.begin(), tags.end());
@@ -234,8 +238,8 @@ struct BuildState {
   std::mutex progress_mutex;
   size_t progress_done = 0;
 
-  // Phase 2 on.
-  Database db;
+  // Phase 2 on: the database, filled in place.
+  Database db = Assembly::empty();
   std::vector<int> bones;       // the joint of every feature channel
   std::vector<int> mirror_map;  // per source joint (only with options.mirror)
   std::vector<ClipJob> jobs;
@@ -473,7 +477,7 @@ void split_idle_clips(BuildState& state) {
 Status start_database(BuildState& state, size_t reference_index) {
   const InputResult& reference = skeleton_input(state, reference_index);
   const Skeleton& source_skeleton = reference.clips[0].skeleton;
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
   db.frame_time = 1.0f / state.options.rate;
   db.schema = state.options.schema;
   Result<Skeleton> skeleton = add_simulation_root(source_skeleton);
@@ -499,7 +503,7 @@ Status start_database(BuildState& state, size_t reference_index) {
 // Phase 2c: clip ranges (a mirrored copy right after its original, the idle clip last) and
 // their tags.
 Status lay_out_clips(BuildState& state, int idle_frames) {
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
   for (size_t i = 0; i < state.results.size(); ++i) {
     if (!state.results[i].processed) continue;
     for (size_t c = 0; c < state.results[i].clips.size(); ++c) {
@@ -548,34 +552,26 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
     state.clip_tag_lists.push_back(std::move(tags));
   }
   if (Status s = assign_tags(db, state.clip_tag_lists); !s) return s;
-  if (data_idles) state.data_idle_tag = db.tag_mask(std::vector<std::string>{kIdleTag});
+  if (data_idles) {
+    state.data_idle_tag = state.db.tag_mask(std::vector<std::string>{kIdleTag});
+  }
   return Status::success();
 }
 
 // Phase 2d: the database arrays, sized; processing writes every value of every clip.
 void allocate_arrays(BuildState& state) {
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
   const size_t frames = state.total_frames;
-  const size_t values = frames * static_cast<size_t>(db.joint_count());
   db.frame_count = static_cast<int>(frames);
-  db.local_positions.resize(values);
-  db.local_rotations.resize(values);
-  db.local_velocities.resize(values);
-  db.local_angular_velocities.resize(values);
-  db.features.resize(frames * static_cast<size_t>(state.context.dims));
-  db.frame_clip.resize(frames);
-  db.contacts.resize(frames * 2);
-  db.searchable.resize(frames);
-  for (size_t r = 0; r < db.clips.size(); ++r) {
-    std::fill(db.frame_clip.begin() + db.clips[r].start, db.frame_clip.begin() + db.clips[r].end,
-              static_cast<int>(r));
-  }
+  Assembly::allocate(state.db, frames);
+  Assembly::derive_frame_clip(state.db);
 }
 
 // Phase 3a, parallel over clips: preprocess and extract raw features straight into the
 // database's arrays at each clip's frames.
 Status process_clips(BuildState& state) {
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
+  const DatabaseFill fill = Assembly::fill(state.db);
   const size_t joints = static_cast<size_t>(db.joint_count());
   std::vector<Status> job_status(state.jobs.size());
   std::vector<std::atomic<int>> jobs_left(state.results.size());
@@ -604,7 +600,7 @@ Status process_clips(BuildState& state) {
       Status status = preprocess_clip(clip, state.results[job.input].roles, preprocess, out,
                                       state.scratch[static_cast<size_t>(worker)].preprocess);
       if (status) {
-        extract_range_features(db, range, state.bones,
+        extract_range_features(fill, range, state.bones,
                                state.scratch[static_cast<size_t>(worker)].features);
       } else {
         status = Error{state.input_names[job.input] + ": " + status.message()};
@@ -626,14 +622,16 @@ Status process_clips(BuildState& state) {
 // Phase 3b: the idle clip, one pass in frame order over the finished clips, then a copy; or,
 // when no frame qualifies, the reserved frames given back.
 Status add_idle_clip(BuildState& state) {
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
   BuildReport& rep = state.rep;
   const ClipRange& idle = db.clips.back();
-  const IdleSourceSearch found = search_idle_source(db);
+  const IdleSourceSearch found = search_idle_source(state.db);
   if (found.frame >= 0) {
-    fill_idle_clip(db, idle, found.frame);
-    extract_range_features(db, idle, state.bones, state.scratch[0].features);
-    const ClipRange& source = db.clips[static_cast<size_t>(db.frame_clip[found.frame])];
+    const DatabaseFill fill = Assembly::fill(state.db);
+    fill_idle_clip(fill, idle, found.frame);
+    extract_range_features(fill, idle, state.bones, state.scratch[0].features);
+    const ClipRange& source = *std::find_if(
+        db.clips.begin(), db.clips.end(), [&](const ClipRange& c) { return found.frame < c.end; });
     rep.idle_frames = idle.frame_count();
     rep.idle_source_clip = source.name;
     rep.idle_source_frame = found.frame - source.start;
@@ -645,23 +643,13 @@ Status add_idle_clip(BuildState& state) {
   db.clips.pop_back();
   state.clip_tag_lists.pop_back();
   if (Status s = assign_tags(db, state.clip_tag_lists); !s) return Error{s.message()};
-  const size_t frames = state.total_frames;
-  db.frame_count = static_cast<int>(frames);
-  const size_t kept = frames * static_cast<size_t>(db.joint_count());
-  db.local_positions.resize(kept);
-  db.local_rotations.resize(kept);
-  db.local_velocities.resize(kept);
-  db.local_angular_velocities.resize(kept);
-  db.features.resize(frames * static_cast<size_t>(state.context.dims));
-  db.frame_clip.resize(frames);
-  db.contacts.resize(frames * 2);
-  db.searchable.resize(frames);
+  Assembly::keep_frames(state.db, state.total_frames);
   return Status::success();
 }
 
-// Phase 4: normalization over the whole database, then a final check.
+// Phase 4: normalization over the whole database.
 Status normalize_and_check(BuildState& state) {
-  Database& db = state.db;
+  Assembly::Parts db = Assembly::parts(state.db);
   BuildReport& rep = state.rep;
   for (const ClipRange& range : db.clips) {
     if (std::find(db.searchable.begin() + range.start, db.searchable.begin() + range.end,
@@ -684,17 +672,11 @@ Status normalize_and_check(BuildState& state) {
     normalize_features(std::span(db.features).subspan(first * dims, rows * dims),
                        normalization.offset, normalization.scale);
   });
-  db.feature_offset = std::move(normalization.offset);
-  db.feature_scale = std::move(normalization.scale);
+  std::copy(normalization.offset.begin(), normalization.offset.end(), db.feature_offset.begin());
+  std::copy(normalization.scale.begin(), normalization.scale.end(), db.feature_scale.begin());
   rep.warnings.insert(rep.warnings.end(), normalization.warnings.begin(),
                       normalization.warnings.end());
 
-  if (Status s = db.validate(); !s) {
-    return Error{
-        "build: the assembled database is inconsistent (a bug or a non-finite input "
-        "value): " +
-        s.message()};
-  }
   rep.clips = static_cast<int>(db.clips.size());
   rep.frames = db.frame_count;
   rep.duration_s = static_cast<double>(db.frame_count) / static_cast<double>(state.options.rate);
@@ -746,6 +728,12 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   phase_start = Clock::now();
 
   if (Status s = normalize_and_check(state); !s) return Error{s.message()};
+  if (Status s = state.db.validate(); !s) {
+    return Error{
+        "build: the assembled database is inconsistent (a bug or a non-finite input "
+        "value): " +
+        s.message()};
+  }
   rep.finish_seconds = seconds_since(phase_start);
   rep.total_seconds = seconds_since(start);
   return std::move(state.db);

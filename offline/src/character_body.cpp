@@ -516,7 +516,7 @@ Status validate_roles(const Skeleton& skeleton, const JointRoleIndices& roles) {
 
 }  // namespace
 
-int bind_source_frame(const Database& db) {
+int bind_source_frame(const DatabaseView& db) {
   if (db.frame_count <= 0) return -1;
   if (const int idle = find_idle_clip(db); idle >= 0)
     return db.clips[static_cast<size_t>(idle)].start;
@@ -605,7 +605,7 @@ Result<CharacterBody> build_character_body(const Skeleton& skeleton,
   return body;
 }
 
-Result<CharacterBody> build_character_body(const Database& db,
+Result<CharacterBody> build_character_body(const DatabaseView& db,
                                            const CharacterBodyOptions& options) {
   const int frame = bind_source_frame(db);
   if (frame < 0) return Error{"character body: the database has no frames to take a pose from"};

@@ -269,7 +269,7 @@ void denormalize_features(std::span<float> rows, std::span<const float> offset,
   }
 }
 
-void extract_range_features(Database& db, const ClipRange& range,
+void extract_range_features(const DatabaseFill& db, const ClipRange& range,
                             std::span<const int> channel_bones, FeatureScratch& scratch) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t dims = static_cast<size_t>(db.schema.dims());
@@ -289,7 +289,7 @@ void extract_range_features(Database& db, const ClipRange& range,
       std::span(db.searchable).subspan(range.start, range.frame_count()), scratch);
 }
 
-Status compute_database_features(Database& db, std::vector<std::string>* warnings) {
+Status compute_database_features(DatabaseContents& db, std::vector<std::string>* warnings) {
   if (Status s = db.schema.validate(); !s) return s;
   const int joints = db.joint_count();
   const size_t values = static_cast<size_t>(db.frame_count) * joints;

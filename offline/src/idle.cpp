@@ -16,7 +16,7 @@ namespace mm {
 namespace {
 
 // Global transforms of one frame's pose (its simulation root where it stands).
-void frame_globals(const Database& db, int frame, std::vector<Transform>& local,
+void frame_globals(const DatabaseView& db, int frame, std::vector<Transform>& local,
                    std::vector<Transform>& global) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   local.resize(joints);
@@ -29,7 +29,7 @@ void frame_globals(const Database& db, int frame, std::vector<Transform>& local,
   forward_kinematics(db.skeleton.parents(), local, global);
 }
 
-float feet_distance(const Database& db, const std::vector<Transform>& global) {
+float feet_distance(const DatabaseView& db, const std::vector<Transform>& global) {
   const int joints = db.joint_count();
   const int left = db.roles.left_foot;
   const int right = db.roles.right_foot;
@@ -45,7 +45,7 @@ float feet_distance(const Database& db, const std::vector<Transform>& global) {
 // arm is an arm end only where the skeleton has no hands; its joint is the elbow, which hangs at
 // the waist, a little below halfway from the hips to the shoulder: it is measured from two thirds
 // of the way from the hips to its upper arm.
-float arm_end_height(const Database& db, const std::vector<int>& arm_ends,
+float arm_end_height(const DatabaseView& db, const std::vector<int>& arm_ends,
                      const std::vector<Transform>& global) {
   float highest = -std::numeric_limits<float>::infinity();
   if (db.roles.hips < 0) return highest;
@@ -72,7 +72,7 @@ std::string metres(float value) {
 
 }  // namespace
 
-double idle_motion_energy(const Database& db, int frame) {
+double idle_motion_energy(const DatabaseView& db, int frame) {
   const int joints = db.joint_count();
   const size_t base = static_cast<size_t>(frame) * static_cast<size_t>(joints);
   double energy = 0.0;
@@ -87,7 +87,7 @@ double idle_motion_energy(const Database& db, int frame) {
   return energy;
 }
 
-float horizontal_feet_distance(const Database& db, int frame) {
+float horizontal_feet_distance(const DatabaseView& db, int frame) {
   std::vector<Transform> local, global;
   frame_globals(db, frame, local, global);
   return feet_distance(db, global);
@@ -120,13 +120,13 @@ std::vector<int> arm_end_joints(const Skeleton& skeleton, const JointRoleIndices
   return ends;
 }
 
-float highest_arm_end_over_hips(const Database& db, int frame) {
+float highest_arm_end_over_hips(const DatabaseView& db, int frame) {
   std::vector<Transform> local, global;
   frame_globals(db, frame, local, global);
   return arm_end_height(db, arm_end_joints(db.skeleton, db.roles), global);
 }
 
-IdleSourceSearch search_idle_source(const Database& db, const IdleCriteria& criteria) {
+IdleSourceSearch search_idle_source(const DatabaseView& db, const IdleCriteria& criteria) {
   IdleSourceSearch out;
   const size_t joints = static_cast<size_t>(db.joint_count());
   const std::vector<int> arm_ends = arm_end_joints(db.skeleton, db.roles);
@@ -155,7 +155,7 @@ IdleSourceSearch search_idle_source(const Database& db, const IdleCriteria& crit
   return out;
 }
 
-int find_calmest_standing_frame(const Database& db, const IdleCriteria& criteria) {
+int find_calmest_standing_frame(const DatabaseView& db, const IdleCriteria& criteria) {
   return search_idle_source(db, criteria).frame;
 }
 
@@ -180,7 +180,7 @@ std::string idle_search_failure(const IdleSourceSearch& search, const IdleCriter
          metres(criteria.max_arm_end_over_hips) + " m above the hips";
 }
 
-void fill_idle_clip(Database& db, const ClipRange& range, int source_frame) {
+void fill_idle_clip(const DatabaseFill& db, const ClipRange& range, int source_frame) {
   MM_ASSERT(source_frame >= 0 && source_frame < db.frame_count);
   MM_ASSERT(source_frame < range.start || source_frame >= range.end);
   MM_ASSERT(range.start >= 0 && range.end <= db.frame_count);

@@ -514,7 +514,7 @@ std::string csv_header(const Database& db) {
   std::string h =
       "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,"
       "desired_yaw_deg,transition,contact_l,contact_r,clip,frame";
-  for (const std::string& name : db.skeleton.names()) {
+  for (const std::string& name : db.skeleton().names()) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
   return h;
@@ -595,13 +595,13 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
   // no more, so memory does not grow with the clips' length or a small dt.
   std::vector<glm::vec3> recent[3];
   for (std::vector<glm::vec3>& step : recent) step.assign(joints, glm::vec3(0.0f));
-  for (const ClipRange& clip : db.clips) {
+  for (const ClipRange& clip : db.clips()) {
     if (clip.tags & excluded_tags) continue;
-    const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time;
+    const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time();
     const int64_t steps = clamped_integer<int64_t>(std::floor(duration / dt)) + 1;
     if (steps < 3) continue;
     for (int64_t s = 0; s < steps; ++s) {
-      const float x = static_cast<float>(s) * dt / db.frame_time;
+      const float x = static_cast<float>(s) * dt / db.frame_time();
       const int i0 = std::min(clamped_integer<int>(std::floor(x)), clip.frame_count() - 1);
       const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
       const float a = x - static_cast<float>(i0);
@@ -609,7 +609,7 @@ double database_acceleration_p99(const Database& db, float dt, uint64_t excluded
         local[j] = sample_database_joint(db, clip.start + i0, clip.start + i1, a, j, cubic,
                                          InterpolationMethod::Nlerp);
       }
-      forward_kinematics(db.skeleton.parents(), local, global);
+      forward_kinematics(db.skeleton().parents(), local, global);
       std::vector<glm::vec3>& now = recent[s % 3];
       for (size_t j = 0; j < joints; ++j) now[j] = global[j].translation;
       if (s >= 2) {
@@ -646,7 +646,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   const size_t joints = static_cast<size_t>(db.joint_count());
 
   if (options.dump) *options.dump << csv_header(db) << "\n";
-  EvaluationAccumulator accumulator(db.roles, joints, dt);
+  EvaluationAccumulator accumulator(db.roles(), joints, dt);
   std::vector<glm::vec3> positions(joints);
   using Clock = std::chrono::steady_clock;
   for (int f = 0; f < *frame_count; ++f) {

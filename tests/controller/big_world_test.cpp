@@ -80,7 +80,7 @@ TEST(BigWorld, TheLocalOriginFollowsTheCharacter) {
 // on without a jump (walking past many rebases near the origin, where floats are fine anyway).
 TEST(BigWorld, RebasingDoesNotMoveTheCharacter) {
   Controller c = test::make_controller();
-  const int toe = c.controller_database().database().roles.left_toe;
+  const int toe = c.controller_database().database().roles().left_toe;
   ASSERT_GE(toe, 0);
   glm::dvec3 previous_root = c.world_root_position();
   glm::dvec3 previous_toe = c.origin() + glm::dvec3(c.origin_transforms()[toe].translation);

@@ -47,16 +47,16 @@ inline ControllerInput push_toward(float degrees, bool run = false) {
 inline float hips_yaw(const Controller& c) {
   const Database& db = c.controller_database().database();
   const std::span<const Transform> g = c.global_transforms();
-  return pair_yaw(g[static_cast<size_t>(db.roles.left_upper_leg)].translation,
-                  g[static_cast<size_t>(db.roles.right_upper_leg)].translation);
+  return pair_yaw(g[static_cast<size_t>(db.roles().left_upper_leg)].translation,
+                  g[static_cast<size_t>(db.roles().right_upper_leg)].translation);
 }
 
 // The chest's facing as `mm eval` reads it: across the upper arms.
 inline float chest_yaw(const Controller& c) {
   const Database& db = c.controller_database().database();
   const std::span<const Transform> g = c.global_transforms();
-  return pair_yaw(g[static_cast<size_t>(db.roles.left_upper_arm)].translation,
-                  g[static_cast<size_t>(db.roles.right_upper_arm)].translation);
+  return pair_yaw(g[static_cast<size_t>(db.roles().left_upper_arm)].translation,
+                  g[static_cast<size_t>(db.roles().right_upper_arm)].translation);
 }
 
 inline float horizontal_speed(const glm::vec3& a, const glm::vec3& b, float dt) {

@@ -134,16 +134,16 @@ TEST(ControllerDatabaseTest, CandidatesLeaveClipEndsOutAndSpeedsComeFromTheData)
   const auto shared = normal_controller_database();
   const Database& db = shared->database();
   const int excluded =
-      static_cast<int>(std::lround(shared->options().clip_end_exclusion / db.frame_time));
+      static_cast<int>(std::lround(shared->options().clip_end_exclusion / db.frame_time()));
   ASSERT_GT(excluded, 0);
   int candidates = 0;
-  for (const ClipRange& clip : db.clips) {
+  for (const ClipRange& clip : db.clips()) {
     const bool idle = (clip.tags & shared->idle_tags()) != 0;
     for (int f = clip.start; f < clip.end; ++f) {
       const bool candidate = shared->candidates()[static_cast<size_t>(f)] != 0;
       candidates += candidate ? 1 : 0;
       if (candidate) {
-        EXPECT_TRUE(db.searchable[static_cast<size_t>(f)]) << clip.name << " " << f;
+        EXPECT_TRUE(db.searchable()[static_cast<size_t>(f)]) << clip.name << " " << f;
       }
       if (!idle && f >= clip.end - excluded) {
         EXPECT_FALSE(candidate) << clip.name << " " << f;
@@ -293,7 +293,7 @@ TEST(ControllerTest, EarlyInADeadBlendAFootIsDownOnlyWhereBothPosesHaveItDown) {
     const bool is_early = blend_time < 0.5f * settings.dead_blend_time;
     early += is_early;
     for (int side = 0; side < 2; ++side) {
-      const bool label = db.contacts[static_cast<size_t>(d.frame) * 2 + side] != 0;
+      const bool label = db.contacts()[static_cast<size_t>(d.frame) * 2 + side] != 0;
       EXPECT_EQ(d.contact[side], label && (!is_early || held[side]))
           << "frame " << i << " " << side;
       differing += is_early && label != held[side];
@@ -341,7 +341,7 @@ TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
   for (int i = 0; i < 180; ++i) c.update(kDt, push_toward(0.0f));
   ASSERT_GT(glm::length(c.debug().simulation_velocity), 0.5f);
   const Database& db = c.controller_database().database();
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
   // Released: after about a second the root and the toes are still, and stay so.
   ControllerInput released;
   std::vector<Transform> previous(c.global_transforms().begin(), c.global_transforms().end());
@@ -360,7 +360,7 @@ TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
     }
     previous.assign(c.global_transforms().begin(), c.global_transforms().end());
   }
-  EXPECT_TRUE(c.controller_database().database().clips[static_cast<size_t>(c.debug().clip)].tags &
+  EXPECT_TRUE(c.controller_database().database().clips()[static_cast<size_t>(c.debug().clip)].tags &
               c.controller_database().idle_tags());
   // Pushed again: the search answers on the first frame, and the character is walking off
   // within a second (the Bandai walks that start from rest take about that to reach speed, and
@@ -368,8 +368,9 @@ TEST(ControllerTest, StopsWithinASecondAndStandsStillThenStartsAgain) {
   const glm::vec3 start = c.root_transform().translation;
   c.update(kDt, push_toward(90.0f));
   EXPECT_TRUE(c.debug().searched);
-  EXPECT_FALSE(c.controller_database().database().clips[static_cast<size_t>(c.debug().clip)].tags &
-               c.controller_database().idle_tags());
+  EXPECT_FALSE(
+      c.controller_database().database().clips()[static_cast<size_t>(c.debug().clip)].tags &
+      c.controller_database().idle_tags());
   glm::vec3 before_last = start;
   for (int i = 1; i < 60; ++i) {
     before_last = c.root_transform().translation;
@@ -393,8 +394,8 @@ struct LockRun {
 LockRun locked_toes(const ControllerSettings& settings) {
   Controller c = make(settings);
   const Database& db = c.controller_database().database();
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
-  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
+  const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
   LockRun run;
   double sum = 0.0, contact_sum = 0.0;
   int contact_frames = 0;
@@ -417,8 +418,8 @@ LockRun locked_toes(const ControllerSettings& settings) {
       previous[side] = toe;
       // Upper and lower leg keep the lengths of the pose being played.
       const int foot = feet[side];
-      const int knee = db.skeleton.parent(foot);
-      const int hip = db.skeleton.parent(knee);
+      const int knee = db.skeleton().parent(foot);
+      const int hip = db.skeleton().parent(knee);
       const std::span<const Transform> l = c.local_transforms();
       const float upper = glm::length(g[static_cast<size_t>(knee)].translation -
                                       g[static_cast<size_t>(hip)].translation);
@@ -458,18 +459,18 @@ TEST(ControllerTest, TagRequestPlaysTaggedClipsThenLocomotionResumes) {
   const auto shared = normal_controller_database();
   const Database& db = shared->database();
   uint64_t wave = 0;
-  for (size_t i = 0; i < db.tag_names.size(); ++i) {
-    if (db.tag_names[i].rfind("wave-", 0) == 0) wave |= uint64_t{1} << i;
+  for (size_t i = 0; i < db.tag_names().size(); ++i) {
+    if (db.tag_names()[i].rfind("wave-", 0) == 0) wave |= uint64_t{1} << i;
   }
   ASSERT_NE(wave, 0u);
   ControllerInput input;
   input.tag = "wave";
   for (int i = 0; i < 60; ++i) c.update(kDt, input);
-  EXPECT_TRUE(db.clips[static_cast<size_t>(c.debug().clip)].tags & wave)
-      << db.clips[static_cast<size_t>(c.debug().clip)].name;
+  EXPECT_TRUE(db.clips()[static_cast<size_t>(c.debug().clip)].tags & wave)
+      << db.clips()[static_cast<size_t>(c.debug().clip)].name;
   for (int i = 0; i < 60; ++i) c.update(kDt, push_toward(0.0f));
-  EXPECT_FALSE(db.clips[static_cast<size_t>(c.debug().clip)].tags & shared->action_tags())
-      << db.clips[static_cast<size_t>(c.debug().clip)].name;
+  EXPECT_FALSE(db.clips()[static_cast<size_t>(c.debug().clip)].tags & shared->action_tags())
+      << db.clips()[static_cast<size_t>(c.debug().clip)].name;
 }
 
 TEST(ControllerTest, DifferentFrameRatesTrackTheSameTrajectory) {
@@ -523,9 +524,9 @@ TEST(ControllerDatabaseTest, IdleTakesKeepTheirLastSecondsOut) {
   const ControllerDatabase& shared = **made;
   const Database& db = shared.database();
   const int excluded =
-      static_cast<int>(std::lround(shared.options().idle_clip_end_exclusion / db.frame_time));
+      static_cast<int>(std::lround(shared.options().idle_clip_end_exclusion / db.frame_time()));
   int takes = 0;
-  for (const ClipRange& clip : db.clips) {
+  for (const ClipRange& clip : db.clips()) {
     if ((clip.tags & shared.idle_tags()) == 0 || clip.name == "idle") continue;
     ++takes;
     const int end_frames = std::min(excluded, (clip.end - clip.start) / 2);
@@ -551,7 +552,7 @@ TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
   const Database& base = c.controller_database().database();
   const uint64_t idle = base.tag_mask(std::vector<std::string>{"idle"});
   ControllerInput released;
-  const int head = base.roles.head;
+  const int head = base.roles().head;
   ASSERT_GE(head, 0);
   std::set<int> frames;
   int jumps = 0, last_frame = -1;
@@ -563,7 +564,7 @@ TEST(ControllerTest, ALongStandOnRealIdleClipsStaysAliveAndVaries) {
     c.update(kDt, released);
     const glm::vec3 h = c.global_transforms()[static_cast<size_t>(head)].translation;
     if (i > settle) {
-      ASSERT_NE(base.clips[static_cast<size_t>(c.debug().clip)].tags & idle, 0u) << i;
+      ASSERT_NE(base.clips()[static_cast<size_t>(c.debug().clip)].tags & idle, 0u) << i;
       head_path += glm::distance(h, previous);
       frames.insert(c.debug().frame);
       const int step = c.debug().frame - last_frame;

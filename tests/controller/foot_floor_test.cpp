@@ -26,15 +26,16 @@ TEST(FootFloorTest, TheDataLowestToeIsTheLowestOfEveryFrame) {
   const ControllerDatabase& shared = *normal_controller_database();
   const Database& db = shared.database();
   const size_t joints = static_cast<size_t>(db.joint_count());
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
   float lowest[2] = {std::numeric_limits<float>::infinity(),
                      std::numeric_limits<float>::infinity()};
   std::vector<Transform> local(joints), global(joints);
-  for (size_t f = 0; f < static_cast<size_t>(db.frame_count); ++f) {
+  for (size_t f = 0; f < static_cast<size_t>(db.frame_count()); ++f) {
     for (size_t j = 0; j < joints; ++j) {
-      local[j] = Transform{db.local_rotations[f * joints + j], db.local_positions[f * joints + j]};
+      local[j] =
+          Transform{db.local_rotations()[f * joints + j], db.local_positions()[f * joints + j]};
     }
-    forward_kinematics(db.skeleton.parents(), local, global);
+    forward_kinematics(db.skeleton().parents(), local, global);
     for (int side = 0; side < 2; ++side) {
       lowest[side] = std::min(lowest[side], global[static_cast<size_t>(toes[side])].translation.y);
     }

@@ -54,8 +54,8 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
   EXPECT_TRUE(made.ok()) << (made.ok() ? "" : made.message());
   Controller c = std::move(made).value();
   const Database& db = c.controller_database().database();
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
-  const int feet[2] = {db.roles.left_foot, db.roles.right_foot};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
+  const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
   const int settle_frames = static_cast<int>(std::lround(1.0f / dt));
   for (int i = 0; i < settle_frames; ++i) c.update(dt, ControllerInput{});
 
@@ -99,8 +99,8 @@ StandTurn turn_on_the_spot(float degrees, float dt, float seconds = 3.0f,
     turn.foot_twist_degrees[side] =
         yaw_error_degrees(foot_yaw_to_hips(c, feet[side], toes[side]), stance[side]);
     const std::span<const Transform> g = c.global_transforms();
-    const int knee = db.skeleton.parents()[static_cast<size_t>(feet[side])];
-    const int hip = db.skeleton.parents()[static_cast<size_t>(knee)];
+    const int knee = db.skeleton().parents()[static_cast<size_t>(feet[side])];
+    const int hip = db.skeleton().parents()[static_cast<size_t>(knee)];
     const glm::vec3 h = g[static_cast<size_t>(hip)].translation;
     const glm::vec3 k = g[static_cast<size_t>(knee)].translation;
     const glm::vec3 a = g[static_cast<size_t>(feet[side])].translation;

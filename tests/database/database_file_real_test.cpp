@@ -35,40 +35,41 @@ TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
       build_database(std::span<const fs::path>(&folder, 1), BuildOptions{}, &report);
   ASSERT_TRUE(built.ok()) << built.message();
   const Database& db = *built;
-  ASSERT_GE(db.clips.size(), 472u);
+  ASSERT_GE(db.clips().size(), 472u);
   const fs::path path = test::scratch_dir() / "normal.mmdb";
   ASSERT_TRUE(save_database(db, path).ok());
   Result<Database> loaded = load_database(path);
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   const Database& back = *loaded;
-  std::printf("normal set: %zu clips, %d frames, file %.1f MB\n", db.clips.size(), db.frame_count,
-              static_cast<double>(fs::file_size(path)) / 1e6);
+  std::printf("normal set: %zu clips, %d frames, file %.1f MB\n", db.clips().size(),
+              db.frame_count(), static_cast<double>(fs::file_size(path)) / 1e6);
 
   const size_t joints = static_cast<size_t>(db.joint_count());
   ASSERT_EQ(back.joint_count(), db.joint_count());
-  ASSERT_EQ(back.frame_count, db.frame_count);
-  ASSERT_EQ(back.clips.size(), db.clips.size());
-  for (size_t c = 0; c < db.clips.size(); ++c) {
-    const ClipRange& clip = db.clips[c];
-    if (c % 100 == 0) std::printf("  clip %zu of %zu: %s\n", c, db.clips.size(), clip.name.c_str());
-    ASSERT_EQ(back.clips[c].name, clip.name);
-    ASSERT_EQ(back.clips[c].start, clip.start);
-    ASSERT_EQ(back.clips[c].end, clip.end);
+  ASSERT_EQ(back.frame_count(), db.frame_count());
+  ASSERT_EQ(back.clips().size(), db.clips().size());
+  for (size_t c = 0; c < db.clips().size(); ++c) {
+    const ClipRange& clip = db.clips()[c];
+    if (c % 100 == 0)
+      std::printf("  clip %zu of %zu: %s\n", c, db.clips().size(), clip.name.c_str());
+    ASSERT_EQ(back.clips()[c].name, clip.name);
+    ASSERT_EQ(back.clips()[c].start, clip.start);
+    ASSERT_EQ(back.clips()[c].end, clip.end);
     const size_t first = static_cast<size_t>(clip.start) * joints;
     const size_t count = static_cast<size_t>(clip.frame_count()) * joints;
     // Locals bit for bit (so global positions agree exactly too; checked below on a few frames).
-    EXPECT_TRUE(
-        same_bits(back.local_positions.data() + first, db.local_positions.data() + first, count))
+    EXPECT_TRUE(same_bits(back.local_positions().data() + first,
+                          db.local_positions().data() + first, count))
         << clip.name;
-    EXPECT_TRUE(
-        same_bits(back.local_rotations.data() + first, db.local_rotations.data() + first, count))
+    EXPECT_TRUE(same_bits(back.local_rotations().data() + first,
+                          db.local_rotations().data() + first, count))
         << clip.name;
     // Recomputed velocities: the builder's bit for bit (both come from the clip's own frames).
-    EXPECT_TRUE(
-        same_bits(back.local_velocities.data() + first, db.local_velocities.data() + first, count))
+    EXPECT_TRUE(same_bits(back.local_velocities().data() + first,
+                          db.local_velocities().data() + first, count))
         << clip.name;
-    EXPECT_TRUE(same_bits(back.local_angular_velocities.data() + first,
-                          db.local_angular_velocities.data() + first, count))
+    EXPECT_TRUE(same_bits(back.local_angular_velocities().data() + first,
+                          db.local_angular_velocities().data() + first, count))
         << clip.name;
     for (const int f : {clip.start, (clip.start + clip.end) / 2, clip.end - 1}) {
       const std::vector<Transform> a = test::frame_globals(db, f);
@@ -83,12 +84,12 @@ TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
     for (int f = 0; f < clip.frame_count(); ++f) {
       const int a = std::max(0, f - 1), b = std::min(clip.frame_count() - 1, f + 1);
       if (a == b) break;
-      const float inv_dt = 1.0f / (static_cast<float>(b - a) * back.frame_time);
-      const glm::quat* rotation = back.local_rotations.data() + first;
+      const float inv_dt = 1.0f / (static_cast<float>(b - a) * back.frame_time());
+      const glm::quat* rotation = back.local_rotations().data() + first;
       for (size_t j = 0; j < joints; ++j) {
         const glm::vec3 expected =
             angular_velocity_between(rotation[a * joints + j], rotation[b * joints + j], inv_dt);
-        const glm::vec3& got = back.local_angular_velocities[first + f * joints + j];
+        const glm::vec3& got = back.local_angular_velocities()[first + f * joints + j];
         ASSERT_TRUE(same_bits(&got, &expected, 1))
             << clip.name << " frame " << f << " joint " << j << ": " << got.x << " " << got.y << " "
             << got.z << " instead of " << expected.x << " " << expected.y << " " << expected.z;
@@ -97,15 +98,15 @@ TEST(DatabaseFileRealData, EveryNormalClipRoundTripsLosslessly) {
     // No velocity looks across the boundary: the first and last frames of a clip (of more than
     // one frame) are one-sided differences of the clip's own positions.
     if (clip.frame_count() > 1) {
-      const float inv_dt = 1.0f / db.frame_time;
+      const float inv_dt = 1.0f / db.frame_time();
       const auto p = [&](int f, size_t j) {
-        return back.local_positions[static_cast<size_t>(f) * joints + j];
+        return back.local_positions()[static_cast<size_t>(f) * joints + j];
       };
       for (size_t j = 0; j < joints; ++j) {
-        EXPECT_EQ(back.local_velocities[first + j],
+        EXPECT_EQ(back.local_velocities()[first + j],
                   (p(clip.start + 1, j) - p(clip.start, j)) * inv_dt)
             << clip.name << " joint " << j;
-        EXPECT_EQ(back.local_velocities[first + count - joints + j],
+        EXPECT_EQ(back.local_velocities()[first + count - joints + j],
                   (p(clip.end - 1, j) - p(clip.end - 2, j)) * inv_dt)
             << clip.name << " joint " << j;
       }

@@ -56,7 +56,7 @@ FeatureSchema two_channel_schema() {
 
 // Velocities and angular velocities as the builder makes them and load recomputes them: clip by
 // clip, never across a boundary.
-void derive_velocities(Database& db) {
+void derive_velocities(DatabaseContents& db) {
   const size_t joints = static_cast<size_t>(db.joint_count());
   db.local_velocities.resize(db.local_positions.size());
   db.local_angular_velocities.resize(db.local_positions.size());
@@ -73,10 +73,10 @@ void derive_velocities(Database& db) {
 
 // `frames_in_clip1` lets one test make a large database with the same shape. Joint 3 keeps one
 // position through clip 0 (a constant column, stored once); every other column varies.
-Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
+DatabaseContents make_contents(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  Database db;
+  DatabaseContents db;
   std::vector<Transform> rest(kJoints);
   for (Transform& t : rest) {
     t.rotation = random_unit_quat(rng);
@@ -109,9 +109,11 @@ Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
     db.feature_scale.push_back(0.5f + unit(rng));
   }
   for (int f = 0; f < db.frame_count; ++f) db.searchable.push_back(unit(rng) < 0.8f ? 1 : 0);
-  db.frame_clip.assign(kClip0Frames, 0);
-  db.frame_clip.insert(db.frame_clip.end(), clip1_frames, 1);
   return db;
+}
+
+Database make_database(int clip1_frames = kClip1Frames, uint32_t seed = 7) {
+  return Database::create(make_contents(clip1_frames, seed)).value();
 }
 
 bool contains(const std::string& text, const std::string& part) {
@@ -150,8 +152,8 @@ uint64_t section_offset(const std::vector<std::byte>& bytes, DatabaseSection s) 
 // Round trips.
 
 TEST(DatabaseFile, SaveLoadRoundTripIsExact) {
-  const Database db = make_database();
-  ASSERT_TRUE(db.validate().ok()) << db.validate().message();
+  const DatabaseContents db = make_contents();
+  ASSERT_TRUE(validate_database(db).ok()) << validate_database(db).message();
   const auto path = test::scratch_dir() / "small.mmdb";
   const Status saved = save_database(db, path);
   ASSERT_TRUE(saved.ok()) << saved.message();
@@ -165,7 +167,7 @@ TEST(DatabaseFile, SaveLoadRoundTripIsExact) {
 }
 
 TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
-  const Database db = make_database();
+  const DatabaseContents db = make_contents();
   const std::vector<std::byte> bytes = serialize_database(db);
   const unsigned char magic[8] = {0x8A, 'M', 'M', 'D', '\r', '\n', 0x1A, '\n'};
   EXPECT_EQ(std::memcmp(bytes.data(), magic, 8), 0);
@@ -253,7 +255,7 @@ TEST(DatabaseFile, HeaderReaderReportsSizes) {
 
 TEST(DatabaseFileThreads, LargeFileRoundTripsAndCatchesCorruptionWithParallelHash) {
   // 70k frames make a file over 8 MiB, which takes the two-thread path.
-  const Database db = make_database(70000, 11);
+  const DatabaseContents db = make_contents(70000, 11);
   std::vector<std::byte> bytes = serialize_database(db);
   ASSERT_GT(bytes.size(), size_t{8} << 20);
   Result<Database> loaded = deserialize_database(bytes, "large");
@@ -276,7 +278,7 @@ TEST(DatabaseFileThreads, LargeFileRoundTripsAndCatchesCorruptionWithParallelHas
 TEST(DatabaseFile, VelocitiesThatOverflowOnLoadAreRefusedByName) {
   // Finite positions whose difference overflows: the velocities recomputed on load are
   // infinite, and the load fails naming the first one (frame 4 differences frames 3 and 5).
-  Database db = make_database();
+  DatabaseContents db = make_contents();
   const size_t joints = static_cast<size_t>(db.joint_count());
   db.local_positions[5 * joints + 1].x = 3e38f;
   db.local_positions[6 * joints + 1].x = -3e38f;
@@ -285,23 +287,54 @@ TEST(DatabaseFile, VelocitiesThatOverflowOnLoadAreRefusedByName) {
       << message;
 }
 
-TEST(DatabaseFile, PerFrameArraysStillValueInitializeOutsideTheLoader) {
-  // The loader sizes the per-frame arrays without zero-filling them (it writes every value);
-  // after a load, growing one of them, or refilling one that held values, gives value-initialized
-  // elements as a std::vector does (zeros, and the identity for GLM's quaternions).
-  Result<Database> loaded = deserialize_database(serialize_database(make_database(300, 7)), "db");
+TEST(DatabaseFile, TheLoadedPerFrameArraysShareOneAllocation) {
+  // Loaded or created, a database's per-frame arrays are consecutive cache-line aligned runs of
+  // one block, none overlapping another.
+  Result<Database> loaded = deserialize_database(serialize_database(make_contents(300, 7)), "db");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
-  FrameArray<glm::vec3>& positions = loaded->local_positions;
-  const size_t size = positions.size();
-  positions.resize(size + 5);
-  for (size_t i = size; i < size + 5; ++i) EXPECT_EQ(positions[i], glm::vec3(0.0f)) << i;
-  FrameArray<glm::quat> rotations;
-  rotations.assign(64, glm::quat(0.5f, 0.5f, 0.5f, 0.5f));
-  rotations.clear();
-  rotations.resize(64);  // the same block, which still holds the old values
-  for (const glm::quat& q : rotations) EXPECT_EQ(q, glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
-  FrameArray<float> features(16);
-  for (const float f : features) EXPECT_EQ(f, 0.0f);
+  const Database created = make_database();
+  for (const Database* db : std::array<const Database*, 2>{&*loaded, &created}) {
+    struct Run {
+      const std::byte* begin;
+      size_t bytes;
+    };
+    const auto run = [](auto span) {
+      return Run{reinterpret_cast<const std::byte*>(span.data()), span.size_bytes()};
+    };
+    std::vector<Run> runs = {run(db->local_rotations()),  run(db->local_positions()),
+                             run(db->local_velocities()), run(db->local_angular_velocities()),
+                             run(db->features()),         run(db->feature_offset()),
+                             run(db->feature_scale()),    run(db->frame_clip()),
+                             run(db->contacts()),         run(db->searchable())};
+    std::sort(runs.begin(), runs.end(),
+              [](const Run& a, const Run& b) { return a.begin < b.begin; });
+    for (size_t i = 0; i < runs.size(); ++i) {
+      EXPECT_EQ(reinterpret_cast<uintptr_t>(runs[i].begin) % 64, 0u) << i;
+      if (i == 0) continue;
+      const std::byte* previous_end = runs[i - 1].begin + runs[i - 1].bytes;
+      EXPECT_GE(runs[i].begin, previous_end) << i;
+      EXPECT_LT(runs[i].begin - previous_end, 64) << i;  // no more than the alignment's padding
+    }
+  }
+}
+
+TEST(DatabaseCreate, RefusesWhatValidateRefusesAndCopiesTheRest) {
+  DatabaseContents contents = make_contents();
+  contents.feature_scale[2] = 0.0f;
+  Result<Database> refused = Database::create(contents);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(contains(refused.message(), "feature_scale[2]")) << refused.message();
+  contents.feature_scale[2] = 1.0f;
+  Result<Database> created = Database::create(contents);
+  ASSERT_TRUE(created.ok()) << created.message();
+  test::expect_same_database(contents, *created);
+  // frame_clip is derived from the clips.
+  EXPECT_EQ(created->frame_clip()[kClip0Frames - 1], 0);
+  EXPECT_EQ(created->frame_clip()[kClip0Frames], 1);
+  // contents() gives back what went in; a move leaves the source without frames.
+  test::expect_same_database(created->contents(), *created);
+  Database moved = std::move(created).value();
+  EXPECT_EQ(moved.frame_count(), contents.frame_count);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -430,7 +463,7 @@ TEST(DatabaseFile, EmptyAndMissingFilesNameThePath) {
 }
 
 TEST(DatabaseFile, SaveRefusesAnInvalidDatabaseAndWritesNothing) {
-  Database db = make_database();
+  DatabaseContents db = make_contents();
   db.feature_scale[2] = 0.0f;
   const auto path = test::scratch_dir() / "invalid.mmdb";
   const Status saved = save_database(db, path);
@@ -500,7 +533,7 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundByStructuralChecks) {
 }
 
 TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
-  const Database db = make_database();
+  const DatabaseContents db = make_contents();
   const std::vector<std::byte> bytes = serialize_database(db);
   const uint64_t parents = section_offset(bytes, DatabaseSection::SkeletonParents);
   const uint64_t clips = section_offset(bytes, DatabaseSection::Clips);
@@ -566,7 +599,7 @@ TEST(DatabaseFile, FormatVersion1FileIsRefusedWithARebuildMessage) {
 // What the compact layout derives or encodes: bit-exact rotations, recomputed velocities.
 
 TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
-  Database db = make_database();
+  DatabaseContents db = make_contents();
   // Quaternions the "smallest three" code cannot predict to within 15 ulps (not exactly unit,
   // though within validation's 1e-3) go to the exception list; signed zeros, a negative left-out
   // component and a rotation of exactly 180 degrees (w = 0) round-trip too.
@@ -576,15 +609,15 @@ TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
   db.local_rotations[7] = glm::normalize(glm::quat(0.3f, -0.2f, 0.9f, 0.1f)) * 0.9997f;
   db.local_rotations[45] = glm::quat(-0.5f, -0.5f, -0.5f, -0.5f);
   derive_velocities(db);
-  ASSERT_TRUE(db.validate().ok()) << db.validate().message();
+  ASSERT_TRUE(validate_database(db).ok()) << validate_database(db).message();
   const std::vector<std::byte> bytes = serialize_database(db);
   Result<DatabaseFileInfo> info = parse_database_header(bytes, "fixture");
   ASSERT_TRUE(info.ok()) << info.message();
   EXPECT_EQ(info->section(DatabaseSection::RotationExceptions).length, 2u * 16);
   Result<Database> loaded = deserialize_database(bytes, "fixture");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
-  ASSERT_EQ(loaded->local_rotations.size(), db.local_rotations.size());
-  EXPECT_EQ(std::memcmp(loaded->local_rotations.data(), db.local_rotations.data(),
+  ASSERT_EQ(loaded->local_rotations().size(), db.local_rotations.size());
+  EXPECT_EQ(std::memcmp(loaded->local_rotations().data(), db.local_rotations.data(),
                         db.local_rotations.size() * sizeof(glm::quat)),
             0);
   test::expect_same_database(db, *loaded);
@@ -611,7 +644,7 @@ TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
 }
 
 TEST(DatabaseFile, VelocitiesAreRecomputedOnLoadClipByClip) {
-  Database db = make_database();
+  DatabaseContents db = make_contents();
   // Whatever velocities the database holds, the file keeps only the poses.
   for (glm::vec3& v : db.local_velocities) v = glm::vec3(7.0f);
   for (glm::vec3& v : db.local_angular_velocities) v = glm::vec3(-7.0f);
@@ -624,9 +657,9 @@ TEST(DatabaseFile, VelocitiesAreRecomputedOnLoadClipByClip) {
   const float inv_dt = 1.0f / db.frame_time;
   for (int j = 0; j < kJoints; ++j) {
     const auto p = [&](int f) { return db.local_positions[f * kJoints + j]; };
-    EXPECT_EQ(loaded->local_velocities[11 * kJoints + j], (p(11) - p(10)) * inv_dt) << j;
-    EXPECT_EQ(loaded->local_velocities[12 * kJoints + j], (p(13) - p(12)) * inv_dt) << j;
-    EXPECT_EQ(loaded->local_velocities[5 * kJoints + j], (p(6) - p(4)) * (inv_dt / 2.0f)) << j;
+    EXPECT_EQ(loaded->local_velocities()[11 * kJoints + j], (p(11) - p(10)) * inv_dt) << j;
+    EXPECT_EQ(loaded->local_velocities()[12 * kJoints + j], (p(13) - p(12)) * inv_dt) << j;
+    EXPECT_EQ(loaded->local_velocities()[5 * kJoints + j], (p(6) - p(4)) * (inv_dt / 2.0f)) << j;
   }
 }
 
@@ -634,62 +667,70 @@ TEST(DatabaseFile, VelocitiesAreRecomputedOnLoadClipByClip) {
 // Database::validate and tag_mask on in-memory databases.
 
 TEST(DatabaseValidate, CatchesEachInconsistency) {
-  ASSERT_TRUE(make_database().validate().ok());
+  ASSERT_TRUE(validate_database(make_contents()).ok());
   struct Case {
     const char* what;
-    void (*damage)(Database&);
+    void (*damage)(DatabaseContents&);
     const char* expected;
   };
   const Case cases[] = {
-      {"frame time", [](Database& d) { d.frame_time = -1.0f; }, "frame_time"},
-      {"no frames", [](Database& d) { d.frame_count = 0; }, "has no frames"},
-      {"role", [](Database& d) { d.roles.head = 4; }, "role head is joint 4"},
-      {"positions size", [](Database& d) { d.local_positions.pop_back(); },
+      {"frame time", [](DatabaseContents& d) { d.frame_time = -1.0f; }, "frame_time"},
+      {"no frames", [](DatabaseContents& d) { d.frame_count = 0; }, "has no frames"},
+      {"role", [](DatabaseContents& d) { d.roles.head = 4; }, "role head is joint 4"},
+      {"positions size", [](DatabaseContents& d) { d.local_positions.pop_back(); },
        "local_positions has 79 values, expected 80"},
-      {"rotations size", [](Database& d) { d.local_rotations.emplace_back(); },
+      {"rotations size", [](DatabaseContents& d) { d.local_rotations.emplace_back(); },
        "local_rotations has 81 values, expected 80"},
-      {"contacts size", [](Database& d) { d.contacts.pop_back(); }, "contacts has 39 values"},
-      {"features size", [](Database& d) { d.features.pop_back(); }, "features has 139 values"},
-      {"offset size", [](Database& d) { d.feature_offset.pop_back(); }, "feature_offset has 6"},
-      {"scale size", [](Database& d) { d.feature_scale.push_back(1.0f); }, "feature_scale has 8"},
-      {"searchable size", [](Database& d) { d.searchable.clear(); }, "searchable has 0 values"},
-      {"frame_clip size", [](Database& d) { d.frame_clip.pop_back(); }, "frame_clip has 19"},
-      {"frame_clip value", [](Database& d) { d.frame_clip[13] = 0; },
-       "frame_clip[13] is 0, but the frame is in clip 1"},
-      {"no clips", [](Database& d) { d.clips.clear(); }, "no clips"},
-      {"clip gap", [](Database& d) { d.clips[1].start = 13; }, "starts at frame 13, expected 12"},
-      {"clips short", [](Database& d) { d.clips[1].end = 19; }, "the clips end at frame 19"},
-      {"clip past end", [](Database& d) { d.clips[1].end = 21; }, "range [12, 21)"},
+      {"contacts size", [](DatabaseContents& d) { d.contacts.pop_back(); },
+       "contacts has 39 values"},
+      {"features size", [](DatabaseContents& d) { d.features.pop_back(); },
+       "features has 139 values"},
+      {"offset size", [](DatabaseContents& d) { d.feature_offset.pop_back(); },
+       "feature_offset has 6"},
+      {"scale size", [](DatabaseContents& d) { d.feature_scale.push_back(1.0f); },
+       "feature_scale has 8"},
+      {"searchable size", [](DatabaseContents& d) { d.searchable.clear(); },
+       "searchable has 0 values"},
+      {"no clips", [](DatabaseContents& d) { d.clips.clear(); }, "no clips"},
+      {"clip gap", [](DatabaseContents& d) { d.clips[1].start = 13; },
+       "starts at frame 13, expected 12"},
+      {"clips short", [](DatabaseContents& d) { d.clips[1].end = 19; },
+       "the clips end at frame 19"},
+      {"clip past end", [](DatabaseContents& d) { d.clips[1].end = 21; }, "range [12, 21)"},
       {"empty clip",
-       [](Database& d) {
+       [](DatabaseContents& d) {
          d.clips[0].end = 0;
          d.clips[1].start = 0;
        },
        "range [0, 0)"},
-      {"tag bit", [](Database& d) { d.clips[0].tags = uint64_t{1} << 63; }, "tag bit 63"},
-      {"too many tags", [](Database& d) { d.tag_names.resize(65, "x"); }, "65 tag names"},
-      {"duplicate tag", [](Database& d) { d.tag_names[2] = "walk"; }, "duplicate tag name 'walk'"},
-      {"empty tag", [](Database& d) { d.tag_names[1].clear(); }, "tag name 1 is empty"},
-      {"unknown bone", [](Database& d) { d.schema.channels[0].bone = "Tail"; },
+      {"tag bit", [](DatabaseContents& d) { d.clips[0].tags = uint64_t{1} << 63; }, "tag bit 63"},
+      {"too many tags", [](DatabaseContents& d) { d.tag_names.resize(65, "x"); }, "65 tag names"},
+      {"duplicate tag", [](DatabaseContents& d) { d.tag_names[2] = "walk"; },
+       "duplicate tag name 'walk'"},
+      {"empty tag", [](DatabaseContents& d) { d.tag_names[1].clear(); }, "tag name 1 is empty"},
+      {"unknown bone", [](DatabaseContents& d) { d.schema.channels[0].bone = "Tail"; },
        "names bone 'Tail', which is neither a role nor a joint"},
-      {"missing role", [](Database& d) { d.roles.left_foot = -1; }, "uses role 'left_foot'"},
-      {"bad schema", [](Database& d) { d.schema.channels[1].weight = 0.0f; }, "schema:"},
-      {"rotation", [](Database& d) { d.local_rotations[77] = glm::quat(0.9f, 0, 0, 0); },
+      {"missing role", [](DatabaseContents& d) { d.roles.left_foot = -1; },
+       "uses role 'left_foot'"},
+      {"bad schema", [](DatabaseContents& d) { d.schema.channels[1].weight = 0.0f; }, "schema:"},
+      {"rotation", [](DatabaseContents& d) { d.local_rotations[77] = glm::quat(0.9f, 0, 0, 0); },
        "local_rotations[frame 19, joint 1 'Hips']"},
-      {"rotation nan", [](Database& d) { d.local_rotations[3].x = nan; },
+      {"rotation nan", [](DatabaseContents& d) { d.local_rotations[3].x = nan; },
        "local_rotations[frame 0, joint 3 'Foot_R']"},
-      {"position", [](Database& d) { d.local_positions[9].y = INFINITY; },
+      {"position", [](DatabaseContents& d) { d.local_positions[9].y = INFINITY; },
        "local_positions[frame 2, joint 1 'Hips'] is not finite"},
-      {"velocity", [](Database& d) { d.local_velocities[0].z = nan; }, "local_velocities[frame 0"},
-      {"angular velocity", [](Database& d) { d.local_angular_velocities[79].x = nan; },
+      {"velocity", [](DatabaseContents& d) { d.local_velocities[0].z = nan; },
+       "local_velocities[frame 0"},
+      {"angular velocity", [](DatabaseContents& d) { d.local_angular_velocities[79].x = nan; },
        "local_angular_velocities[frame 19, joint 3"},
-      {"contact", [](Database& d) { d.contacts[4] = 7; }, "contacts[frame 2, left] is 7"},
-      {"feature", [](Database& d) { d.features[15] = nan; }, "features[frame 2, column 1]"},
-      {"offset", [](Database& d) { d.feature_offset[6] = nan; }, "feature_offset[6]"},
-      {"scale inf", [](Database& d) { d.feature_scale[0] = INFINITY; }, "feature_scale[0] is inf"},
-      {"searchable", [](Database& d) { d.searchable[19] = 2; }, "searchable[19] is 2"},
+      {"contact", [](DatabaseContents& d) { d.contacts[4] = 7; }, "contacts[frame 2, left] is 7"},
+      {"feature", [](DatabaseContents& d) { d.features[15] = nan; }, "features[frame 2, column 1]"},
+      {"offset", [](DatabaseContents& d) { d.feature_offset[6] = nan; }, "feature_offset[6]"},
+      {"scale inf", [](DatabaseContents& d) { d.feature_scale[0] = INFINITY; },
+       "feature_scale[0] is inf"},
+      {"searchable", [](DatabaseContents& d) { d.searchable[19] = 2; }, "searchable[19] is 2"},
       {"rest",
-       [](Database& d) {
+       [](DatabaseContents& d) {
          std::vector<Transform> rest = d.skeleton.rest();
          rest[2].translation.x = nan;
          d.skeleton = Skeleton::create(d.skeleton.names(), d.skeleton.parents(), rest).value();
@@ -697,9 +738,9 @@ TEST(DatabaseValidate, CatchesEachInconsistency) {
        "rest transform of joint 2 'Foot_L'"},
   };
   for (const Case& c : cases) {
-    Database db = make_database();
+    DatabaseContents db = make_contents();
     c.damage(db);
-    const Status s = db.validate();
+    const Status s = validate_database(db);
     ASSERT_FALSE(s.ok()) << c.what;
     EXPECT_TRUE(contains(s.message(), c.expected)) << c.what << ": " << s.message();
   }
@@ -708,14 +749,14 @@ TEST(DatabaseValidate, CatchesEachInconsistency) {
 TEST(DatabaseValidateThreads, LargeArraysReportTheFirstBadValue) {
   // Over a million values the scans split across two threads; the first bad index must win
   // whichever half it is in.
-  Database db = make_database(300000, 3);
-  ASSERT_TRUE(db.validate().ok()) << db.validate().message();
+  DatabaseContents db = make_contents(300000, 3);
+  ASSERT_TRUE(validate_database(db).ok()) << validate_database(db).message();
   db.local_positions[1000000].x = nan;  // second half of 1.2M samples
-  EXPECT_TRUE(contains(db.validate().message(), "local_positions[frame 250000, joint 0"))
-      << db.validate().message();
+  EXPECT_TRUE(contains(validate_database(db).message(), "local_positions[frame 250000, joint 0"))
+      << validate_database(db).message();
   db.local_positions[10].z = nan;  // now also one in the first half, which comes first
-  EXPECT_TRUE(contains(db.validate().message(), "local_positions[frame 2, joint 2"))
-      << db.validate().message();
+  EXPECT_TRUE(contains(validate_database(db).message(), "local_positions[frame 2, joint 2"))
+      << validate_database(db).message();
 }
 
 TEST(DatabaseTagMask, KnownNamesSetTheirBitsUnknownNamesNone) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
+
 #include <algorithm>
 #include <filesystem>
 #include <string>
@@ -23,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Built {
-  Database db;
+  std::optional<Database> db;
   CharacterBody body;
 };
 
@@ -36,8 +38,8 @@ const Built& built() {
     Result<Database> db = build_database(inputs, BuildOptions{});
     EXPECT_TRUE(db.ok()) << db.message();
     if (!db) return out;
-    out.db = std::move(db).value();
-    Result<CharacterBody> body = build_character_body(out.db);
+    out.db.emplace(std::move(db).value());
+    Result<CharacterBody> body = build_character_body(*out.db);
     EXPECT_TRUE(body.ok()) << body.message();
     if (body) out.body = std::move(body).value();
     return out;
@@ -47,11 +49,11 @@ const Built& built() {
 
 const glm::vec3& bind_position(const std::string& joint) {
   const Built& b = built();
-  return b.body.skinned.bind_global[static_cast<size_t>(b.db.skeleton.find(joint))].translation;
+  return b.body.skinned.bind_global[static_cast<size_t>(b.db->skeleton().find(joint))].translation;
 }
 
 // The database clip's locals of one frame (unit scale).
-std::vector<Transform> clip_frame(const Database& db, const ClipRange& clip, int frame) {
+std::vector<Transform> clip_frame(const DatabaseView& db, const ClipRange& clip, int frame) {
   const int joints = db.joint_count();
   std::vector<Transform> local(static_cast<size_t>(joints));
   for (int j = 0; j < joints; ++j) {
@@ -112,7 +114,8 @@ TEST(CharacterBody, StandsAtTheOriginFacingZInAnAPose) {
   EXPECT_GT(bind_position("Foot_L").x - bind_position("Foot_R").x, 0.2f);  // legs apart
   // The joints above the hips are at the origin with no rotation, and carry no geometry.
   for (const char* name : {"Simulation", "joint_Root"}) {
-    const Transform& t = b.body.skinned.bind_global[static_cast<size_t>(b.db.skeleton.find(name))];
+    const Transform& t =
+        b.body.skinned.bind_global[static_cast<size_t>(b.db->skeleton().find(name))];
     EXPECT_EQ(t.translation, glm::vec3(0.0f)) << name;
     EXPECT_NEAR(std::abs(t.rotation.w), 1.0f, 1e-6f) << name;
   }
@@ -120,7 +123,7 @@ TEST(CharacterBody, StandsAtTheOriginFacingZInAnAPose) {
 
 TEST(CharacterBody, EveryVertexIsWeightedAndEveryBodyPartOwnsVertices) {
   const Built& b = built();
-  std::vector<int> dominant(static_cast<size_t>(b.db.joint_count()), 0);
+  std::vector<int> dominant(static_cast<size_t>(b.db->joint_count()), 0);
   std::vector<bool> weighted(dominant.size(), false);
   for (const VertexInfluences& in : b.body.skinned.influences) {
     float sum = 0.0f;
@@ -134,8 +137,8 @@ TEST(CharacterBody, EveryVertexIsWeightedAndEveryBodyPartOwnsVertices) {
     EXPECT_NEAR(sum, 1.0f, 1e-4f);
     ++dominant[static_cast<size_t>(in.joints[best])];
   }
-  for (int j = 0; j < b.db.joint_count(); ++j) {
-    const std::string& name = b.db.skeleton.name(j);
+  for (int j = 0; j < b.db->joint_count(); ++j) {
+    const std::string& name = b.db->skeleton().name(j);
     if (name == "Simulation" || name == "joint_Root") {
       EXPECT_FALSE(weighted[static_cast<size_t>(j)]) << name;
     } else {
@@ -148,32 +151,32 @@ TEST(CharacterBody, EveryVertexIsWeightedAndEveryBodyPartOwnsVertices) {
 // The test: export the body with a clip, reload it, and skin both at several frames.
 TEST(CharacterBody, ExportedWithAClipItReloadsToTheSameSkinnedVertices) {
   const Built& b = built();
-  const ClipRange& clip = b.db.clips[1];  // the walk
+  const ClipRange& clip = b.db->clips()[1];  // the walk
   std::vector<Transform> frames;
   for (int f = 0; f < clip.frame_count(); ++f) {
-    const std::vector<Transform> pose = clip_frame(b.db, clip, f);
+    const std::vector<Transform> pose = clip_frame(*b.db, clip, f);
     frames.insert(frames.end(), pose.begin(), pose.end());
   }
   const fs::path out = test::scratch_dir() / "walk_body.glb";
-  ASSERT_TRUE(save_skinned_gltf(b.db.skeleton, b.body.skinned, frames, clip.frame_count(),
-                                b.db.frame_time, clip.name, out)
+  ASSERT_TRUE(save_skinned_gltf(b.db->skeleton(), b.body.skinned, frames, clip.frame_count(),
+                                b.db->frame_time(), clip.name, out)
                   .ok());
   GltfImportOptions options;
-  options.sample_rate = 1.0f / b.db.frame_time;
+  options.sample_rate = 1.0f / b.db->frame_time();
   options.read_skinned_mesh = true;
   Result<GltfAsset> asset = load_gltf(out, options);
   ASSERT_TRUE(asset.ok()) << asset.message();
   ASSERT_TRUE(asset->skinned_mesh.has_value());
-  ASSERT_TRUE(asset->skeleton.same_topology(b.db.skeleton));
+  ASSERT_TRUE(asset->skeleton.same_topology(b.db->skeleton()));
   ASSERT_EQ(asset->clips.size(), 1u);
   ASSERT_EQ(asset->clips[0].frame_count, clip.frame_count());
   ASSERT_EQ(asset->skinned_mesh->mesh.vertex_count(), b.body.skinned.mesh.vertex_count());
   EXPECT_EQ(asset->skinned_mesh->mesh.indices, b.body.skinned.mesh.indices);
 
-  const int joints = b.db.joint_count();
+  const int joints = b.db->joint_count();
   for (int f : {0, clip.frame_count() / 2, clip.frame_count() - 1}) {
     std::vector<Transform> global(static_cast<size_t>(joints)), reloaded(global.size());
-    forward_kinematics(b.db.skeleton.parents(), clip_frame(b.db, clip, f), global);
+    forward_kinematics(b.db->skeleton().parents(), clip_frame(*b.db, clip, f), global);
     forward_kinematics(asset->skeleton.parents(), asset->clips[0].pose(f), reloaded);
     const std::vector<glm::vec3> expected = skin(b.body.skinned, global);
     const std::vector<glm::vec3> actual = skin(*asset->skinned_mesh, reloaded);
@@ -188,16 +191,17 @@ TEST(CharacterBody, ExportedWithAClipItReloadsToTheSameSkinnedVertices) {
 TEST(CharacterBody, LoadBodyMapsJointsByNameAndListsMissingOnes) {
   const Built& b = built();
   const fs::path out = test::scratch_dir() / "body.glb";
-  const std::vector<Transform> pose = clip_frame(b.db, b.db.clips[0], 0);
+  const std::vector<Transform> pose = clip_frame(*b.db, b.db->clips()[0], 0);
   ASSERT_TRUE(
-      save_skinned_gltf(b.db.skeleton, b.body.skinned, pose, 1, b.db.frame_time, "pose", out).ok());
+      save_skinned_gltf(b.db->skeleton(), b.body.skinned, pose, 1, b.db->frame_time(), "pose", out)
+          .ok());
 
   // Mapped back onto the database skeleton by name, it skins as the body it was made from.
-  std::vector<std::string> names = b.db.skeleton.names();
-  Result<SkinnedMesh> loaded = load_body_gltf(out, b.db.skeleton);
+  std::vector<std::string> names = b.db->skeleton().names();
+  Result<SkinnedMesh> loaded = load_body_gltf(out, b.db->skeleton());
   ASSERT_TRUE(loaded.ok()) << loaded.message();
-  std::vector<Transform> global(static_cast<size_t>(b.db.joint_count()));
-  forward_kinematics(b.db.skeleton.parents(), pose, global);
+  std::vector<Transform> global(static_cast<size_t>(b.db->joint_count()));
+  forward_kinematics(b.db->skeleton().parents(), pose, global);
   const std::vector<glm::vec3> expected = skin(b.body.skinned, global);
   const std::vector<glm::vec3> actual = skin(*loaded, global);
   for (size_t v = 0; v < expected.size(); v += 97) {
@@ -208,13 +212,13 @@ TEST(CharacterBody, LoadBodyMapsJointsByNameAndListsMissingOnes) {
   std::replace(names.begin(), names.end(), std::string("Hand_L"), std::string("LeftHand"));
   std::replace(names.begin(), names.end(), std::string("Head"), std::string("Skull"));
   const Skeleton renamed =
-      Skeleton::create(names, b.db.skeleton.parents(), b.db.skeleton.rest()).value();
+      Skeleton::create(names, b.db->skeleton().parents(), b.db->skeleton().rest()).value();
   Result<SkinnedMesh> refused = load_body_gltf(out, renamed);
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.message().find(out.string()), std::string::npos) << refused.message();
   EXPECT_NE(refused.message().find("lacks: Head, Hand_L"), std::string::npos) << refused.message();
 
-  Result<SkinnedMesh> missing = load_body_gltf(out.parent_path() / "none.glb", b.db.skeleton);
+  Result<SkinnedMesh> missing = load_body_gltf(out.parent_path() / "none.glb", b.db->skeleton());
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.message().find("none.glb: cannot open the glTF file (No such file"),
             std::string::npos);
@@ -249,16 +253,16 @@ TEST(CharacterBody, ASkeletonWithoutHandsGetsForearmsAndHands) {
   build.bvh.scale = 0.0f;
   Result<Database> db = build_database(std::span(&take, 1), build);
   ASSERT_TRUE(db.ok()) << db.message();
-  ASSERT_LT(db->roles.left_hand, 0);
-  const std::vector<Transform> pose = clip_frame(*db, db->clips[0], 0);
-  const std::vector<Transform> bind = make_bind_pose(db->skeleton, pose, db->roles);
+  ASSERT_LT(db->roles().left_hand, 0);
+  const std::vector<Transform> pose = clip_frame(*db, db->clips()[0], 0);
+  const std::vector<Transform> bind = make_bind_pose(db->skeleton(), pose, db->roles());
   std::vector<Transform> global(bind.size());
-  forward_kinematics(db->skeleton.parents(), bind, global);
+  forward_kinematics(db->skeleton().parents(), bind, global);
   const std::vector<BoneSegment> segments =
-      character_bone_segments(db->skeleton, global, db->roles, 0.0f);
+      character_bone_segments(db->skeleton(), global, db->roles(), 0.0f);
   for (const auto& [lower, upper] :
-       {std::pair{db->roles.left_lower_arm, db->roles.left_upper_arm},
-        std::pair{db->roles.right_lower_arm, db->roles.right_upper_arm}}) {
+       {std::pair{db->roles().left_lower_arm, db->roles().left_upper_arm},
+        std::pair{db->roles().right_lower_arm, db->roles().right_upper_arm}}) {
     const glm::vec3 shoulder = global[static_cast<size_t>(upper)].translation;
     const glm::vec3 elbow = global[static_cast<size_t>(lower)].translation;
     float reach = 0.0f;
@@ -269,9 +273,9 @@ TEST(CharacterBody, ASkeletonWithoutHandsGetsForearmsAndHands) {
       tip = segment.tail;
     }
     // Longer than the upper arm (forearm and hand), and on from the elbow as the upper arm goes.
-    EXPECT_GT(reach, glm::distance(shoulder, elbow)) << db->skeleton.name(lower);
+    EXPECT_GT(reach, glm::distance(shoulder, elbow)) << db->skeleton().name(lower);
     EXPECT_GT(glm::dot(glm::normalize(tip - elbow), glm::normalize(elbow - shoulder)), 0.95f)
-        << db->skeleton.name(lower);
+        << db->skeleton().name(lower);
   }
 }
 
@@ -296,7 +300,7 @@ TEST(CharacterBody, RefusesWhatItCannotBuildByMessage) {
   options.mesh.voxel_size = -1.0f;
   expect_error(build_character_body(two, rest, JointRoleIndices{}, options),
                "voxel size must be a positive");
-  expect_error(build_character_body(Database{}), "the database has no frames");
+  expect_error(build_character_body(DatabaseContents{}), "the database has no frames");
 }
 
 }  // namespace

@@ -398,7 +398,7 @@ TEST(FeatureNormalization, AllRowsCountWhenNoneIsSearchable) {
 TEST(FeatureExtraction, DatabaseFeaturesNeverReadAcrossClips) {
   // Two clips back to back: the first slides along +X, the second along -X from far away.
   // Trajectory features near the end of clip 0 must clamp to its last frame, not read clip 1.
-  Database db;
+  DatabaseContents db;
   Result<Skeleton> sk = Skeleton::create({"Simulation", "Hips", "Foot_L", "Foot_R"}, {-1, 0, 1, 1},
                                          std::vector<Transform>(4));
   ASSERT_TRUE(sk);
@@ -429,7 +429,7 @@ TEST(FeatureExtraction, DatabaseFeaturesNeverReadAcrossClips) {
   int searchable = 0;
   for (uint8_t s : db.searchable) searchable += s;
   EXPECT_EQ(searchable, (n0 - 30) + (n1 - 30));
-  FrameArray<float> raw = db.features;
+  std::vector<float> raw = db.features;
   denormalize_features(raw, db.feature_offset, db.feature_scale);
   const int dims = 27;
   // Frame n0 - 5 of clip 0: 4 frames left, every future time clamps to 4 frames of motion.

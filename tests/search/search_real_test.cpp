@@ -35,8 +35,9 @@ bool same_cost(float a, float b) {
 
 // Every 9th file of the normal-style set (52 clips: walks, turns, runs and standing gestures),
 // plus the duplicated takes walk-turn-left 027 and 031 (identical frame for frame).
+// A failed build or load was reported by its EXPECT; value() then stops the program.
 const Database& subset_database() {
-  static const Database db = [] {
+  static const Result<Database> db = [] {
     const fs::path folder = test::data_dir();
     auto files = collect_input_files(std::span<const fs::path>(&folder, 1));
     EXPECT_TRUE(files) << files.message();
@@ -51,18 +52,18 @@ const Database& subset_database() {
     }
     auto built = build_database(chosen, BuildOptions{});
     EXPECT_TRUE(built) << built.message();
-    return built ? std::move(built).value() : Database{};
+    return built;
   }();
-  return db;
+  return db.value();
 }
 
 const Database& normal_database() {
-  static const Database db = [] {
+  static const Result<Database> db = [] {
     auto loaded = test::normal_database();
     EXPECT_TRUE(loaded) << loaded.message();
-    return loaded ? std::move(loaded).value() : Database{};
+    return loaded;
   }();
-  return db;
+  return db.value();
 }
 
 // The search views of a database (one per database, kept for the whole test program).
@@ -111,7 +112,8 @@ std::vector<Query> real_queries(const Database& db, int count, uint64_t seed) {
     q.constraints.exclude_tags = excludes[k % 3];
     if (playing == 1) q.constraints.current_frame = one.source_frames[0];
     if (playing == 2)
-      q.constraints.current_frame = static_cast<int>(rng() % static_cast<uint32_t>(db.frame_count));
+      q.constraints.current_frame =
+          static_cast<int>(rng() % static_cast<uint32_t>(db.frame_count()));
     queries.push_back(std::move(q));
   }
   return queries;
@@ -164,8 +166,8 @@ class RealExactness : public ::testing::TestWithParam<MethodCase> {};
 
 TEST_P(RealExactness, SameCostAsBruteOnTwoThousandConstrainedQueries) {
   const Database& db = subset_database();
-  ASSERT_GT(db.clips.size(), 40u);
-  ASSERT_GT(db.frame_count, 5000);
+  ASSERT_GT(db.clips().size(), 40u);
+  ASSERT_GT(db.frame_count(), 5000);
   auto brute = make_bench_searcher("brute", views(db));
   auto method = make_bench_searcher(GetParam().method, views(db), GetParam().options());
   ASSERT_TRUE(brute) << brute.message();
@@ -202,22 +204,22 @@ TEST_P(RealExactness, ExactDuplicateFramesTieAtZeroDistance) {
   // the transition cost, whatever rotation the structure searches in.
   int clip027 = -1;
   int clip031 = -1;
-  for (size_t c = 0; c < db.clips.size(); ++c) {
-    if (db.clips[c].name == "dataset-2_walk-turn-left_normal_027") clip027 = static_cast<int>(c);
-    if (db.clips[c].name == "dataset-2_walk-turn-left_normal_031") clip031 = static_cast<int>(c);
+  for (size_t c = 0; c < db.clips().size(); ++c) {
+    if (db.clips()[c].name == "dataset-2_walk-turn-left_normal_027") clip027 = static_cast<int>(c);
+    if (db.clips()[c].name == "dataset-2_walk-turn-left_normal_031") clip031 = static_cast<int>(c);
   }
   ASSERT_GE(clip027, 0);
   ASSERT_GE(clip031, 0);
-  const ClipRange& a = db.clips[clip027];
-  const ClipRange& b = db.clips[clip031];
+  const ClipRange& a = db.clips()[clip027];
+  const ClipRange& b = db.clips()[clip031];
   int checked = 0;
   for (int f = a.start; f < a.end; ++f) {
-    if (!db.searchable[f]) continue;
+    if (!db.searchable()[f]) continue;
     const std::span<const float> row = db.feature_row(f);
     bool has_twin = false;
     for (int g = b.start; g < b.end && !has_twin; ++g) {
       const std::span<const float> other = db.feature_row(g);
-      has_twin = db.searchable[g] && std::equal(row.begin(), row.end(), other.begin());
+      has_twin = db.searchable()[g] && std::equal(row.begin(), row.end(), other.begin());
     }
     if (!has_twin) continue;
     const std::vector<float> query(row.begin(), row.end());
@@ -279,7 +281,7 @@ TEST(RealApprox, KdtreeEpsWithinItsBoundOnConstrainedQueries) {
 // against brute on unconstrained and playing queries.
 TEST(RealNormalSet, TreesMatchBruteOnTheFullDatabase) {
   const Database& db = normal_database();
-  ASSERT_GT(db.frame_count, 50000);
+  ASSERT_GT(db.frame_count(), 50000);
   const SearchInput input = views(db);
   auto brute = make_bench_searcher("brute", input);
   ASSERT_TRUE(brute) << brute.message();

@@ -72,14 +72,14 @@ TEST(Cli, BuildWritesALoadableDatabaseAndPrintsItsSummary) {
   EXPECT_NE(build.output.find(" of dataset-2_", idle_line), std::string::npos) << build.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  ASSERT_EQ(db->clips.size(), 4u);
-  EXPECT_EQ(db->clips[3].name, "idle");
+  ASSERT_EQ(db->clips().size(), 4u);
+  EXPECT_EQ(db->clips()[3].name, "idle");
   // The frames of the three sources, counted by the importer independently of the builder,
   // and the idle clip's.
   int frames = 0;
   for (const auto& entry : fs::directory_iterator(in))
     frames += load_bvh(entry.path())->frame_count;
-  EXPECT_EQ(db->frame_count, frames + 90);
+  EXPECT_EQ(db->frame_count(), frames + 90);
 
   const CommandRun info = run_mm("info " + quoted(out));
   EXPECT_EQ(info.exit_code, 0) << info.output;
@@ -105,7 +105,7 @@ TEST(Cli, BuildRefusesABadFileNamingItAndSkipBadBuildsFromTheRest) {
   EXPECT_NE(skip.output.find("broken.bvh"), std::string::npos) << skip.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  EXPECT_EQ(db->clips.size(), 3u);
+  EXPECT_EQ(db->clips().size(), 3u);
 }
 
 TEST(Cli, IdleLengthIsAnOptionAndInfoShowsTheIdleClip) {
@@ -119,7 +119,7 @@ TEST(Cli, IdleLengthIsAnOptionAndInfoShowsTheIdleClip) {
   EXPECT_NE(none.output.find("idle:        none"), std::string::npos) << none.output;
   Result<Database> db = load_database(out);
   ASSERT_TRUE(db.ok()) << db.message();
-  EXPECT_EQ(db->clips.size(), 3u);
+  EXPECT_EQ(db->clips().size(), 3u);
 
   const CommandRun two = run_mm("build " + quoted(in) + " -o " + quoted(out) + " --idle 2");
   ASSERT_EQ(two.exit_code, 0) << two.output;
@@ -162,7 +162,7 @@ TEST(Cli, ContactThresholdsAreConfigurable) {
     Result<Database> db = load_database(file);
     EXPECT_TRUE(db.ok()) << db.message();
     int n = 0;
-    for (uint8_t c : db->contacts) n += c;
+    for (uint8_t c : db->contacts()) n += c;
     return n;
   };
   ASSERT_EQ(run_mm("build " + quoted(in) + " -o " + quoted(dir / "a.mmdb") + " --quiet").exit_code,

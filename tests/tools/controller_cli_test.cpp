@@ -166,7 +166,7 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
   std::string header =
       "t,sim_x,sim_z,sim_yaw_deg,root_x,root_z,root_yaw_deg,desired_vx,desired_vz,desired_yaw_deg,"
       "transition,contact_l,contact_r,clip,frame";
-  for (const std::string& joint : db->skeleton.names()) {
+  for (const std::string& joint : db->skeleton().names()) {
     header.append(",").append(joint).append("_x,").append(joint).append("_y,").append(joint).append(
         "_z");
   }

@@ -199,11 +199,11 @@ TEST(RetargetCli, BuildTargetPutsTheDatabaseOnThatSkeletonAndRetargetReadsIt) {
   const Skeleton target = in_metres(reactidle_clip()).skeleton;
   ASSERT_EQ(db->joint_count(), target.joint_count() + 1);
   for (int j = 0; j < target.joint_count(); ++j) {
-    EXPECT_EQ(db->skeleton.name(j + 1), target.name(j));
-    EXPECT_EQ(db->skeleton.parent(j + 1), target.parent(j) + 1) << target.name(j);
-    EXPECT_EQ(db->skeleton.rest(j + 1).translation, target.rest(j).translation) << target.name(j);
+    EXPECT_EQ(db->skeleton().name(j + 1), target.name(j));
+    EXPECT_EQ(db->skeleton().parent(j + 1), target.parent(j) + 1) << target.name(j);
+    EXPECT_EQ(db->skeleton().rest(j + 1).translation, target.rest(j).translation) << target.name(j);
   }
-  EXPECT_EQ(db->skeleton.name(db->roles.left_foot), "foot.L");
+  EXPECT_EQ(db->skeleton().name(db->roles().left_foot), "foot.L");
 
   // The database as a target: its skeleton without the simulation root, in metres.
   const fs::path out = dir / "walk_on_db.bvh";

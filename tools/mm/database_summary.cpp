@@ -44,20 +44,21 @@ void print_joint_map(FILE* out, const Skeleton& skeleton, const JointRoleIndices
 void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
                             const std::string& idle_source) {
   int mirrored = 0;
-  for (const ClipRange& c : db.clips) mirrored += c.mirrored ? 1 : 0;
-  const long long searchable = std::count(db.searchable.begin(), db.searchable.end(), uint8_t{1});
-  const double rate = db.frame_time > 0.0f ? 1.0 / db.frame_time : 0.0;
-  std::fprintf(out, "clips:       %zu", db.clips.size());
+  for (const ClipRange& c : db.clips()) mirrored += c.mirrored ? 1 : 0;
+  const long long searchable =
+      std::count(db.searchable().begin(), db.searchable().end(), uint8_t{1});
+  const double rate = db.frame_time() > 0.0f ? 1.0 / db.frame_time() : 0.0;
+  std::fprintf(out, "clips:       %zu", db.clips().size());
   if (mirrored) std::fprintf(out, " (%d of them mirrored)", mirrored);
-  std::fprintf(out, "\nframes:      %d at %.4g Hz (%.1f s, %.1f min)\n", db.frame_count, rate,
-               db.frame_count * static_cast<double>(db.frame_time),
-               db.frame_count * static_cast<double>(db.frame_time) / 60.0);
+  std::fprintf(out, "\nframes:      %d at %.4g Hz (%.1f s, %.1f min)\n", db.frame_count(), rate,
+               db.frame_count() * static_cast<double>(db.frame_time()),
+               db.frame_count() * static_cast<double>(db.frame_time()) / 60.0);
   std::fprintf(out, "searchable:  %lld frames (%.1f %%)\n", searchable,
-               db.frame_count ? 100.0 * searchable / db.frame_count : 0.0);
+               db.frame_count() ? 100.0 * searchable / db.frame_count() : 0.0);
   if (const int idle = find_idle_clip(db); idle >= 0) {
-    const ClipRange& clip = db.clips[static_cast<size_t>(idle)];
+    const ClipRange& clip = db.clips()[static_cast<size_t>(idle)];
     std::fprintf(out, "idle:        %d frames (%.1f s), clip %d", clip.frame_count(),
-                 clip.frame_count() * static_cast<double>(db.frame_time), idle);
+                 clip.frame_count() * static_cast<double>(db.frame_time()), idle);
     if (!idle_source.empty()) std::fprintf(out, ", holding %s", idle_source.c_str());
     std::fprintf(out, "\n");
   } else {
@@ -65,7 +66,7 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
     const uint64_t idle_tag = db.tag_mask(std::vector<std::string>{kIdleTag});
     int clips = 0;
     long long frames = 0;
-    for (const ClipRange& c : db.clips) {
+    for (const ClipRange& c : db.clips()) {
       if (!(c.tags & idle_tag)) continue;
       ++clips;
       frames += c.frame_count();
@@ -74,26 +75,26 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
       std::fprintf(out, "idle:        none\n");
     } else {
       std::fprintf(out, "idle:        %d clips of the data tagged idle, %lld frames (%.1f s)\n",
-                   clips, frames, frames * static_cast<double>(db.frame_time));
+                   clips, frames, frames * static_cast<double>(db.frame_time()));
     }
   }
   std::fprintf(out, "joints:      %d (joint 0 '%s')\n", db.joint_count(),
-               db.joint_count() ? db.skeleton.name(0).c_str() : "-");
-  print_joint_map(out, db.skeleton, db.roles);
+               db.joint_count() ? db.skeleton().name(0).c_str() : "-");
+  print_joint_map(out, db.skeleton(), db.roles());
   std::fprintf(out, "features:    %d dimensions in %zu channels:", db.feature_dims(),
-               db.schema.channels.size());
-  for (const FeatureChannel& c : db.schema.channels) std::fprintf(out, " %s", c.name.c_str());
-  std::fprintf(out, "\ntags:        %zu\n", db.tag_names.size());
-  for (size_t t = 0; t < db.tag_names.size() && t < 64; ++t) {
+               db.schema().channels.size());
+  for (const FeatureChannel& c : db.schema().channels) std::fprintf(out, " %s", c.name.c_str());
+  std::fprintf(out, "\ntags:        %zu\n", db.tag_names().size());
+  for (size_t t = 0; t < db.tag_names().size() && t < 64; ++t) {
     int clips = 0;
     long long frames = 0;
-    for (const ClipRange& c : db.clips) {
+    for (const ClipRange& c : db.clips()) {
       if (c.tags & (uint64_t{1} << t)) {
         ++clips;
         frames += c.frame_count();
       }
     }
-    std::fprintf(out, "  %-24s %5d clips %8lld frames\n", db.tag_names[t].c_str(), clips, frames);
+    std::fprintf(out, "  %-24s %5d clips %8lld frames\n", db.tag_names()[t].c_str(), clips, frames);
   }
   if (file_bytes > 0) std::fprintf(out, "file size:   %s\n", format_bytes(file_bytes).c_str());
 }
@@ -104,10 +105,10 @@ void print_feature_statistics(FILE* out, const Database& db) {
   const int dims = db.feature_dims();
   std::vector<double> sum(dims, 0.0), sum_squares(dims, 0.0);
   long long rows = 0;
-  for (int f = 0; f < db.frame_count; ++f) {
-    if (!db.searchable[f]) continue;
+  for (int f = 0; f < db.frame_count(); ++f) {
+    if (!db.searchable()[f]) continue;
     ++rows;
-    const float* row = db.features.data() + static_cast<size_t>(f) * dims;
+    const float* row = db.features().data() + static_cast<size_t>(f) * dims;
     for (int c = 0; c < dims; ++c) {
       sum[c] += row[c];
       sum_squares[c] += static_cast<double>(row[c]) * row[c];
@@ -117,9 +118,9 @@ void print_feature_statistics(FILE* out, const Database& db) {
                "feature statistics over the %lld searchable frames (group std = the channel's "
                "normalization deviation = scale * weight):\n",
                rows);
-  for (size_t i = 0; i < db.schema.channels.size(); ++i) {
-    const FeatureChannel& c = db.schema.channels[i];
-    const int first = db.schema.offset(static_cast<int>(i));
+  for (size_t i = 0; i < db.schema().channels.size(); ++i) {
+    const FeatureChannel& c = db.schema().channels[i];
+    const int first = db.schema().offset(static_cast<int>(i));
     std::string source;
     if (c.kind == FeatureKind::TrajectoryPosition || c.kind == FeatureKind::TrajectoryDirection) {
       source = "times";
@@ -132,20 +133,20 @@ void print_feature_statistics(FILE* out, const Database& db) {
     } else {
       source = "bone " + c.bone;
     }
-    const double group_std = static_cast<double>(db.feature_scale[first]) * c.weight;
+    const double group_std = static_cast<double>(db.feature_scale()[first]) * c.weight;
     std::fprintf(out, "  %-22s %-20s %-24s columns %2d-%2d  weight %-5g group std %.4f\n",
                  c.name.c_str(), kind_name(c.kind), source.c_str(), first, first + c.dims() - 1,
                  c.weight, group_std);
     std::fprintf(out, "      mean:");
     for (int k = first; k < first + c.dims(); ++k)
-      std::fprintf(out, " %8.4f", db.feature_offset[k]);
+      std::fprintf(out, " %8.4f", db.feature_offset()[k]);
     std::fprintf(out, "\n      std: ");
     for (int k = first; k < first + c.dims(); ++k) {
       double column_std = 0.0;
       if (rows > 0) {
         const double mean = sum[k] / rows;
         column_std =
-            std::sqrt(std::max(0.0, sum_squares[k] / rows - mean * mean)) * db.feature_scale[k];
+            std::sqrt(std::max(0.0, sum_squares[k] / rows - mean * mean)) * db.feature_scale()[k];
       }
       std::fprintf(out, " %8.4f", column_std);
     }

@@ -88,17 +88,17 @@ std::vector<Transform> database_clip_frames(const Database& db, const ClipRange&
     for (int j = 0; j < joints; ++j) {
       const size_t from = static_cast<size_t>(range.start + f) * joints + j;
       Transform& t = frames[static_cast<size_t>(f) * joints + j];
-      t.translation = db.local_positions[from];
-      t.rotation = db.local_rotations[from];
+      t.translation = db.local_positions()[from];
+      t.rotation = db.local_rotations()[from];
     }
   }
   return frames;
 }
 
 Status export_database_clip(const Database& db, size_t clip, const fs::path& out) {
-  const ClipRange& range = db.clips[clip];
+  const ClipRange& range = db.clips()[clip];
   const std::vector<Transform> frames = database_clip_frames(db, range);
-  return save_gltf(db.skeleton, frames, range.frame_count(), db.frame_time, range.name, out);
+  return save_gltf(db.skeleton(), frames, range.frame_count(), db.frame_time(), range.name, out);
 }
 
 // The clip with the generated body; says what was made and how long it took on stdout.
@@ -112,10 +112,10 @@ Status export_database_body(const Database& db, size_t clip, const CharacterBody
       "%s weights %.2f s\n",
       mesh.vertex_count(), mesh.triangle_count(), body->segments.size(), body->mesh_seconds,
       std::string(weight_method_name(options.weights.method)).c_str(), body->weight_seconds);
-  const ClipRange& range = db.clips[clip];
+  const ClipRange& range = db.clips()[clip];
   const std::vector<Transform> frames = database_clip_frames(db, range);
-  return save_skinned_gltf(db.skeleton, body->skinned, frames, range.frame_count(), db.frame_time,
-                           range.name, out);
+  return save_skinned_gltf(db.skeleton(), body->skinned, frames, range.frame_count(),
+                           db.frame_time(), range.name, out);
 }
 
 // The clip the arguments' --clip selects among `clips` (a database's or a glTF file's).
@@ -130,13 +130,13 @@ Result<size_t> select_clip_in(const Clips& clips, const Arguments& arguments) {
 Result<std::string> export_from_database(const Arguments& arguments) {
   Result<Database> db = load_database(arguments.input);
   if (!db) return Error{db.message()};
-  Result<size_t> clip = select_clip_in(db->clips, arguments);
+  Result<size_t> clip = select_clip_in(db->clips(), arguments);
   if (!clip) return Error{clip.message()};
   const Status written = arguments.with_body
                              ? export_database_body(*db, *clip, arguments.body, arguments.output)
                              : export_database_clip(*db, *clip, arguments.output);
   if (!written) return Error{written.message()};
-  const ClipRange& range = db->clips[*clip];
+  const ClipRange& range = db->clips()[*clip];
   return clip_description(range.name, range.frame_count(), db->joint_count()) +
          (arguments.with_body ? ", with the body" : "");
 }

@@ -15,11 +15,11 @@ namespace {
 
 void print_clips(const Database& db) {
   std::printf("clips:\n");
-  for (size_t c = 0; c < db.clips.size(); ++c) {
-    const ClipRange& clip = db.clips[c];
+  for (size_t c = 0; c < db.clips().size(); ++c) {
+    const ClipRange& clip = db.clips()[c];
     std::string tags;
-    for (size_t t = 0; t < db.tag_names.size() && t < 64; ++t) {
-      if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : " ") + db.tag_names[t];
+    for (size_t t = 0; t < db.tag_names().size() && t < 64; ++t) {
+      if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : " ") + db.tag_names()[t];
     }
     std::printf("  %4zu  %6d frames  %-48s %s\n", c, clip.frame_count(), clip.name.c_str(),
                 tags.c_str());

@@ -97,14 +97,16 @@ Result<Skeleton> skeleton_without_simulation_root(const Skeleton& s) {
 // Every database frame on that skeleton; the joints under joint 0 take on its transform.
 std::vector<Transform> frames_without_simulation_root(const Database& db) {
   const int joints = db.joint_count();
-  std::vector<Transform> local(static_cast<size_t>(db.frame_count) * (joints - 1));
-  for (int f = 0; f < db.frame_count; ++f) {
+  std::vector<Transform> local(static_cast<size_t>(db.frame_count()) * (joints - 1));
+  for (int f = 0; f < db.frame_count(); ++f) {
     const size_t row = static_cast<size_t>(f) * joints;
-    const Transform simulation{db.local_rotations[row], db.local_positions[row], glm::vec3(1.0f)};
+    const Transform simulation{db.local_rotations()[row], db.local_positions()[row],
+                               glm::vec3(1.0f)};
     for (int j = 1; j < joints; ++j) {
-      const Transform t{db.local_rotations[row + j], db.local_positions[row + j], glm::vec3(1.0f)};
+      const Transform t{db.local_rotations()[row + j], db.local_positions()[row + j],
+                        glm::vec3(1.0f)};
       local[static_cast<size_t>(f) * (joints - 1) + (j - 1)] =
-          db.skeleton.parent(j) == 0 ? compose(simulation, t) : t;
+          db.skeleton().parent(j) == 0 ? compose(simulation, t) : t;
     }
   }
   return local;
@@ -113,19 +115,19 @@ std::vector<Transform> frames_without_simulation_root(const Database& db) {
 Result<MotionFile> read_database(const std::string& path) {
   Result<Database> db = load_database(path);
   if (!db) return Error{db.message()};
-  Result<Skeleton> skeleton = skeleton_without_simulation_root(db->skeleton);
+  Result<Skeleton> skeleton = skeleton_without_simulation_root(db->skeleton());
   if (!skeleton) return Error{path + ": " + skeleton.message()};
   MotionFile file;
   file.clip.name = fs::path(path).stem().string();
   file.clip.source_path = path;
   file.clip.skeleton = std::move(skeleton).value();
-  file.clip.frame_time = db->frame_time;
-  file.clip.frame_count = db->frame_count;
+  file.clip.frame_time = db->frame_time();
+  file.clip.frame_count = db->frame_count();
   file.clip.local = frames_without_simulation_root(*db);
   file.rest_frame = std::max(bind_source_frame(*db), 0);
   JointRoleIndices roles;
   for (const JointRoleInfo& role : kJointRoles) {
-    const int j = db->roles.*role.index;
+    const int j = db->roles().*role.index;
     roles.*role.index = j > 0 ? j - 1 : -1;
   }
   file.stored_roles = roles;

@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -265,7 +266,7 @@ struct TimedMethod {
 
 // The data under test: a database file or synthetic rows, seen as a SearchInput.
 struct BenchData {
-  Database database;
+  std::optional<Database> database;
   std::unique_ptr<DatabaseSearchInput> database_input;
   SyntheticSearchData synthetic;
   SearchInput input;
@@ -294,7 +295,7 @@ int resolve_tags(const Arguments& arguments, BenchData& data) {
   for (const auto* names : {&arguments.include, &arguments.exclude}) {
     for (const std::string& name : *names) {
       const std::string one[] = {name};
-      const uint64_t bit = data.database.tag_mask(one);
+      const uint64_t bit = data.database->tag_mask(one);
       if (bit == 0) {
         std::fprintf(stderr, "mm search-bench: the database has no tag '%s'\n", name.c_str());
         return 2;
@@ -319,8 +320,8 @@ int load_data(const Arguments& arguments, BenchData& data) {
       std::fprintf(stderr, "mm search-bench: %s\n", loaded.message().c_str());
       return 1;
     }
-    data.database = std::move(loaded.value());
-    data.database_input = std::make_unique<DatabaseSearchInput>(data.database);
+    data.database.emplace(std::move(loaded).value());
+    data.database_input = std::make_unique<DatabaseSearchInput>(*data.database);
     data.input = data.database_input->input;
     data.source = arguments.db_path;
   }

@@ -20,7 +20,7 @@ std::string describe(const SkinnedMesh& mesh, const std::string& origin) {
 Result<BodySource> make_body(const Database& database, const ViewerOptions& options) {
   BodySource source;
   if (!options.body_path.empty()) {
-    Result<SkinnedMesh> loaded = load_body_gltf(options.body_path, database.skeleton);
+    Result<SkinnedMesh> loaded = load_body_gltf(options.body_path, database.skeleton());
     if (!loaded) return loaded.error();
     source.mesh = std::move(*loaded);
     source.description = describe(source.mesh, "body loaded from " + options.body_path);

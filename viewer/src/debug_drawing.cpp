@@ -53,9 +53,9 @@ void draw_roots(const Controller& controller, DebugLines& lines) {
 // the character's root frame.
 void draw_feature_row(const Database& db, const Transform& root, const float* row, int dims,
                       const glm::vec3& colour, DebugLines& lines) {
-  const FeatureSchema& schema = db.schema;
+  const FeatureSchema& schema = db.schema();
   auto raw = [&](int column) {
-    return row[column] * db.feature_scale[column] + db.feature_offset[column];
+    return row[column] * db.feature_scale()[column] + db.feature_offset()[column];
   };
   for (int c = 0; c < static_cast<int>(schema.channels.size()); ++c) {
     const FeatureChannel& channel = schema.channels[c];
@@ -109,7 +109,7 @@ void draw_features(const Controller& controller, DebugLines& lines) {
   const Database& db = controller.controller_database().database();
   const Transform& root = controller.root_transform();
   if (d.query_dims > 0) draw_feature_row(db, root, d.last_query, d.query_dims, kQuery, lines);
-  if (d.last_best_frame >= 0 && d.last_best_frame < db.frame_count) {
+  if (d.last_best_frame >= 0 && d.last_best_frame < db.frame_count()) {
     const std::span<const float> row = db.feature_row(d.last_best_frame);
     draw_feature_row(db, root, row.data(), static_cast<int>(row.size()), kMatch, lines);
   }
@@ -118,7 +118,7 @@ void draw_features(const Controller& controller, DebugLines& lines) {
 void draw_contacts(const Controller& controller, DebugLines& lines) {
   const ControllerDebug& d = controller.debug();
   const Database& db = controller.controller_database().database();
-  const int toes[2] = {db.roles.left_toe, db.roles.right_toe};
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
   const auto globals = controller.global_transforms();
   for (int side = 0; side < 2; ++side) {
     if (toes[side] < 0) continue;
@@ -140,7 +140,7 @@ void draw_controller_debug(const Controller& controller, const DebugToggles& tog
 }
 
 void draw_skeleton(const Controller& controller, DebugLines& lines) {
-  const Skeleton& skeleton = controller.controller_database().database().skeleton;
+  const Skeleton& skeleton = controller.controller_database().database().skeleton();
   const auto globals = controller.global_transforms();
   // Joint 0 is the simulation root on the ground, and a source root the controller plays at
   // joint 0 (Bandai's joint_Root) sits there too: their links to the hips are not bones.

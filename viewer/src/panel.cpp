@@ -26,13 +26,13 @@ void timings(const Scene& scene, const PanelState& state) {
 void playback(const Scene& scene) {
   const ControllerDebug& d = scene.controller().debug();
   const Database& db = scene.database();
-  if (d.clip < 0 || d.clip >= static_cast<int>(db.clips.size())) return;
-  const ClipRange& clip = db.clips[d.clip];
+  if (d.clip < 0 || d.clip >= static_cast<int>(db.clips().size())) return;
+  const ClipRange& clip = db.clips()[d.clip];
   ImGui::Text("clip %s", clip.name.c_str());
   ImGui::Text("frame %d (%.2f s into the clip)", d.frame, d.clip_time);
   std::string tags;
-  for (size_t t = 0; t < db.tag_names.size(); ++t) {
-    if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : ", ") + db.tag_names[t];
+  for (size_t t = 0; t < db.tag_names().size(); ++t) {
+    if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : ", ") + db.tag_names()[t];
   }
   ImGui::Text("tags: %s", tags.empty() ? "-" : tags.c_str());
   ImGui::Text("transitions %d   searches %d   %s", d.transitions, d.searches,
@@ -41,7 +41,7 @@ void playback(const Scene& scene) {
 
 void last_search(const Scene& scene) {
   const ControllerDebug& d = scene.controller().debug();
-  const FeatureSchema& schema = scene.database().schema;
+  const FeatureSchema& schema = scene.database().schema();
   ImGui::Text("cost %.3f (best frame %d)", d.last_cost, d.last_best_frame);
   float largest = 1e-6f;
   for (int c = 0; c < d.channel_count; ++c) largest = std::max(largest, d.last_channel_costs[c]);
@@ -86,7 +86,7 @@ void settings(Scene& scene, PanelState& state) {
 }
 
 void feature_weights(Scene& scene, PanelState& state) {
-  const FeatureSchema& schema = scene.database().schema;
+  const FeatureSchema& schema = scene.database().schema();
   ImGui::TextWrapped(
       "A new weight rebuilds the normalized features and the search, and starts "
       "the character again where it stands.");

@@ -72,7 +72,7 @@ void Scene::record_sample() {
   s.character = root.translation;
   const glm::vec3 forward = root.rotation * glm::vec3(0.0f, 0.0f, 1.0f);
   s.character_facing = glm::vec2(forward.x, forward.z);
-  const int toes[2] = {database_->roles.left_toe, database_->roles.right_toe};
+  const int toes[2] = {database_->roles().left_toe, database_->roles().right_toe};
   for (int side = 0; side < 2; ++side) {
     if (toes[side] >= 0) s.toes[side] = controller_->global_transforms()[toes[side]].translation;
     s.contact[side] = d.contact[side];
@@ -125,7 +125,7 @@ Status Scene::apply_settings(const ControllerSettings& settings) {
 }
 
 Status Scene::set_channel_weight(int channel, float weight) {
-  const FeatureSchema& schema = database_->schema;
+  const FeatureSchema& schema = database_->schema();
   if (channel < 0 || channel >= static_cast<int>(schema.channels.size())) {
     return Error{"viewer: no feature channel " + std::to_string(channel)};
   }
@@ -133,18 +133,21 @@ Status Scene::set_channel_weight(int channel, float weight) {
     return Error{"viewer: a feature weight must be finite and > 0"};
   }
   // features = (raw - offset) / (std / weight): a new weight rescales the channel's columns.
-  auto reweighted = std::make_shared<Database>(*database_);
-  const float ratio = weight / reweighted->schema.channels[channel].weight;
-  reweighted->schema.channels[channel].weight = weight;
+  DatabaseContents contents = database_->contents();
+  const float ratio = weight / contents.schema.channels[channel].weight;
+  contents.schema.channels[channel].weight = weight;
   const int first = schema.offset(channel);
   const int dims = schema.dims();
   const int count = schema.channels[channel].dims();
   for (int c = first; c < first + count; ++c) {
-    reweighted->feature_scale[c] /= ratio;
-    for (int f = 0; f < reweighted->frame_count; ++f) {
-      reweighted->features[static_cast<size_t>(f) * dims + c] *= ratio;
+    contents.feature_scale[c] /= ratio;
+    for (int f = 0; f < contents.frame_count; ++f) {
+      contents.features[static_cast<size_t>(f) * dims + c] *= ratio;
     }
   }
+  Result<Database> created = Database::create(contents);
+  if (!created) return Error{created.message()};
+  auto reweighted = std::make_shared<const Database>(std::move(created).value());
   Result<std::shared_ptr<const ControllerDatabase>> shared =
       ControllerDatabase::create(reweighted, shared_->options());
   if (!shared) return Error{shared.message()};

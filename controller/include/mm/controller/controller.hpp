@@ -299,7 +299,7 @@ struct ControllerDebug {
   glm::vec3 desired_positions[kMaxTrajectoryPoints] = {};
 
   // Playback.
-  int clip = -1;              // index into database().clips
+  int clip = -1;              // index into database().clips()
   int frame = -1;             // the database frame nearest the playback time
   float clip_time = 0.0f;     // seconds since the clip's first frame
   bool transitioned = false;  // this update jumped to a new frame

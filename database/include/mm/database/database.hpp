@@ -1,14 +1,18 @@
 #pragma once
 // The motion database: every clip resampled to one rate, expressed relative to a simulation
 // root (joint 0), with velocities, foot contacts, clip ranges and tags, and the normalized
-// feature matrix the search runs over. Built by the builder (builder.hpp), saved and loaded as
-// one versioned binary file (database_file.hpp).
+// feature matrix the search runs over.
+//
+// A game holds a Database: immutable, made only by loading a file (database_file.hpp) or by
+// Database::create(), the builder's last step (mm/offline/builder.hpp), both of which validate
+// it. Its per-frame arrays live in one allocation and are read through spans. What builds one
+// fills a DatabaseContents (plain vectors); what reads either takes a DatabaseView.
 
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -16,6 +20,7 @@
 
 #include "mm/database/features.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "mm/runtime/result.hpp"
 #include "mm/runtime/skeleton.hpp"
 
 namespace mm {
@@ -31,40 +36,10 @@ struct ClipRange {
   int frame_count() const { return end - start; }
 };
 
-namespace detail {
-// Set only while the builder or the loader sizes arrays it is about to fill completely
-// (detail::resize_large): value-initializing ~200 MB first would write every byte twice.
-inline thread_local bool skip_value_initialization = false;
-}  // namespace detail
-
-// std::allocator, except that while detail::skip_value_initialization is set, a value-initialized
-// element (resize(n), vector(n)) is left unwritten. Every other use behaves as std::allocator.
-template <class T>
-struct FrameAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = FrameAllocator<U>;
-  };
-  FrameAllocator() = default;
-  template <class U>
-  FrameAllocator(const FrameAllocator<U>&) noexcept {}
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    // GLM's vectors and quaternions are plain floats (with GLM_FORCE_CTOR_INIT their
-    // constructors only zero them, so they do not count as trivially copyable).
-    if constexpr (sizeof...(Args) == 0 && std::is_standard_layout_v<U> &&
-                  std::is_trivially_destructible_v<U>) {
-      if (detail::skip_value_initialization) return;
-    }
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-
-// The per-frame arrays of the database: a std::vector with that allocator.
-template <class T>
-using FrameArray = std::vector<T, FrameAllocator<T>>;
-
-struct Database {
+// Everything a database holds, as plain vectors: what the builder (and a test) fills before
+// Database::create() checks it and packs it. The fields mean what Database's accessors of the
+// same names return.
+struct DatabaseContents {
   // Joint 0 is the simulation root (hips projected on the ground, smoothed facing); the source
   // skeleton's joints follow it, depth-first. Rest transforms are the first clip's.
   Skeleton skeleton;
@@ -74,39 +49,184 @@ struct Database {
 
   // Per-frame, per-joint arrays, frame-major: [frame * joint_count + joint]. Local to the
   // parent; joint 0's values are relative to the world (its clip's origin).
-  FrameArray<glm::vec3> local_positions;           // metres
-  FrameArray<glm::quat> local_rotations;           // unit
-  FrameArray<glm::vec3> local_velocities;          // metres / second, in the parent's frame
-  FrameArray<glm::vec3> local_angular_velocities;  // radians / second, in the parent's frame
+  std::vector<glm::vec3> local_positions;           // metres
+  std::vector<glm::quat> local_rotations;           // unit
+  std::vector<glm::vec3> local_velocities;          // metres / second, in the parent's frame
+  std::vector<glm::vec3> local_angular_velocities;  // radians / second, in the parent's frame
   // Per-frame foot contacts: [frame * 2 + 0] left, [frame * 2 + 1] right; 1 = in contact.
   std::vector<uint8_t> contacts;
 
-  std::vector<ClipRange> clips;
+  std::vector<ClipRange> clips;        // tile [0, frame_count) in order
   std::vector<std::string> tag_names;  // at most 64
 
   // The feature matrix: frame_count rows of schema.dims() floats, row-major, normalized:
   // features[f * dims + c] = (raw - feature_offset[c]) / feature_scale[c]. The plain squared
   // Euclidean distance between rows is the weighted distance the search minimizes.
   FeatureSchema schema;
-  FrameArray<float> features;
+  std::vector<float> features;
   std::vector<float> feature_offset;  // dims: per-column mean
   std::vector<float> feature_scale;   // dims: group standard deviation / weight (never 0)
   // 1 when the frame may be matched: every feature time of the frame lies inside its clip.
   std::vector<uint8_t> searchable;
-  // Clip index of every frame (derived from clips on build and load).
-  std::vector<int> frame_clip;
+
+  int joint_count() const { return skeleton.joint_count(); }
+  int feature_dims() const { return schema.dims(); }
+};
+
+class Database;
+
+// A read-only view of a database, a Database or a DatabaseContents alike (it converts from
+// both), for code that reads either: validation, the idle search, the generated body. Valid
+// while what it views lives and is not changed. frame_clip is empty for a DatabaseContents.
+struct DatabaseView {
+  DatabaseView(const Database& db);          // NOLINT: implicit, as a span from a vector
+  DatabaseView(const DatabaseContents& db);  // NOLINT
+
+  const Skeleton& skeleton;
+  const JointRoleIndices& roles;
+  float frame_time;
+  int frame_count;
+  std::span<const glm::vec3> local_positions;
+  std::span<const glm::quat> local_rotations;
+  std::span<const glm::vec3> local_velocities;
+  std::span<const glm::vec3> local_angular_velocities;
+  std::span<const uint8_t> contacts;
+  std::span<const ClipRange> clips;
+  std::span<const std::string> tag_names;
+  const FeatureSchema& schema;
+  std::span<const float> features;
+  std::span<const float> feature_offset;
+  std::span<const float> feature_scale;
+  std::span<const uint8_t> searchable;
+  std::span<const int> frame_clip;
 
   int joint_count() const { return skeleton.joint_count(); }
   int feature_dims() const { return schema.dims(); }
   std::span<const float> feature_row(int frame) const {
     const size_t d = static_cast<size_t>(feature_dims());
-    return {features.data() + frame * d, d};
+    return features.subspan(static_cast<size_t>(frame) * d, d);
+  }
+  uint64_t tag_mask(std::span<const std::string> names) const;
+};
+
+// The per-frame arrays of a database being made, writable, with what writing them reads: what
+// the build side's writers (a range's features, the idle clip) take, over a DatabaseContents'
+// vectors (it converts) or over the builder's new database.
+struct DatabaseFill {
+  DatabaseFill(DatabaseContents& db);  // NOLINT: implicit, as a span from a vector
+  DatabaseFill(const DatabaseView& read, std::span<glm::vec3> local_positions,
+               std::span<glm::quat> local_rotations, std::span<glm::vec3> local_velocities,
+               std::span<glm::vec3> local_angular_velocities, std::span<uint8_t> contacts,
+               std::span<float> features, std::span<uint8_t> searchable);
+
+  const Skeleton& skeleton;
+  const FeatureSchema& schema;
+  float frame_time;
+  int frame_count;
+  std::span<glm::vec3> local_positions;
+  std::span<glm::quat> local_rotations;
+  std::span<glm::vec3> local_velocities;
+  std::span<glm::vec3> local_angular_velocities;
+  std::span<uint8_t> contacts;
+  std::span<float> features;
+  std::span<uint8_t> searchable;
+
+  int joint_count() const { return skeleton.joint_count(); }
+};
+
+namespace detail {
+// Fills a database in place: the file loader and the builder, the two ways a Database is made
+// from raw data (database/internal/, never installed).
+class DatabaseAssembly;
+}  // namespace detail
+
+class Database {
+ public:
+  // The builder's last step: checks `contents` (validate()) and copies it into a database,
+  // its per-frame arrays in one allocation; frame_clip is derived from the clips.
+  static Result<Database> create(const DatabaseContents& contents);
+
+  Database(Database&& other) noexcept;
+  Database& operator=(Database&& other) noexcept;
+  Database(const Database&) = delete;  // one copy of the frames; share it (shared_ptr)
+  Database& operator=(const Database&) = delete;
+  ~Database() = default;
+
+  // A copy of everything as plain vectors, to change and create() again (tools, tests).
+  DatabaseContents contents() const;
+  DatabaseView view() const { return *this; }
+
+  const Skeleton& skeleton() const { return skeleton_; }
+  const JointRoleIndices& roles() const { return roles_; }
+  float frame_time() const { return frame_time_; }  // seconds
+  int frame_count() const { return frame_count_; }
+  int joint_count() const { return skeleton_.joint_count(); }
+
+  // DatabaseContents' arrays of the same names.
+  std::span<const glm::vec3> local_positions() const { return local_positions_; }
+  std::span<const glm::quat> local_rotations() const { return local_rotations_; }
+  std::span<const glm::vec3> local_velocities() const { return local_velocities_; }
+  std::span<const glm::vec3> local_angular_velocities() const { return local_angular_velocities_; }
+  std::span<const uint8_t> contacts() const { return contacts_; }
+  std::span<const ClipRange> clips() const { return clips_; }
+  std::span<const std::string> tag_names() const { return tag_names_; }
+
+  const FeatureSchema& schema() const { return schema_; }
+  int feature_dims() const { return schema_.dims(); }
+  std::span<const float> features() const { return features_; }
+  std::span<const float> feature_offset() const { return feature_offset_; }
+  std::span<const float> feature_scale() const { return feature_scale_; }
+  std::span<const uint8_t> searchable() const { return searchable_; }
+  // Clip index of every frame.
+  std::span<const int> frame_clip() const { return frame_clip_; }
+
+  std::span<const float> feature_row(int frame) const {
+    const size_t d = static_cast<size_t>(feature_dims());
+    return features_.subspan(static_cast<size_t>(frame) * d, d);
   }
   // Bit mask of the named tags (unknown names give no bits), for search filters.
   uint64_t tag_mask(std::span<const std::string> names) const;
-  // Consistency of sizes and indices between all the arrays above.
+  // Consistency of sizes and indices between all the arrays, and their values (finite, unit
+  // rotations, boolean flags). A created or loaded database always passes.
   Status validate() const;
+
+ private:
+  friend class detail::DatabaseAssembly;
+  Database() = default;
+  // Sizes the per-frame arrays (one allocation, huge pages where the system has them, the
+  // values left unwritten for the caller to fill).
+  void allocate(size_t frames, size_t joints, size_t dims);
+  // Keeps the first `frames` frames of every per-frame array (no reallocation).
+  void keep_frames(size_t frames);
+  // Fills frame_clip from the clips (which tile the frames).
+  void derive_frame_clip();
+
+  struct FreeBlock {
+    void operator()(std::byte* block) const;
+  };
+
+  Skeleton skeleton_;
+  JointRoleIndices roles_;
+  float frame_time_ = 1.0f / 30.0f;
+  int frame_count_ = 0;
+  std::vector<ClipRange> clips_;
+  std::vector<std::string> tag_names_;
+  FeatureSchema schema_;
+  std::unique_ptr<std::byte[], FreeBlock> block_;
+  std::span<glm::vec3> local_positions_;
+  std::span<glm::quat> local_rotations_;
+  std::span<glm::vec3> local_velocities_;
+  std::span<glm::vec3> local_angular_velocities_;
+  std::span<uint8_t> contacts_;
+  std::span<float> features_;
+  std::span<float> feature_offset_;
+  std::span<float> feature_scale_;
+  std::span<uint8_t> searchable_;
+  std::span<int> frame_clip_;
 };
+
+// Checks of a database being built or loaded: the whole of Database::validate().
+Status validate_database(const DatabaseView& db);
 
 // The name and the tag of the idle clip the builder synthesizes (mm/offline/idle.hpp).
 inline constexpr const char* kIdleClipName = "idle";
@@ -114,10 +234,10 @@ inline constexpr const char* kIdleTag = "idle";
 
 // True for that clip: named kIdleClipName, tagged kIdleTag, not mirrored. (A source file that
 // happens to be called "idle.bvh" carries no such tag.)
-bool is_idle_clip(const Database& db, const ClipRange& clip);
+bool is_idle_clip(const DatabaseView& db, const ClipRange& clip);
 
 // Index of the last clip is_idle_clip accepts, -1 when there is none.
-int find_idle_clip(const Database& db);
+int find_idle_clip(const DatabaseView& db);
 
 // The clip checks of Database::validate() on their own: the clips are named, tile
 // [0, frame_count) in order and carry only the bits of `tag_count` tags. The file loader runs

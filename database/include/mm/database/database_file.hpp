@@ -148,7 +148,7 @@ uint64_t database_checksum(std::span<const std::byte> bytes);
 // The exact bytes of the file save_database() writes. Writes whatever the arrays hold (an
 // inconsistent database gives a file that load refuses); does not validate. The velocities and
 // angular velocities are not written: load recomputes them from the poses.
-std::vector<std::byte> serialize_database(const Database& db);
+std::vector<std::byte> serialize_database(const DatabaseView& db);
 
 // Parses and checks the header of a file image (magic, endianness, version, header and total
 // sizes, section table against the counts). `name_for_messages` prefixes every message. Does not
@@ -164,7 +164,7 @@ Result<Database> deserialize_database(std::span<const std::byte> bytes,
 
 // Validates the database, then writes it to `path` through a temporary file in the same folder
 // renamed into place, so a failed write never leaves a half-written database behind.
-Status save_database(const Database& db, const std::filesystem::path& path);
+Status save_database(const DatabaseView& db, const std::filesystem::path& path);
 
 // Reads the whole file (memory-mapped when possible) and deserializes it. Messages name the path.
 Result<Database> load_database(const std::filesystem::path& path);

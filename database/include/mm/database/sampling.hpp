@@ -19,14 +19,14 @@ inline Transform sample_database_joint(const Database& db, int frame0, int frame
   const size_t k0 = static_cast<size_t>(frame0) * joints + joint;
   const size_t k1 = static_cast<size_t>(frame1) * joints + joint;
   Transform t0, t1;
-  t0.rotation = db.local_rotations[k0];
-  t0.translation = db.local_positions[k0];
-  t1.rotation = db.local_rotations[k1];
-  t1.translation = db.local_positions[k1];
+  t0.rotation = db.local_rotations()[k0];
+  t0.translation = db.local_positions()[k0];
+  t1.rotation = db.local_rotations()[k1];
+  t1.translation = db.local_positions()[k1];
   if (cubic && frame1 != frame0) {
-    return transform_hermite(t0, db.local_velocities[k0], db.local_angular_velocities[k0], t1,
-                             db.local_velocities[k1], db.local_angular_velocities[k1],
-                             db.frame_time, weight);
+    return transform_hermite(t0, db.local_velocities()[k0], db.local_angular_velocities()[k0], t1,
+                             db.local_velocities()[k1], db.local_angular_velocities()[k1],
+                             db.frame_time(), weight);
   }
   return interpolate(t0, t1, weight, method);
 }

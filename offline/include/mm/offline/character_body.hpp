@@ -68,7 +68,7 @@ struct CharacterBody {
 
 // The database frame the bind pose starts from: the idle clip's first frame, else the calmest
 // standing frame (find_calmest_standing_frame), else frame 0; -1 for an empty database.
-int bind_source_frame(const Database& db);
+int bind_source_frame(const DatabaseView& db);
 
 // The bind pose (phase 1 above) from any pose of the skeleton (local transforms, one per
 // joint). Limbs are found from the roles: the legs are the chains from the hips to each foot,
@@ -94,7 +94,7 @@ Result<CharacterBody> build_character_body(const Skeleton& skeleton,
                                            const CharacterBodyOptions& options = {});
 
 // The body of a database's character: make_bind_pose of bind_source_frame, then the above.
-Result<CharacterBody> build_character_body(const Database& db,
+Result<CharacterBody> build_character_body(const DatabaseView& db,
                                            const CharacterBodyOptions& options = {});
 
 // Loads a skinned glTF body (load_gltf with read_skinned_mesh) and maps its joints onto

@@ -81,7 +81,7 @@ void extract_clip_features(const FeatureSchema& schema, std::span<const int> cha
 
 // Extracts one clip range of a database in place: reads its motion arrays, writes its raw
 // (un-normalized) rows of db.features and its db.searchable flags. Arrays must be sized.
-void extract_range_features(Database& db, const ClipRange& range,
+void extract_range_features(const DatabaseFill& db, const ClipRange& range,
                             std::span<const int> channel_bones, FeatureScratch& scratch);
 
 // Per-column offsets and scales that normalize a feature matrix, and warnings for channels
@@ -117,6 +117,7 @@ void denormalize_features(std::span<float> rows, std::span<const float> offset,
 // Recomputes db.features, db.feature_offset, db.feature_scale and db.searchable from the
 // motion arrays, clip ranges, roles and db.schema (e.g. after changing weights). Warnings from
 // the normalization are appended to `warnings` when given.
-Status compute_database_features(Database& db, std::vector<std::string>* warnings = nullptr);
+Status compute_database_features(DatabaseContents& db,
+                                 std::vector<std::string>* warnings = nullptr);
 
 }  // namespace mm

@@ -55,11 +55,11 @@ struct IdleSourceSearch {
 };
 
 // The motion energy of one frame (see the top of this file).
-double idle_motion_energy(const Database& db, int frame);
+double idle_motion_energy(const DatabaseView& db, int frame);
 
 // Horizontal distance in metres between the left_foot and right_foot roles' global positions
 // on one frame; infinity when the database lacks either role.
-float horizontal_feet_distance(const Database& db, int frame);
+float horizontal_feet_distance(const DatabaseView& db, int frame);
 
 // The joints the arm check looks at: the two hand roles (or, without hands, the lower arms,
 // whose ends are the wrists) when the joint map has both sides; otherwise the leaves of the
@@ -71,14 +71,14 @@ std::vector<int> arm_end_joints(const Skeleton& skeleton, const JointRoleIndices
 // How far in metres the highest arm end of one frame is above the hips (negative: below), a
 // lower arm above two thirds of the way from the hips to its upper arm; minus infinity when
 // there are no arm ends.
-float highest_arm_end_over_hips(const Database& db, int frame);
+float highest_arm_end_over_hips(const DatabaseView& db, int frame);
 
 // The calmest standing frame and the candidate counts. Reads the motion arrays, contacts,
 // clips and roles; deterministic (one pass in frame order).
-IdleSourceSearch search_idle_source(const Database& db, const IdleCriteria& criteria = {});
+IdleSourceSearch search_idle_source(const DatabaseView& db, const IdleCriteria& criteria = {});
 
 // search_idle_source(db, criteria).frame: the calmest standing frame, -1 when none qualifies.
-int find_calmest_standing_frame(const Database& db, const IdleCriteria& criteria = {});
+int find_calmest_standing_frame(const DatabaseView& db, const IdleCriteria& criteria = {});
 
 // A sentence saying why `search` found no frame ("no frame stands with both feet in contact",
 // ...), for the builder's warning; empty when it found one.
@@ -90,7 +90,7 @@ std::string idle_search_failure(const IdleSourceSearch& search, const IdleCriter
 // root already, so the pose stands on the ground exactly as captured), every velocity and
 // angular velocity zero, both contacts 1. The source frame must lie outside `range`. Features,
 // searchable flags and frame_clip are the caller's (extract_range_features).
-void fill_idle_clip(Database& db, const ClipRange& range, int source_frame);
+void fill_idle_clip(const DatabaseFill& db, const ClipRange& range, int source_frame);
 
 // ---- Idle clips of the data -------------------------------------------------------------
 
