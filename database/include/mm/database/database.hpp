@@ -3,10 +3,11 @@
 // root (joint 0), with velocities, foot contacts, clip ranges and tags, and the normalized
 // feature matrix the search runs over.
 //
-// A game holds a Database: immutable, made only by loading a file (database_file.hpp) or by
-// Database::create(), the builder's last step (mm/offline/builder.hpp), both of which validate
-// it. Its per-frame arrays live in one allocation and are read through spans. What builds one
-// fills a DatabaseContents (plain vectors); what reads either takes a DatabaseView.
+// A game holds a Database: immutable, made only by loading a file (database_file.hpp) or by the
+// builder (mm/offline/builder.hpp), both of which fill it in place and validate it. Its
+// per-frame arrays live in one allocation and are read through spans. Anything else that makes
+// one (a test, a tool changing one) fills a DatabaseContents (plain vectors) and calls
+// Database::create(). Code that reads either takes a DatabaseView.
 
 #include <cstddef>
 #include <cstdint>
@@ -31,7 +32,7 @@ struct ClipRange {
   std::string name;   // source file stem; mirrored copies end in "_mirror"
   int start = 0;      // first database frame of the clip
   int end = 0;        // one past the last frame
-  uint64_t tags = 0;  // bit i set when the clip carries Database::tag_names[i]
+  uint64_t tags = 0;  // bit i set when the clip carries the database's tag name i
   bool mirrored = false;
   int frame_count() const { return end - start; }
 };
@@ -142,8 +143,8 @@ class DatabaseAssembly;
 
 class Database {
  public:
-  // The builder's last step: checks `contents` (validate()) and copies it into a database,
-  // its per-frame arrays in one allocation; frame_clip is derived from the clips.
+  // Checks `contents` (validate()) and copies it into a database, its per-frame arrays in one
+  // allocation; frame_clip is derived from the clips.
   static Result<Database> create(const DatabaseContents& contents);
 
   Database(Database&& other) noexcept;
