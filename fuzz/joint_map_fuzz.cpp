@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "fuzz_checks.hpp"
-#include "mm/database/joint_roles.hpp"
+#include "mm/offline/joint_map.hpp"
 
 namespace {
 
