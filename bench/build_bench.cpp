@@ -29,6 +29,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/offline/builder.hpp"
 #include "mm/offline/bvh.hpp"
+#include "mm/offline/database_writer.hpp"
 
 namespace {
 

@@ -24,6 +24,7 @@
 
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/offline/database_writer.hpp"
 
 namespace {
 

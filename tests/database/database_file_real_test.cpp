@@ -15,6 +15,7 @@
 #include "database_helpers.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/offline/builder.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "mm/offline/preprocess.hpp"
 #include "test_support.hpp"
 

@@ -12,6 +12,7 @@
 #include "mm/database/database.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/database/velocities.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "test_support.hpp"
 
 namespace mm {

@@ -16,6 +16,7 @@
 #include "mm/database/database_file.hpp"
 #include "mm/offline/builder.hpp"
 #include "mm/offline/bvh.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "mm/offline/feature_extraction.hpp"
 #include "mm/offline/gltf.hpp"
 #include "mm/offline/idle.hpp"

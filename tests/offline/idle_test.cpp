@@ -17,6 +17,7 @@
 #include "database_helpers.hpp"
 #include "mm/database/database_file.hpp"
 #include "mm/offline/builder.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "mm/offline/feature_extraction.hpp"
 #include "mm/offline/idle.hpp"
 #include "mm/offline/preprocess.hpp"

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "database_helpers.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "normal_database.hpp"
 
 namespace mm {

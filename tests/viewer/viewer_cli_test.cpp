@@ -17,6 +17,7 @@
 
 #include "mm/controller/script.hpp"
 #include "mm/database/database_file.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "normal_database.hpp"
 #include "test_support.hpp"
 

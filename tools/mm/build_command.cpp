@@ -16,6 +16,7 @@
 #include "mm/database/files.hpp"
 #include "mm/database/joint_roles.hpp"
 #include "mm/offline/builder.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "mm/programs/command_line.hpp"
 #include "mm/programs/number_parsing.hpp"
 #include "mm/programs/progress_bar.hpp"

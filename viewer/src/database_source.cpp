@@ -8,6 +8,7 @@
 
 #include "mm/database/database_file.hpp"
 #include "mm/offline/builder.hpp"
+#include "mm/offline/database_writer.hpp"
 #include "mm/programs/progress_bar.hpp"
 
 namespace mm::viewer {

@@ -1,5 +1,6 @@
 #pragma once
-// The database file: one relocatable binary blob written and read by one call each. Loading
+// The database file: one relocatable binary blob written and read by one call each (the writer,
+// save_database(), is on the build side: mm/offline/database_writer.hpp). Loading
 // trusts nothing: the magic, version, endianness, sizes, every section's place, every count and
 // string length, a 64-bit checksum over the whole file and finally Database::validate() are all
 // checked, and any failure comes back as a message naming the file, the section and the index.
@@ -145,11 +146,6 @@ struct DatabaseFileInfo {
 // 8-byte word is always detected.
 uint64_t database_checksum(std::span<const std::byte> bytes);
 
-// The exact bytes of the file save_database() writes. Writes whatever the arrays hold (an
-// inconsistent database gives a file that load refuses); does not validate. The velocities and
-// angular velocities are not written: load recomputes them from the poses.
-std::vector<std::byte> serialize_database(const DatabaseView& db);
-
 // Parses and checks the header of a file image (magic, endianness, version, header and total
 // sizes, section table against the counts). `name_for_messages` prefixes every message. Does not
 // verify the checksum; `stored_checksum` is filled when the image is complete.
@@ -161,10 +157,6 @@ Result<DatabaseFileInfo> parse_database_header(std::span<const std::byte> bytes,
 // checking it against the bytes.
 Result<Database> deserialize_database(std::span<const std::byte> bytes,
                                       std::string_view name_for_messages);
-
-// Validates the database, then writes it to `path` through a temporary file in the same folder
-// renamed into place, so a failed write never leaves a half-written database behind.
-Status save_database(const DatabaseView& db, const std::filesystem::path& path);
 
 // Reads the whole file (memory-mapped when possible) and deserializes it. Messages name the path.
 Result<Database> load_database(const std::filesystem::path& path);

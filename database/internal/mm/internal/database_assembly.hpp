@@ -40,12 +40,22 @@ class DatabaseAssembly {
   // A database with nothing in it, to fill.
   static Database empty() { return Database(); }
   static Parts parts(Database& db) {
-    return {db.skeleton_,         db.roles_,           db.frame_time_,
-            db.frame_count_,      db.clips_,           db.tag_names_,
-            db.schema_,           db.local_positions_, db.local_rotations_,
-            db.local_velocities_, db.local_angular_velocities_,
-            db.contacts_,         db.features_,        db.feature_offset_,
-            db.feature_scale_,    db.searchable_};
+    return {db.skeleton_,
+            db.roles_,
+            db.frame_time_,
+            db.frame_count_,
+            db.clips_,
+            db.tag_names_,
+            db.schema_,
+            db.local_positions_,
+            db.local_rotations_,
+            db.local_velocities_,
+            db.local_angular_velocities_,
+            db.contacts_,
+            db.features_,
+            db.feature_offset_,
+            db.feature_scale_,
+            db.searchable_};
   }
   // The per-frame arrays for `frames` frames of the skeleton's joints and the schema's columns,
   // their values unwritten: the caller writes every one.
@@ -61,8 +71,7 @@ class DatabaseAssembly {
   // The per-frame arrays, writable, for the build side's writers.
   static DatabaseFill fill(Database& db) {
     return DatabaseFill(db, db.local_positions_, db.local_rotations_, db.local_velocities_,
-                        db.local_angular_velocities_, db.contacts_, db.features_,
-                        db.searchable_);
+                        db.local_angular_velocities_, db.contacts_, db.features_, db.searchable_);
   }
 };
 
