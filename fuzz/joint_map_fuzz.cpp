@@ -3,7 +3,7 @@
 // - a refusal reads "fuzz.map:<line>: <what is wrong>";
 // - an accepted map assigns only roles of kJointRoles, each once, to non-empty joint names
 //   without surrounding spaces, with a line number in the text and the file as source.
-// Seeds: maps like the ones docs/your-own-data.md and tests/database/joint_roles_test.cpp show
+// Seeds: maps like the ones docs/your-own-data.md and tests/offline/joint_roles_test.cpp show
 // (written into the corpus by fuzz/CMakeLists.txt).
 //
 // Run: scripts/fuzz.sh, or cmake --build build/fuzz --target fuzz_run_joint_map.

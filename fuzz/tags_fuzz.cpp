@@ -4,7 +4,7 @@
 // - an accepted manifest's rules each have a glob, at least one tag of letters, digits and
 //   "_-.:+", and a line number in the text; matching them against clip names (clip_tags,
 //   glob_match, mirrored or not) gives sorted tags without duplicates.
-// Seeds: manifests like the ones tests/database/tags_test.cpp reads (written into the corpus
+// Seeds: manifests like the ones tests/offline/tags_test.cpp reads (written into the corpus
 // by fuzz/CMakeLists.txt).
 //
 // Run: scripts/fuzz.sh, or cmake --build build/fuzz --target fuzz_run_tags.
