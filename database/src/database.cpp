@@ -344,8 +344,8 @@ void Database::allocate(size_t frames, size_t joints, size_t dims) {
 
 void Database::keep_frames(size_t frames) {
   MM_ASSERT(frames <= frame_clip_.size());
-  const size_t joints = local_positions_.size() / std::max<size_t>(frame_clip_.size(), 1);
-  const size_t dims = features_.size() / std::max<size_t>(frame_clip_.size(), 1);
+  const size_t joints = static_cast<size_t>(joint_count());
+  const size_t dims = static_cast<size_t>(feature_dims());
   frame_count_ = static_cast<int>(frames);
   local_positions_ = local_positions_.first(frames * joints);
   local_rotations_ = local_rotations_.first(frames * joints);
@@ -416,9 +416,11 @@ DatabaseContents Database::contents() const {
 }
 
 bool is_idle_clip(const DatabaseView& db, const ClipRange& clip) {
-  const std::string tag = kIdleTag;
-  return clip.name == kIdleClipName && !clip.mirrored &&
-         (clip.tags & db.tag_mask(std::span(&tag, 1))) != 0;
+  if (clip.name != kIdleClipName || clip.mirrored) return false;
+  for (size_t t = 0; t < db.tag_names.size() && t < 64; ++t) {
+    if (db.tag_names[t] == kIdleTag) return ((clip.tags >> t) & 1u) != 0;
+  }
+  return false;
 }
 
 int find_idle_clip(const DatabaseView& db) {

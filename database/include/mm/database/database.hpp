@@ -155,7 +155,6 @@ class Database {
 
   // A copy of everything as plain vectors, to change and create() again (tools, tests).
   DatabaseContents contents() const;
-  DatabaseView view() const { return *this; }
 
   const Skeleton& skeleton() const { return skeleton_; }
   const JointRoleIndices& roles() const { return roles_; }
