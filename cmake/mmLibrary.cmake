@@ -1,6 +1,18 @@
 # mm_library(<name> COMPONENT <game|offline> EXPORT <export set>): the static library mm_<name>
 # (mm::<name>, here and installed) of the calling folder's src/*.cpp, its public headers in the
 # folder's include/, both installed into the component. The caller adds what it links.
+# The Python module (python/) is a shared object that links the static libraries, so when it is
+# built their code is compiled position independent; without semantic interposition, so that
+# the compiler still inlines and calls directly within a library as in an executable. Only the
+# libraries: the programs keep the compiler's default (PIE), which the tests' precompiled header
+# must match.
+function(mm_shared_object_ready target)
+  if(MM_PYTHON_FOUND)
+    set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+    target_compile_options(${target} PRIVATE -fno-semantic-interposition)
+  endif()
+endfunction()
+
 function(mm_library name)
   cmake_parse_arguments(arg "" "COMPONENT;EXPORT" "" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp)
@@ -10,6 +22,7 @@ function(mm_library name)
   target_include_directories(mm_${name} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
                                                $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(mm_${name} PRIVATE $<BUILD_INTERFACE:mm_warnings>)
+  mm_shared_object_ready(mm_${name})
   install(TARGETS mm_${name} EXPORT ${arg_EXPORT} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           COMPONENT ${arg_COMPONENT})
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}

@@ -5,12 +5,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The python3-* and pybind11 packages build and test the Python module (python/);
+# assimp-testmodels holds real-world BVH files the importer's tests read.
 packages=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libeigen3-dev libtinygltf-dev libflann-dev nlohmann-json3-dev libstb-dev
   libglfw3-dev libgl-dev libegl-dev libosmesa6-dev libgl1-mesa-dri xvfb xauth libimgui-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang clang-format libclang-rt-14-dev xz-utils
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+  assimp-testmodels
 )
 missing=()
 for p in "${packages[@]}"; do

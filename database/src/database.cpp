@@ -393,6 +393,31 @@ Result<Database> Database::create(const DatabaseContents& contents) {
   return db;
 }
 
+Result<Database> with_channel_weight(const Database& db, int channel, float weight) {
+  const FeatureSchema& schema = db.schema();
+  if (channel < 0 || channel >= static_cast<int>(schema.channels.size())) {
+    return Error{"feature weight: no channel " + std::to_string(channel) + " (the schema has " +
+                 std::to_string(schema.channels.size()) + ")"};
+  }
+  if (!std::isfinite(weight) || weight <= 0.0f) {
+    return Error{"feature weight: the weight of " + schema.channels[channel].name +
+                 " must be finite and > 0"};
+  }
+  DatabaseContents contents = db.contents();
+  const float ratio = weight / contents.schema.channels[channel].weight;
+  contents.schema.channels[channel].weight = weight;
+  const int first = schema.offset(channel);
+  const int dims = schema.dims();
+  const int count = schema.channels[channel].dims();
+  for (int c = first; c < first + count; ++c) {
+    contents.feature_scale[c] /= ratio;
+    for (int f = 0; f < contents.frame_count; ++f) {
+      contents.features[static_cast<size_t>(f) * dims + c] *= ratio;
+    }
+  }
+  return Database::create(contents);
+}
+
 DatabaseContents Database::contents() const {
   DatabaseContents out;
   out.skeleton = skeleton_;

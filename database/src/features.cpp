@@ -1,5 +1,6 @@
 #include "mm/database/features.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <unordered_set>
 
@@ -43,6 +44,25 @@ int FeatureSchema::offset(int channel) const {
     column += channels[i].dims();
   }
   return column;
+}
+
+std::vector<std::string> FeatureSchema::column_names() const {
+  std::vector<std::string> names;
+  names.reserve(static_cast<size_t>(dims()));
+  for (const FeatureChannel& c : channels) {
+    if (is_trajectory_kind(c.kind)) {
+      for (const float time : c.times) {
+        char text[32];
+        const auto end = std::to_chars(text, text + sizeof text, time).ptr;
+        const std::string prefix = c.name + "_" + std::string(text, end) + "s_";
+        names.push_back(prefix + "x");
+        names.push_back(prefix + "z");
+      }
+    } else {
+      for (const char* axis : {"_x", "_y", "_z"}) names.push_back(c.name + axis);
+    }
+  }
+  return names;
 }
 
 Status FeatureSchema::validate() const {

@@ -658,6 +658,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     const EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
     accumulator.add(frame);
     if (options.dump) *options.dump << csv_row(frame) << "\n";
+    if (options.on_frame) options.on_frame(frame);
   }
   EvaluationResult result;
   result.metrics = accumulator.metrics();

@@ -338,6 +338,55 @@ TEST(DatabaseCreate, RefusesWhatValidateRefusesAndCopiesTheRest) {
   EXPECT_EQ(moved.frame_count(), contents.frame_count);
 }
 
+TEST(DatabaseWeight, ANewChannelWeightRescalesThatChannelsColumnsOnly) {
+  const Database db = make_database();
+  // Channel 1 (trajectory_position, weight 1.5, columns 3-6) to weight 3: twice the weight.
+  Result<Database> heavier = with_channel_weight(db, 1, 3.0f);
+  ASSERT_TRUE(heavier.ok()) << heavier.message();
+  EXPECT_EQ(heavier->schema().channels[1].weight, 3.0f);
+  EXPECT_EQ(heavier->schema().channels[0].weight, db.schema().channels[0].weight);
+  for (int c = 0; c < kDims; ++c) {
+    const float ratio = c >= 3 ? 2.0f : 1.0f;
+    EXPECT_FLOAT_EQ(heavier->feature_scale()[c], db.feature_scale()[c] / ratio) << c;
+    EXPECT_EQ(heavier->feature_offset()[c], db.feature_offset()[c]) << c;
+    for (int f = 0; f < db.frame_count(); f += 7) {
+      EXPECT_FLOAT_EQ(heavier->feature_row(f)[c], db.feature_row(f)[c] * ratio) << f << " " << c;
+    }
+  }
+  // Everything but the features is the same database.
+  DatabaseContents expected = db.contents();
+  DatabaseContents got = heavier->contents();
+  got.schema = expected.schema;
+  got.features = expected.features;
+  got.feature_scale = expected.feature_scale;
+  test::expect_same_database(expected, Database::create(got).value());
+
+  Result<Database> no_channel = with_channel_weight(db, 2, 1.0f);
+  ASSERT_FALSE(no_channel.ok());
+  EXPECT_EQ(no_channel.message(), "feature weight: no channel 2 (the schema has 2)");
+  for (const float bad : {0.0f, -1.0f, std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity()}) {
+    Result<Database> refused = with_channel_weight(db, 0, bad);
+    ASSERT_FALSE(refused.ok()) << bad;
+    EXPECT_EQ(refused.message(),
+              "feature weight: the weight of left_foot_position must be finite and > 0");
+  }
+}
+
+TEST(FeatureSchema, ColumnNamesNameEveryColumnInOrder) {
+  const std::vector<std::string> names = two_channel_schema().column_names();
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "left_foot_position_x", "left_foot_position_y", "left_foot_position_z",
+                       "trajectory_position_0.33s_x", "trajectory_position_0.33s_z",
+                       "trajectory_position_0.67s_x", "trajectory_position_0.67s_z"}));
+  const FeatureSchema schema = FeatureSchema::default_schema();
+  const std::vector<std::string> all = schema.column_names();
+  ASSERT_EQ(all.size(), static_cast<size_t>(schema.dims()));
+  EXPECT_EQ(all[12], "hips_velocity_x");
+  EXPECT_EQ(all[20], "trajectory_position_1s_z");
+  EXPECT_EQ(all[26], "trajectory_direction_1s_z");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Damaged files.
 

@@ -13,6 +13,7 @@
 #include "command.hpp"
 #include "mm/programs/command_line.hpp"
 #include "mm/programs/evaluation.hpp"
+#include "mm/programs/evaluation_json.hpp"
 #include "mm/programs/number_parsing.hpp"
 #include "mm/programs/shared_options.hpp"
 
@@ -77,47 +78,6 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
     return usage_error(app, "--dump takes one script");
   }
   return check_settings(app, out.options.settings);
-}
-
-nlohmann::json to_json(const EvaluationMetrics& m) {
-  return {{"foot_skate_cm_s_mean", m.foot_skate_cm_s_mean},
-          {"foot_skate_cm_s_p95", m.foot_skate_cm_s_p95},
-          {"root_sim_distance_cm_mean", m.root_sim_distance_cm_mean},
-          {"root_sim_distance_cm_max", m.root_sim_distance_cm_max},
-          {"facing_error_deg_mean", m.facing_error_deg_mean},
-          {"speed_response_s", m.speed_response_s},
-          {"speed_events", m.speed_events},
-          {"speed_events_reached", m.speed_events_reached},
-          {"heading_response_s", m.heading_response_s},
-          {"heading_events", m.heading_events},
-          {"heading_events_reached", m.heading_events_reached},
-          {"stand_root_speed_cm_s_mean", m.stand_root_speed_cm_s_mean},
-          {"stand_foot_speed_cm_s_mean", m.stand_foot_speed_cm_s_mean},
-          {"stand_frames", m.stand_frames},
-          {"transitions_per_s", m.transitions_per_s},
-          {"transition_accel_ratio", m.transition_accel_ratio},
-          {"transition_accel_p99_m_s2", m.transition_accel_p99},
-          {"database_accel_p99_m_s2", m.database_accel_p99},
-          {"transition_accel_ratio_same_sampling", m.transition_accel_ratio_same_sampling},
-          {"database_accel_p99_same_sampling_m_s2", m.database_accel_p99_same_sampling},
-          {"search_us_mean", m.search_us_mean},
-          {"update_us_mean", m.update_us_mean},
-          {"body_turn_rate_deg_s_p99", m.body_turn_rate_deg_s_p99},
-          {"body_turn_rate_deg_s_max", m.body_turn_rate_deg_s_max},
-          {"foot_pivot_deg_s_mean", m.foot_pivot_deg_s_mean},
-          {"foot_pivot_frames", m.foot_pivot_frames},
-          {"stand_turns", m.stand_turns},
-          {"stand_turn_unsettled", m.stand_turn_unsettled},
-          {"stand_turn_response_s", m.stand_turn_response_s},
-          {"stand_turn_final_error_deg_mean", m.stand_turn_final_error_deg_mean},
-          {"stand_turn_peak_rate_deg_s_max", m.stand_turn_peak_rate_deg_s_max},
-          {"strafe_chest_error_deg_mean", m.strafe_chest_error_deg_mean},
-          {"strafe_chest_frames", m.strafe_chest_frames},
-          {"idle_head_speed_cm_s_mean", m.idle_head_speed_cm_s_mean},
-          {"idle_head_frames", m.idle_head_frames},
-          {"toe_height_min_cm", m.toe_height_min_cm},
-          {"frames", m.frames},
-          {"seconds", m.seconds}};
 }
 
 void print_table_header() {
@@ -235,11 +195,7 @@ int run_eval(const std::vector<std::string>& args) {
       return 1;
     }
     const std::string name = std::filesystem::path(path).stem().string();
-    nlohmann::json json = to_json(result->metrics);
-    json["script"] = path;
-    json["dt"] = arguments.options.dt;
-    json["ik"] = arguments.options.settings.ik_enabled;
-    json["start"] = {arguments.options.start.x, arguments.options.start.y};
+    const nlohmann::json json = evaluation_run_json(result->metrics, path, arguments.options);
     if (table) {
       print_table_row(name, result->metrics);
       rows.emplace_back(name, result->metrics);

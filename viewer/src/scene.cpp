@@ -125,28 +125,8 @@ Status Scene::apply_settings(const ControllerSettings& settings) {
 }
 
 Status Scene::set_channel_weight(int channel, float weight) {
-  const FeatureSchema& schema = database_->schema();
-  if (channel < 0 || channel >= static_cast<int>(schema.channels.size())) {
-    return Error{"viewer: no feature channel " + std::to_string(channel)};
-  }
-  if (!std::isfinite(weight) || weight <= 0.0f) {
-    return Error{"viewer: a feature weight must be finite and > 0"};
-  }
-  // features = (raw - offset) / (std / weight): a new weight rescales the channel's columns.
-  DatabaseContents contents = database_->contents();
-  const float ratio = weight / contents.schema.channels[channel].weight;
-  contents.schema.channels[channel].weight = weight;
-  const int first = schema.offset(channel);
-  const int dims = schema.dims();
-  const int count = schema.channels[channel].dims();
-  for (int c = first; c < first + count; ++c) {
-    contents.feature_scale[c] /= ratio;
-    for (int f = 0; f < contents.frame_count; ++f) {
-      contents.features[static_cast<size_t>(f) * dims + c] *= ratio;
-    }
-  }
-  Result<Database> created = Database::create(contents);
-  if (!created) return Error{created.message()};
+  Result<Database> created = with_channel_weight(*database_, channel, weight);
+  if (!created) return Error{"viewer: " + created.message()};
   auto reweighted = std::make_shared<const Database>(std::move(created).value());
   Result<std::shared_ptr<const ControllerDatabase>> shared =
       ControllerDatabase::create(reweighted, shared_->options());

@@ -225,6 +225,13 @@ class Database {
   std::span<int> frame_clip_;
 };
 
+// A copy of `db` whose feature channel `channel` (an index into its schema's channels) has
+// weight `weight` instead, as if it had been built with it: the channel's columns of features
+// and feature_scale rescaled (features = (raw - offset) / (std / weight)), nothing else
+// changed. Fails, naming what is wrong, on a channel out of range or a weight not finite and
+// > 0. Costs a copy of the database (the viewer's weight slider, feature-weight sweeps).
+Result<Database> with_channel_weight(const Database& db, int channel, float weight);
+
 // Checks of a database being built or loaded: the whole of Database::validate().
 Status validate_database(const DatabaseView& db);
 

@@ -37,6 +37,10 @@ struct FeatureSchema {
   int dims() const;
   // The first column of channel i.
   int offset(int channel) const;
+  // One name per column, in column order: the channel's name and the axis for bone kinds
+  // ("left_foot_position_x"), and the time too for trajectory kinds
+  // ("trajectory_position_0.33s_x", times as the shortest decimal that reads back, in seconds).
+  std::vector<std::string> column_names() const;
   // Names unique and non-empty, weights positive and finite, bone kinds name a bone,
   // trajectory kinds have at least one finite time.
   Status validate() const;

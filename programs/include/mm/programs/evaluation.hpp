@@ -84,6 +84,7 @@
 // does), so a slow drift also counts as a change once it adds up.
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <span>
@@ -230,6 +231,10 @@ struct EvaluationOptions {
   // is made (t, simulation, root, desired motion, transition, contacts, every joint's global
   // position). The caller checks the stream's state afterwards.
   std::ostream* dump = nullptr;
+  // When set, called with every frame's record right after its update, before the next one
+  // (the record's joints are valid during the call only): how a caller other than the CSV dump
+  // (the Python module's run_script) keeps the run frame by frame.
+  std::function<void(const EvaluationFrame&)> on_frame;
 };
 
 struct EvaluationResult {
