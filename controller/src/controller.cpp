@@ -304,9 +304,12 @@ Status Controller::set_settings(const ControllerSettings& settings) {
 
 // teleport() relative to the origin (teleport_world() picks the origin first).
 void Controller::place(const glm::vec3& position, float yaw) {
-  const glm::vec3 ground(position.x, 0.0f, position.z);
+  // On the flat plane the ground is y = 0; in a world, the ground is searched from the given
+  // height (settle_on_ground).
+  const glm::vec3 ground(position.x, world_ ? position.y : 0.0f, position.z);
   const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
   sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
+  if (world_) settle_on_ground();
   sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
   sim_rotation_ = desired_rotation_ = simulation_goal_rotation_ = warp_facing_ = rotation;
   warp_facing_reached_ = true;
@@ -320,7 +323,8 @@ void Controller::place(const glm::vec3& position, float yaw) {
     // Without offsets the displayed pose is the played one, then placed.
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
     std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
-    move_root(sim_position_, rotation);
+    move_root(glm::vec3(sim_position_.x, 0.0f, sim_position_.z), rotation);
+    if (world_) locals_[0].translation.y += ground_height_;
     predict();
     refresh_outputs(0.0f);
   } else {
@@ -353,9 +357,11 @@ void Controller::update(float dt, const ControllerInput& input) {
                                 rotation_vector_rate_to_angular_velocity(
                                     root_offsets_.rotations[0], root_offsets_.rotation_rates[0]);
   simulate(dt);
+  if (world_) collide_root_motion();
   synchronize(dt);
   limit_body_turn(dt);
   turn_chest_to_facing(dt);
+  if (world_) lift_to_ground(dt);
   predict();
   refresh_outputs(dt);
 }
@@ -707,17 +713,22 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
 }
 
 void Controller::simulate(float dt) {
+  const glm::vec3 before = sim_position_;
   spring_character_update(sim_position_, sim_velocity_, sim_acceleration_, desired_velocity_,
                           settings_.simulation_velocity_halflife, dt);
   if (stopping_) {
     stand_turn(dt);
   } else {
-    const glm::quat before = sim_rotation_;
+    const glm::quat before_rotation = sim_rotation_;
     critical_spring_update(sim_rotation_, sim_angular_velocity_, simulation_goal_rotation_,
                            settings_.simulation_rotation_halflife, dt);
-    limit_turn_rate(before, dt);
+    limit_turn_rate(before_rotation, dt);
   }
-  sim_position_.y = 0.0f;
+  if (world_) {
+    collide_simulation(before);
+  } else {
+    sim_position_.y = 0.0f;
+  }
 }
 
 // The rotation spring's step, and its rate, cut to simulation_max_turn_rate: a large change of
@@ -762,6 +773,7 @@ void Controller::predict() {
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
                           simulation_goal_rotation_, settings_.simulation_rotation_halflife,
                           trajectory_times_);
+  if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
   const float yaw = quat_yaw(sim_rotation_);
@@ -792,7 +804,8 @@ void Controller::synchronize(float dt) {
     case SyncMode::None:
       return;
     case SyncMode::SimulationFollowsCharacter:
-      sim_position_ = glm::vec3(root.translation.x, 0.0f, root.translation.z);
+      sim_position_ =
+          glm::vec3(root.translation.x, world_ ? last_root_.y : 0.0f, root.translation.z);
       sim_rotation_ = yaw_rotation(quat_yaw(root.rotation));
       return;
     case SyncMode::CharacterFollowsSimulation:
@@ -1107,7 +1120,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
   // toe dead at the floor, a jerk the legs show.
-  const float floor = shared_->lowest_foot_end(side);
+  float floor = shared_->lowest_foot_end(side);
+  // In a world, the body stands on the ground under the root (ground_height_).
+  if (world_) floor += ground_height_;
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
   f.target = target;

@@ -66,6 +66,12 @@ constexpr FloatField kFloatFields[] = {
     {"stand_turn_acceleration", &ControllerSettings::stand_turn_acceleration, 0.1f, 1000.0f},
     {"foot_unlock_radius", &ControllerSettings::foot_unlock_radius, 0.0f, 10.0f},
     {"foot_lock_release_halflife", &ControllerSettings::foot_lock_release_halflife, 0.0f, 10.0f},
+    {"character_radius", &ControllerSettings::character_radius, 0.01f, 10.0f},
+    {"character_height", &ControllerSettings::character_height, 0.02f, 20.0f},
+    {"step_height", &ControllerSettings::step_height, 0.0f, 10.0f},
+    {"max_step_down", &ControllerSettings::max_step_down, 0.0f, 100.0f},
+    {"max_slope", &ControllerSettings::max_slope, 0.0f, 1.5f},
+    {"ground_height_halflife", &ControllerSettings::ground_height_halflife, 0.0f, 10.0f},
     {"max_dt", &ControllerSettings::max_dt, 1e-4f, 10.0f},
 };
 
@@ -149,6 +155,12 @@ Status ControllerSettings::validate() const {
                    joined(f.names) + " (0 to " + std::to_string(f.names.size() - 1) + "), found " +
                    std::to_string(f.value)};
     }
+  }
+  if (character_height < 2.0f * character_radius) {
+    return Error{
+        "controller settings: character_height must be at least twice character_radius "
+        "(a capsule), found " +
+        std::to_string(character_height) + " and " + std::to_string(character_radius)};
   }
   if (bone_length_iterations < 0 || bone_length_iterations > 100) {
     return Error{"controller settings: bone_length_iterations must be in [0, 100], found " +

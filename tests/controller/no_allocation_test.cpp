@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <limits>
 #include <new>
 
+#include "analytic_world.hpp"
 #include "controller_support.hpp"
 
 namespace {
@@ -94,12 +96,15 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
 namespace mm {
 namespace {
 
-TEST(ControllerNoAllocationTest, UpdateNeverAllocates) {
+// 3000 updates of varied input (turns, runs, stops, strafes, a tag, a NaN stick, two rates) on
+// a controller, with or without a world; fails if any of them allocated.
+void expect_updates_never_allocate(const WorldQueries* world) {
   const auto shared = test::normal_controller_database();
   ControllerSettings settings;
   Result<Controller> made = Controller::create(shared, settings);
   ASSERT_TRUE(made.ok()) << made.message();
   Controller& c = *made;
+  c.set_world(world);
   // The counter can see allocations at all.
   const long probe = g_allocations.load();
   ::operator delete(::operator new(16));
@@ -122,6 +127,23 @@ TEST(ControllerNoAllocationTest, UpdateNeverAllocates) {
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(c.debug().searches, 100);
   EXPECT_GT(c.debug().transitions, 10);
+}
+
+TEST(ControllerNoAllocationTest, UpdateNeverAllocates) {
+  expect_updates_never_allocate(nullptr);
+}
+
+// In a world of walls, a ramp and steps, the moves through it (character_mover.hpp) use the
+// controller's fixed buffers too (the test world's own answers allocate nothing).
+TEST(ControllerNoAllocationTest, UpdateInAWorldNeverAllocates) {
+  test::AnalyticWorld world;
+  world.height = [](double x, double) { return std::clamp(x - 2.0, 0.0, 3.0) * 0.2; };
+  world.boxes.push_back(
+      test::AnalyticBox{glm::vec2(0.0f, 6.0f), glm::vec2(8.0f, 0.2f), 0.3f, 3.0f});
+  world.boxes.push_back(
+      test::AnalyticBox{glm::vec2(-3.0f, 0.0f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
+  expect_updates_never_allocate(&world);
+  EXPECT_GT(world.sweeps, 3000);
 }
 
 }  // namespace

@@ -39,8 +39,10 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "mm/controller/character_mover.hpp"
 #include "mm/controller/input.hpp"
 #include "mm/controller/local_origin.hpp"
+#include "mm/controller/world.hpp"
 #include "mm/database/database.hpp"
 #include "mm/runtime/dead_blending.hpp"
 #include "mm/runtime/inertialization.hpp"
@@ -252,6 +254,16 @@ struct ControllerSettings {
   // Passes of the distance-constraint solver that restores the leg's bone lengths.
   int bone_length_iterations = 2;
 
+  // ---- The world (set_world; docs/world.md). The capsule the simulation object, its predicted
+  // trajectory and the root are moved as through walls, steps and slopes (character_mover.hpp),
+  // and how the body follows the ground's height. Unused on the flat plane (no world).
+  float character_radius = 0.3f;  // m
+  float character_height = 1.7f;  // m
+  float step_height = 0.35f;      // m: a step up to this is climbed, a higher one is a wall
+  float max_step_down = 0.5f;     // m: a drop deeper than this is a ledge the character stops at
+  float max_slope = 0.8f;         // radians: ground steeper than this is not walkable
+  float ground_height_halflife = 0.1f;  // s: the body rises and falls to the ground on a spring
+
   // ---- Robustness. A dt larger than this is clamped to it (s).
   float max_dt = 0.1f;
   // Fills skinning_matrices() on every update.
@@ -318,6 +330,12 @@ struct ControllerDebug {
   int query_dims = 0;
   float last_query[kMaxQueryDims] = {};  // normalized; the first kMaxQueryDims columns
 
+  // The world (none: all zero).
+  float ground_height = 0.0f;          // the ground under the root the body stands on (m)
+  bool simulation_blocked = false;     // the simulation object's move met an obstacle
+  glm::vec3 simulation_contact{0.0f};  // that obstacle's horizontal normal
+  int64_t world_rejected = 0;          // the world's answers ignored (world.hpp), since create()
+
   // Feet: 0 left, 1 right.
   bool contact[2] = {false, false};  // the playing frame's contact, false while stepping
   bool locked[2] = {false, false};   // the toe is held by the foot lock
@@ -374,6 +392,13 @@ class Controller {
   // The speeds in use (settings, or the database's where the settings say 0).
   const ControllerDatabase::Speeds& speeds() const { return speeds_; }
 
+  // The game's world (world.hpp): the simulation object, its predicted trajectory and the root
+  // meet its walls, steps and slopes, and the body stands on its ground (docs/world.md). Not
+  // owned: it must outlive its use here. nullptr (the default) is the flat plane y = 0, exactly
+  // as without a world. Cold: the character is placed on the new ground where it stands.
+  void set_world(const WorldQueries* world);
+  const WorldQueries* world() const { return world_; }
+
   // Live tuning between updates (cold). Fails, changing nothing, on invalid settings.
   Status set_settings(const ControllerSettings& settings);
 
@@ -397,6 +422,14 @@ class Controller {
   void follow_character();
   void shift_origin(const glm::vec3& shift);
   void publish_world_transforms();
+  // The world (controller_world.cpp): the moves of the simulation object, its trajectory and
+  // the root through it, and the body's height over its ground.
+  CharacterShape character_shape() const;
+  void collide_simulation(const glm::vec3& before);
+  void collide_trajectory(std::span<glm::vec3> positions);
+  void collide_root_motion();
+  void lift_to_ground(float dt);
+  void settle_on_ground();
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
@@ -552,6 +585,14 @@ class Controller {
   bool warp_facing_reached_ = true;
   float chest_twist_ = 0.0f;
   float chest_twist_velocity_ = 0.0f;
+
+  // The world (null: the flat plane), the capsule's mover, the ground's height under the root on
+  // its spring, and the root's ground position after the last update (its next move's start).
+  const WorldQueries* world_ = nullptr;
+  CharacterMover mover_;
+  float ground_height_ = 0.0f;
+  float ground_velocity_ = 0.0f;
+  glm::vec3 last_root_{0.0f};
 
   ControllerDebug debug_;
 };

@@ -1,0 +1,90 @@
+#pragma once
+// Moving a character's capsule through the game's world (world.hpp): the rules the controller
+// applies to its simulation object, its predicted trajectory and its animated root, in one
+// place so that all three meet walls, steps and slopes alike.
+//
+// A move goes from a point standing on the ground toward a horizontal goal (its y is ignored):
+// 1. sweep: the capsule, lifted by step_height (so a step lower than that passes under it),
+//    from the start toward the goal. A hit stops it `kSkin` short of the contact;
+// 2. slide: what the hit cut off, less its part into the obstacle (the contact normal made
+//    horizontal), is swept again from there: pushing diagonally along a wall keeps moving along
+//    it, pushing head-on stops. A second hit stops the slide (a corner);
+// 3. ground: a probe down from step_height above the start's height, as far as step_height +
+//    max_step_down, at where the sweeps ended. Walkable ground there is the new height (up a
+//    step, down a step, along a slope). No ground within reach (a ledge) or ground too steep:
+//    the move does not happen, the character stays where it was (never launched into the air,
+//    never below the ground).
+// Each phase is one batched call to the world (all trajectory samples at once). Answers that
+// fail the checks of world.hpp count as no hit and are counted in rejected().
+//
+// No allocation: the buffers are sized for kMaxMoves moves at once.
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "mm/controller/world.hpp"
+
+namespace mm {
+
+// The character's shape and how it climbs (metres; the slope as the cosine of the steepest
+// walkable one).
+struct CharacterShape {
+  float radius = 0.3f;
+  float height = 1.7f;
+  float step_height = 0.35f;
+  float max_step_down = 0.5f;
+  float min_walkable_normal_y = 0.7f;
+};
+
+// Where a move ended.
+struct MoveResult {
+  glm::vec3 position{0.0f};  // on the ground
+  glm::vec3 normal{0.0f};    // the (horizontal) normal of the first obstacle met, else zero
+  bool blocked = false;      // the sweeps met something
+  bool no_ground = false;    // no walkable ground at the end: the move was cancelled
+  glm::vec3 ground_normal{0.0f, 1.0f, 0.0f};  // the surface under `position`
+};
+
+class CharacterMover {
+ public:
+  // At most this many moves in one collide() call (the trajectory's samples).
+  static constexpr int kMaxMoves = 16;
+  // How far short of a contact a sweep stops (m), so that the next sweep does not start
+  // touching the obstacle.
+  static constexpr float kSkin = 0.01f;
+
+  // Moves each start[i] toward goal[i] (y ignored) and writes where it ended to out[i]: three
+  // batched calls to the world (sweep, slide, ground), whatever the count (at most kMaxMoves).
+  // Positions relative to `origin`, as the world's queries take them.
+  void collide(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
+               std::span<const glm::vec3> starts, std::span<const glm::vec3> goals,
+               std::span<MoveResult> out);
+
+  // One move.
+  MoveResult move(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
+                  const glm::vec3& start, const glm::vec3& goal);
+
+  // The ground under `position`, probed from step_height above it down to max_step_down below
+  // it; false when there is no walkable ground within reach.
+  bool ground(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
+              const glm::vec3& position, GroundHit& hit);
+
+  // Answers ignored because they failed the checks (world.hpp), since creation.
+  int64_t rejected() const { return rejected_; }
+
+ private:
+  bool accept(const ShapeSweep& query, SweepHit& hit);
+  bool accept(const GroundProbe& query, GroundHit& hit);
+
+  std::array<ShapeSweep, kMaxMoves> sweeps_{};
+  std::array<SweepHit, kMaxMoves> sweep_hits_{};
+  std::array<GroundProbe, kMaxMoves> probes_{};
+  std::array<GroundHit, kMaxMoves> ground_hits_{};
+  std::array<int, kMaxMoves> slid_{};  // the move each slide sweep belongs to
+  int64_t rejected_ = 0;
+};
+
+}  // namespace mm

@@ -1,0 +1,159 @@
+// A character's capsule through the game's world: sweep, slide, ground (character_mover.hpp).
+
+#include "mm/controller/character_mover.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mm/runtime/assert.hpp"
+#include "mm/runtime/finite.hpp"
+
+namespace mm {
+
+namespace {
+
+// A contact normal's horizontal part, unit length; when the contact is (nearly) level, a floor
+// or ceiling met at the capsule's edge, it stops the move head-on instead.
+glm::vec3 horizontal_normal(const glm::vec3& normal, const glm::vec3& move) {
+  glm::vec3 n(normal.x, 0.0f, normal.z);
+  const float length = glm::length(n);
+  if (length > 0.1f) return n / length;
+  const float move_length = glm::length(move);
+  return move_length > 0.0f ? -move / move_length : glm::vec3(0.0f);
+}
+
+// The part of a sweep from -> to that may be travelled, `skin` short of a hit at `fraction`.
+float safe_fraction(float fraction, float distance, float skin) {
+  return distance > 0.0f ? std::max(0.0f, fraction - skin / distance) : 0.0f;
+}
+
+glm::vec3 lift(const CharacterShape& shape) {
+  return glm::vec3(0.0f, shape.step_height, 0.0f);
+}
+
+}  // namespace
+
+bool CharacterMover::accept(const ShapeSweep& query, SweepHit& hit) {
+  (void)query;
+  if (!hit.hit) return true;
+  const float length = glm::length(hit.normal);
+  if (!std::isfinite(hit.fraction) || hit.fraction < -1e-3f || hit.fraction > 1.0f + 1e-3f ||
+      !finite(hit.normal) || !(length > 0.5f && length < 2.0f)) {
+    ++rejected_;
+    hit = SweepHit{};
+    return false;
+  }
+  hit.fraction = std::clamp(hit.fraction, 0.0f, 1.0f);
+  hit.normal /= length;
+  return true;
+}
+
+bool CharacterMover::accept(const GroundProbe& query, GroundHit& hit) {
+  if (!hit.hit) return true;
+  constexpr float kTolerance = 0.01f;  // m: how far off the probe's segment a point may be
+  const float length = glm::length(hit.normal);
+  const bool on_segment = finite(hit.point) && std::abs(hit.point.x - query.from.x) <= kTolerance &&
+                          std::abs(hit.point.z - query.from.z) <= kTolerance &&
+                          hit.point.y <= query.from.y + kTolerance &&
+                          hit.point.y >= query.from.y - query.max_distance - kTolerance;
+  if (!on_segment || !finite(hit.normal) || !(length > 0.5f && length < 2.0f)) {
+    ++rejected_;
+    hit = GroundHit{};
+    return false;
+  }
+  hit.normal /= length;
+  if (hit.normal.y < 0.0f) hit.normal = -hit.normal;
+  return true;
+}
+
+void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin,
+                             const CharacterShape& shape, std::span<const glm::vec3> starts,
+                             std::span<const glm::vec3> goals, std::span<MoveResult> out) {
+  const size_t n = starts.size();
+  MM_ASSERT(n <= static_cast<size_t>(kMaxMoves) && goals.size() == n && out.size() == n);
+  const glm::vec3 up = lift(shape);
+  // 1. Sweep every move that goes anywhere.
+  size_t count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 d = goals[i] - starts[i];
+    d.y = 0.0f;
+    out[i] = MoveResult{};
+    // Unobstructed, the goal itself (start + (goal - start) is not always the goal in float).
+    out[i].position = glm::vec3(goals[i].x, starts[i].y, goals[i].z);
+    if (glm::length(d) < 1e-6f) continue;
+    sweeps_[count] = ShapeSweep{starts[i] + up, starts[i] + up + d, shape.radius, shape.height};
+    slid_[count++] = static_cast<int>(i);
+  }
+  if (count > 0)
+    world.sweep(origin, std::span(sweeps_).first(count), std::span(sweep_hits_).first(count));
+  // 2. Slide what a hit cut off along the obstacle.
+  size_t slides = 0;
+  for (size_t k = 0; k < count; ++k) {
+    if (!accept(sweeps_[k], sweep_hits_[k]) || !sweep_hits_[k].hit) continue;
+    const size_t i = static_cast<size_t>(slid_[k]);
+    const glm::vec3 d = sweeps_[k].to - sweeps_[k].from;
+    const float distance = glm::length(d);
+    const float travelled = safe_fraction(sweep_hits_[k].fraction, distance, kSkin);
+    const glm::vec3 stop = starts[i] + d * travelled;
+    const glm::vec3 normal = horizontal_normal(sweep_hits_[k].normal, d);
+    out[i].position = stop;
+    out[i].blocked = true;
+    out[i].normal = normal;
+    const glm::vec3 rest = d * (1.0f - travelled);
+    const glm::vec3 slide = rest - normal * glm::dot(rest, normal);
+    if (glm::length(slide) < 1e-6f) continue;
+    // Written over the sweeps already read: slot `slides` <= k.
+    sweeps_[slides] = ShapeSweep{stop + up, stop + up + slide, shape.radius, shape.height};
+    slid_[slides++] = static_cast<int>(i);
+  }
+  if (slides > 0) {
+    world.sweep(origin, std::span(sweeps_).first(slides), std::span(sweep_hits_).first(slides));
+    for (size_t k = 0; k < slides; ++k) {
+      accept(sweeps_[k], sweep_hits_[k]);
+      const glm::vec3 slide = sweeps_[k].to - sweeps_[k].from;
+      const float travelled =
+          sweep_hits_[k].hit ? safe_fraction(sweep_hits_[k].fraction, glm::length(slide), kSkin)
+                             : 1.0f;
+      out[static_cast<size_t>(slid_[k])].position += slide * travelled;
+    }
+  }
+  // 3. The ground where each move ended, reached from the start's height.
+  for (size_t i = 0; i < n; ++i) {
+    probes_[i] = GroundProbe{
+        glm::vec3(out[i].position.x, starts[i].y + shape.step_height, out[i].position.z),
+        shape.step_height + shape.max_step_down, shape.min_walkable_normal_y};
+    ground_hits_[i] = GroundHit{};
+  }
+  if (n > 0)
+    world.probe_ground(origin, std::span(probes_).first(n), std::span(ground_hits_).first(n));
+  for (size_t i = 0; i < n; ++i) {
+    GroundHit& hit = ground_hits_[i];
+    if (accept(probes_[i], hit) && hit.hit && hit.walkable) {
+      out[i].position.y = hit.point.y;
+      out[i].ground_normal = hit.normal;
+    } else {
+      out[i].position = starts[i];
+      out[i].no_ground = true;
+    }
+  }
+}
+
+MoveResult CharacterMover::move(const WorldQueries& world, const glm::dvec3& origin,
+                                const CharacterShape& shape, const glm::vec3& start,
+                                const glm::vec3& goal) {
+  MoveResult result;
+  collide(world, origin, shape, std::span(&start, 1), std::span(&goal, 1), std::span(&result, 1));
+  return result;
+}
+
+bool CharacterMover::ground(const WorldQueries& world, const glm::dvec3& origin,
+                            const CharacterShape& shape, const glm::vec3& position,
+                            GroundHit& hit) {
+  const GroundProbe probe{position + lift(shape), shape.step_height + shape.max_step_down,
+                          shape.min_walkable_normal_y};
+  hit = GroundHit{};
+  world.probe_ground(origin, std::span(&probe, 1), std::span(&hit, 1));
+  return accept(probe, hit) && hit.hit && hit.walkable;
+}
+
+}  // namespace mm

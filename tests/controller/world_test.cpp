@@ -1,0 +1,180 @@
+// The controller in a world (issue 28; world.hpp, controller_world.cpp): walls stop and slide the
+// simulation object, its trajectory and the root; the body follows ramps and stairs; a flat
+// world changes nothing; garbage answers never poison the state. On the Bandai normal database,
+// with the analytic test world (tests/support/analytic_world.hpp).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "analytic_world.hpp"
+#include "controller_support.hpp"
+#include "mm/controller/controller.hpp"
+#include "mm/runtime/finite.hpp"
+
+namespace mm {
+namespace {
+
+using test::AnalyticBox;
+using test::AnalyticWorld;
+using test::make_controller;
+using test::push_toward;
+
+constexpr float kDt = 1.0f / 60.0f;
+
+// A tall wall whose near face is the plane z = `face`.
+AnalyticBox wall_across_z(float face) {
+  return AnalyticBox{glm::vec2(0.0f, face + 0.2f), glm::vec2(30.0f, 0.2f), 0.0f, 3.0f};
+}
+
+float hips_height(const Controller& c) {
+  const Database& db = c.controller_database().database();
+  return c.global_transforms()[static_cast<size_t>(db.roles().hips)].translation.y;
+}
+
+TEST(ControllerWorld, AFlatWorldMovesTheCharacterExactlyAsNoWorld) {
+  AnalyticWorld flat;
+  Controller plain = make_controller();
+  Controller in_world = make_controller();
+  in_world.set_world(&flat);
+  for (int f = 0; f < 600; ++f) {
+    const ControllerInput input = push_toward(f < 300 ? 0.0f : 120.0f, f > 400);
+    plain.update(kDt, input);
+    in_world.update(kDt, input);
+  }
+  const auto a = plain.global_transforms();
+  const auto b = in_world.global_transforms();
+  for (size_t j = 0; j < a.size(); ++j) {
+    EXPECT_EQ(a[j].translation, b[j].translation) << j;
+    EXPECT_EQ(a[j].rotation, b[j].rotation) << j;
+  }
+  EXPECT_GT(flat.probe_calls, 0);
+  EXPECT_LE(flat.probe_calls + flat.sweep_calls, 600 * kMaxWorldCallsPerUpdate);
+}
+
+TEST(ControllerWorld, HeadOnIntoAWallTheCharacterStopsBeforeItAndStands) {
+  AnalyticWorld world;
+  world.boxes.push_back(wall_across_z(4.0f));
+  Controller c = make_controller();
+  c.set_world(&world);
+  const float limit = 4.0f - c.settings().character_radius + 1e-3f;
+  std::vector<float> root_z;
+  for (int f = 0; f < 8 * 60; ++f) {
+    c.update(kDt, push_toward(0.0f));
+    const ControllerDebug& d = c.debug();
+    ASSERT_LE(d.simulation_position.z, limit) << f;
+    ASSERT_LE(c.root_transform().translation.z, limit) << f;
+    for (int i = 0; i < d.trajectory_count; ++i) ASSERT_LE(d.predicted_positions[i].z, limit) << f;
+    root_z.push_back(c.root_transform().translation.z);
+  }
+  // It got to the wall, and for the last two seconds has stood there, pushing.
+  EXPECT_GT(root_z.back(), limit - 0.3f);
+  const auto last = root_z.end() - 120;
+  EXPECT_LT(*std::max_element(last, root_z.end()) - *std::min_element(last, root_z.end()), 0.05f);
+  EXPECT_TRUE(c.debug().simulation_blocked);
+}
+
+TEST(ControllerWorld, DiagonallyIntoAWallTheCharacterWalksAlongIt) {
+  AnalyticWorld world;
+  const float yaw = glm::radians(30.0f);
+  // A wall 30 degrees off +Z, 1 m to the right of the start: pushing along +Z meets it.
+  world.boxes.push_back(AnalyticBox{glm::vec2(-1.2f, 0.0f), glm::vec2(0.2f, 40.0f), yaw, 3.0f});
+  Controller c = make_controller();
+  c.set_world(&world);
+  const glm::vec3 tangent(std::sin(yaw), 0.0f, std::cos(yaw));
+  const glm::vec3 start = c.root_transform().translation;
+  int blocked = 0;
+  for (int f = 0; f < 10 * 60; ++f) {
+    c.update(kDt, push_toward(0.0f));
+    blocked += c.debug().simulation_blocked ? 1 : 0;
+  }
+  // It met the wall and kept walking along it: about 10 s at walking speed times cos(30).
+  EXPECT_GT(blocked, 200);
+  const float along = glm::dot(c.root_transform().translation - start, tangent);
+  EXPECT_GT(along, 6.0f);
+}
+
+TEST(ControllerWorld, UpARampTheBodyStandsOnTheSurface) {
+  AnalyticWorld world;
+  const double slope = std::tan(glm::radians(15.0));
+  world.height = [=](double, double z) { return std::clamp(z - 2.0, 0.0, 6.0) * slope; };
+  Controller c = make_controller();
+  c.set_world(&world);
+  Controller flat = make_controller();
+  float worst = 0.0f;
+  for (int f = 0; f < 8 * 60; ++f) {
+    c.update(kDt, push_toward(0.0f));
+    flat.update(kDt, push_toward(0.0f));
+    const glm::vec3 root = c.root_transform().translation;
+    const float surface = static_cast<float>(world.surface(root.x, root.z));
+    if (f > 60) worst = std::max(worst, std::abs(c.debug().ground_height - surface));
+  }
+  // The ground height under the root on its spring lags the slope by a few centimetres at most.
+  EXPECT_LT(worst, 0.05f);
+  const glm::vec3 root = c.root_transform().translation;
+  EXPECT_GT(root.z, 8.0f);  // up on the plateau
+  EXPECT_NEAR(root.y, 6.0 * slope, 0.02);
+  // The hips stand as high above the plateau as they do above the flat ground.
+  EXPECT_NEAR(hips_height(c) - root.y, hips_height(flat), 0.1f);
+}
+
+TEST(ControllerWorld, UpStairsTheHipsRiseWithoutPopping) {
+  AnalyticWorld world;
+  // 12 steps of 17 cm risers and 30 cm treads from z = 2.
+  for (int i = 0; i < 12; ++i) {
+    world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.0f + 0.3f * i + 4.0f),
+                                      glm::vec2(3.0f, 4.0f), 0.0f, 0.17f * (i + 1)});
+  }
+  Controller c = make_controller();
+  c.set_world(&world);
+  std::vector<float> heights;
+  for (int f = 0; f < 8 * 60; ++f) {
+    c.update(kDt, push_toward(0.0f));
+    heights.push_back(hips_height(c));
+  }
+  // At the top (12 x 17 cm), and every frame's rise no more than a spring allows: a snap of one
+  // riser would be 17 cm in a frame.
+  EXPECT_NEAR(c.debug().ground_height, 12 * 0.17f, 0.02f);
+  float largest_step = 0.0f;
+  for (size_t f = 1; f < heights.size(); ++f) {
+    largest_step = std::max(largest_step, std::abs(heights[f] - heights[f - 1]));
+  }
+  EXPECT_LT(largest_step, 0.05f);
+}
+
+TEST(ControllerWorld, GarbageAnswersNeverPoisonTheController) {
+  AnalyticWorld world;
+  world.garbage = true;
+  Controller c = make_controller();
+  c.set_world(&world);
+  for (int f = 0; f < 120; ++f) c.update(kDt, push_toward(45.0f));
+  for (const Transform& t : c.global_transforms()) {
+    ASSERT_TRUE(finite(t.translation));
+    ASSERT_TRUE(finite(t.rotation));
+  }
+  EXPECT_GT(c.debug().world_rejected, 120);
+  // With no ground it can stand on, the simulation object stays where it was placed.
+  EXPECT_EQ(c.debug().simulation_position, glm::vec3(0.0f));
+}
+
+TEST(ControllerWorld, TheWorldSettingsAreCheckedAndSetByName) {
+  ControllerSettings settings;
+  ASSERT_TRUE(set_controller_setting(settings, "step_height", "0.2").ok());
+  EXPECT_EQ(settings.step_height, 0.2f);
+  ASSERT_TRUE(set_controller_setting(settings, "character_radius", "1").ok());
+  const Status refused = settings.validate();
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.message(),
+            "controller settings: character_height must be at least twice character_radius (a "
+            "capsule), found 1.700000 and 1.000000");
+  settings = ControllerSettings{};
+  settings.max_slope = 2.0f;
+  EXPECT_EQ(settings.validate().message(),
+            "controller settings: max_slope must be a number in [0.000000, 1.500000], found "
+            "2.000000");
+}
+
+}  // namespace
+}  // namespace mm
