@@ -324,7 +324,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
     sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
     std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
     move_root(glm::vec3(sim_position_.x, 0.0f, sim_position_.z), rotation);
-    if (world_) locals_[0].translation.y += ground_height_;
+    if (world_ || game_capsule_) locals_[0].translation.y += ground_height_;
     predict();
     refresh_outputs(0.0f);
   } else {
@@ -361,7 +361,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   synchronize(dt);
   limit_body_turn(dt);
   turn_chest_to_facing(dt);
-  if (world_) lift_to_ground(dt);
+  if (world_ || game_capsule_) lift_to_ground(dt);
   predict();
   refresh_outputs(dt);
 }
@@ -726,7 +726,7 @@ void Controller::simulate(float dt) {
   }
   if (world_) {
     collide_simulation(before);
-  } else {
+  } else if (!game_capsule_) {
     sim_position_.y = 0.0f;
   }
 }
@@ -972,7 +972,7 @@ void Controller::turn_chest_to_facing(float dt) {
 void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& rotation) {
   if (!finite(position) || !usable_rotation(rotation) || clip_ < 0) return;
   body_yaw_known_ = false;
-  move_root(position, glm::normalize(rotation));
+  move_displayed_root(position, glm::normalize(rotation));
   // The feet go with the body: held toes would otherwise pull the legs back.
   for (FootLock& f : feet_) f = FootLock{};
   refresh_outputs(0.0f);
@@ -1122,7 +1122,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
   // toe dead at the floor, a jerk the legs show.
   float floor = shared_->lowest_foot_end(side);
   // In a world, the body stands on the ground under the root (ground_height_).
-  if (world_) floor += ground_height_;
+  if (world_ || game_capsule_) floor += ground_height_;
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
   f.target = target;

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "mm/controller/controller.hpp"
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
 
 namespace mm {
@@ -78,13 +79,76 @@ void Controller::collide_root_motion() {
 // The body lifted onto the ground under the root, on a spring: up and down stairs the hips rise
 // and fall without popping. The root's own height stays the data's (its plane, y = 0): the
 // transition's root mapping never sees the ground; the lift is added to the displayed pose only.
-// The ground is the one found under the root before the synchronization's small pull.
+// In a world, the ground is the one found under the root before the synchronization's small
+// pull; with the game's capsule, the height the game gave the simulation object.
 void Controller::lift_to_ground(float dt) {
-  last_root_ = glm::vec3(locals_[0].translation.x, last_root_.y, locals_[0].translation.z);
-  critical_spring_update(ground_height_, ground_velocity_, last_root_.y,
-                         settings_.ground_height_halflife, dt);
+  float ground = sim_position_.y;
+  if (world_) {
+    last_root_ = glm::vec3(locals_[0].translation.x, last_root_.y, locals_[0].translation.z);
+    ground = last_root_.y;
+  }
+  critical_spring_update(ground_height_, ground_velocity_, ground, settings_.ground_height_halflife,
+                         dt);
   locals_[0].translation.y += ground_height_;
   debug_.ground_height = ground_height_;
+}
+
+void Controller::set_simulation_position_world(const glm::dvec3& position) {
+  if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) {
+    return;
+  }
+  set_simulation_position(glm::vec3(position - origin_));
+}
+
+// What the game's physics refused of the step asked for (the simulation object's position after
+// update()) acts as a wall: its part of the velocity and acceleration goes. Less than a tenth of
+// a millimetre is the game's rounding, not a refusal.
+void Controller::set_simulation_position(const glm::vec3& position) {
+  if (!finite(position)) return;
+  if (!game_capsule_) {
+    // The first hand-back: the body starts at the game's height rather than rising to it.
+    game_capsule_ = true;
+    if (!world_) {
+      ground_height_ = position.y;
+      ground_velocity_ = 0.0f;
+      locals_[0].translation.y += ground_height_;
+    }
+  }
+  glm::vec3 refused = sim_position_ - position;
+  refused.y = 0.0f;
+  const float length = glm::length(refused);
+  if (length > 1e-4f) {
+    const glm::vec3 normal = -refused / length;
+    sim_velocity_ -= normal * std::min(0.0f, glm::dot(sim_velocity_, normal));
+    sim_acceleration_ -= normal * std::min(0.0f, glm::dot(sim_acceleration_, normal));
+  }
+  sim_position_ = position;
+  debug_.simulation_position = sim_position_;
+  debug_.simulation_velocity = sim_velocity_;
+  // The character never farther from the simulation object than the clamp, also after the
+  // game moved it: the root's next move starts within reach of the capsule.
+  if (clip_ < 0) return;
+  const Transform root = locals_[0];
+  glm::vec3 away = root.translation - sim_position_;
+  away.y = 0.0f;
+  const float distance = glm::length(away);
+  if (distance > settings_.clamp_max_distance) {
+    glm::vec3 clamped = sim_position_ + away * (settings_.clamp_max_distance / distance);
+    clamped.y = root.translation.y;
+    move_displayed_root(clamped, root.rotation);
+    refresh_outputs(0.0f);
+  }
+}
+
+// Between updates the displayed root is lifted onto the ground (lift_to_ground); move_root()
+// takes the root in the data's plane, so the lift comes off before and goes back on after.
+void Controller::move_displayed_root(const glm::vec3& position, const glm::quat& rotation) {
+  if (!world_ && !game_capsule_) {
+    move_root(position, rotation);
+    return;
+  }
+  move_root(position - glm::vec3(0.0f, ground_height_, 0.0f), rotation);
+  locals_[0].translation.y += ground_height_;
 }
 
 // A placement on the world's ground: the simulation object on the ground under it (searched

@@ -399,6 +399,21 @@ class Controller {
   void set_world(const WorldQueries* world);
   const WorldQueries* world() const { return world_; }
 
+  // A game that moves the character's capsule with its own physics (docs/world.md): after
+  // update() it moves its capsule toward simulation_position_world() (the step the controller
+  // asks for; simulation_velocity() is its rate), resolves the collisions its own way, and hands
+  // the capsule's resolved foot position back here. The simulation object moves there (what the
+  // game's physics refused of the step is taken out of its velocity, as a wall does), the
+  // character follows it as always (adjustment and clamping), and from then on the body stands
+  // at the height the game gives. Ignored when not finite. Works with or without set_world().
+  void set_simulation_position_world(const glm::dvec3& position);
+  // The same relative to origin().
+  void set_simulation_position(const glm::vec3& position);
+  // The simulation object after the last update: where it stands (world, double) and its
+  // velocity (m/s; what the game's capsule is asked to move at).
+  glm::dvec3 simulation_position_world() const { return to_world(origin_, sim_position_); }
+  const glm::vec3& simulation_velocity() const { return sim_velocity_; }
+
   // Live tuning between updates (cold). Fails, changing nothing, on invalid settings.
   Status set_settings(const ControllerSettings& settings);
 
@@ -428,6 +443,7 @@ class Controller {
   void collide_simulation(const glm::vec3& before);
   void collide_trajectory(std::span<glm::vec3> positions);
   void collide_root_motion();
+  void move_displayed_root(const glm::vec3& position, const glm::quat& rotation);
   void lift_to_ground(float dt);
   void settle_on_ground();
   void desired_motion(const ControllerInput& input);
@@ -593,6 +609,10 @@ class Controller {
   float ground_height_ = 0.0f;
   float ground_velocity_ = 0.0f;
   glm::vec3 last_root_{0.0f};
+  // The game moves the capsule (set_simulation_position): the simulation object keeps the
+  // height the game gave it, and the body stands at it. With a world or the game's capsule, the
+  // displayed root (locals_[0]) is lifted by ground_height_ between updates.
+  bool game_capsule_ = false;
 
   ControllerDebug debug_;
 };
