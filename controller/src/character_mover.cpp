@@ -147,9 +147,9 @@ MoveResult CharacterMover::move(const WorldQueries& world, const glm::dvec3& ori
 }
 
 bool CharacterMover::ground(const WorldQueries& world, const glm::dvec3& origin,
-                            const CharacterShape& shape, const glm::vec3& position,
+                            const CharacterShape& shape, const glm::vec3& position, float above,
                             GroundHit& hit) {
-  const GroundProbe probe{position + lift(shape), shape.step_height + shape.max_step_down,
+  const GroundProbe probe{position + glm::vec3(0.0f, above, 0.0f), above + shape.max_step_down,
                           shape.min_walkable_normal_y};
   hit = GroundHit{};
   world.probe_ground(origin, std::span(&probe, 1), std::span(&hit, 1));

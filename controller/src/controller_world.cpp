@@ -151,11 +151,13 @@ void Controller::move_displayed_root(const glm::vec3& position, const glm::quat&
   locals_[0].translation.y += ground_height_;
 }
 
-// A placement on the world's ground: the simulation object on the ground under it (searched
-// from step_height above its height), the body at that height at once, nothing moving.
+// A placement on the world's ground: the simulation object on the highest walkable ground
+// within the capsule's height above its height down to a step below, the body at that height at
+// once, nothing moving. Nothing there: it stays at the height it was given.
 void Controller::settle_on_ground() {
   GroundHit hit;
-  if (mover_.ground(*world_, origin_, character_shape(), sim_position_, hit)) {
+  const CharacterShape shape = character_shape();
+  if (mover_.ground(*world_, origin_, shape, sim_position_, shape.height, hit)) {
     sim_position_.y = hit.point.y;
   }
   ground_height_ = sim_position_.y;

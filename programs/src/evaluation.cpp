@@ -10,104 +10,26 @@
 #include <cstdio>
 #include <limits>
 #include <ostream>
+
 #include "mm/runtime/assert.hpp"
+#include "statistics.hpp"
 
 #include "mm/database/sampling.hpp"
+#include "mm/programs/ground_metrics.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/pose.hpp"
 
 namespace mm {
 
+using detail::PercentileHistogram;
+using detail::RunningMean;
+
 namespace {
 
 float horizontal_distance(const glm::vec3& a, const glm::vec3& b) {
   return std::hypot(a.x - b.x, a.z - b.z);
 }
-
-// The percentiles of a run in fixed memory, whatever its length: a histogram of the values by
-// their binary exponent and the first kMantissaBits bits of their mantissa, so a bin spans a
-// 2^-kMantissaBits fraction of its lower edge. A percentile is taken by nearest rank, as over
-// the sorted values, and reported as the middle of the bin that rank falls in, clamped to the
-// smallest and largest value seen: within 2^-(kMantissaBits + 1) (0.05 %) of the exact
-// nearest-rank value (exact when all the values are equal).
-// Values below 2^kLowestExponent (zero included) share one bin (absolute resolution
-// 2^kLowestExponent in the values' unit); values from 2^kHighestExponent up and infinity
-// share the last, reported as the largest value seen; NaN is not counted. The bins (about
-// 0.5 MB) are allocated by the first value.
-class PercentileHistogram {
- public:
-  void add(double value) {
-    if (std::isnan(value)) return;
-    if (bins_.empty()) bins_.assign(kBinCount, 0);
-    ++bins_[bin_of(value)];
-    ++count_;
-    if (count_ == 1) min_ = max_ = value;
-    min_ = std::min(min_, value);
-    max_ = std::max(max_, value);
-  }
-
-  size_t count() const { return count_; }
-  double max() const { return count_ > 0 ? max_ : 0.0; }
-
-  // The p-th percentile (0..100) by nearest rank (see the class); 0 for no values.
-  double percentile(double p) const {
-    if (count_ == 0) return 0.0;
-    const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count_));
-    const size_t rank =
-        std::min(count_ - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
-    size_t below = 0;
-    for (size_t bin = 0; bin < kBinCount; ++bin) {
-      below += bins_[bin];
-      if (below > rank) return std::clamp(middle_of(bin), min_, max_);
-    }
-    return max_;
-  }
-
- private:
-  static constexpr int kMantissaBits = 10;
-  static constexpr int kLowestExponent = -20;
-  static constexpr int kHighestExponent = 40;
-  static constexpr size_t kSubBins = size_t{1} << kMantissaBits;
-  // The bin below 2^kLowestExponent, kSubBins per octave, the bin from 2^kHighestExponent up.
-  static constexpr size_t kBinCount = 2 + (kHighestExponent - kLowestExponent) * kSubBins;
-
-  static size_t bin_of(double value) {
-    if (!(value < std::ldexp(1.0, kHighestExponent))) return kBinCount - 1;
-    if (value < std::ldexp(1.0, kLowestExponent)) return 0;
-    int exponent = 0;
-    const double mantissa = std::frexp(value, &exponent);  // value = mantissa * 2^exponent
-    // value in [2^(exponent - 1), 2^exponent); 2 * mantissa in [1, 2).
-    const size_t octave = clamped_integer<size_t>(exponent - 1 - kLowestExponent);
-    const size_t sub =
-        std::min(kSubBins - 1,
-                 clamped_integer<size_t>((2.0 * mantissa - 1.0) * static_cast<double>(kSubBins)));
-    return 1 + octave * kSubBins + sub;
-  }
-
-  double middle_of(size_t bin) const {
-    if (bin == 0) return std::ldexp(0.5, kLowestExponent);
-    if (bin == kBinCount - 1) return max_;
-    const size_t octave = (bin - 1) / kSubBins, sub = (bin - 1) % kSubBins;
-    return std::ldexp(1.0 + (static_cast<double>(sub) + 0.5) / static_cast<double>(kSubBins),
-                      static_cast<int>(octave) + kLowestExponent);
-  }
-
-  std::vector<uint64_t> bins_;
-  size_t count_ = 0;
-  double min_ = 0.0, max_ = 0.0;
-};
-
-// A mean kept as a sum and a count: 0 for no values.
-struct RunningMean {
-  double sum = 0.0;
-  int count = 0;
-  void add(double value) {
-    sum += value;
-    ++count;
-  }
-  double value() const { return count > 0 ? sum / count : 0.0; }
-};
 
 // The absolute angle between two yaws, in degrees, in [0, 180].
 double yaw_error_deg(float a, float b) {
@@ -221,6 +143,7 @@ struct EvaluationAccumulator::State {
   StandTurn stand_turn;
   StandTurnSums stand_turn_sums;
   float toe_height_min = std::numeric_limits<float>::infinity();
+  std::unique_ptr<GroundAccumulator> ground;
 
   bool has_pair(int left, int right) const { return left >= 0 && right >= 0; }
   bool has_hips() const { return has_pair(roles.left_upper_leg, roles.right_upper_leg); }
@@ -255,6 +178,7 @@ EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size
   for (std::vector<glm::vec3>& p : s.positions) p.assign(joint_count, glm::vec3(0.0f));
   s.desired_speed_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
   s.desired_yaw_history.assign(static_cast<size_t>(s.lookback_frames) + 1, 0.0f);
+  s.ground = std::make_unique<GroundAccumulator>(roles, dt);
 }
 
 EvaluationAccumulator::~EvaluationAccumulator() = default;
@@ -270,6 +194,14 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   s.measure_stand_turn(frame, hips_rate);
   s.measure_chest_and_head(frame);
   s.measure_transition_accel(frame);
+  GroundFrame ground;
+  ground.joints = frame.joints;
+  std::copy(std::begin(frame.toe_ground), std::end(frame.toe_ground), ground.toe_ground);
+  ground.hips_ground = frame.hips_ground;
+  std::copy(std::begin(frame.contact), std::end(frame.contact), ground.contact);
+  ground.wall_depth = frame.wall_depth;
+  ground.stuck = frame.stuck;
+  s.ground->add(ground);
   s.remember(frame);
 }
 
@@ -284,6 +216,7 @@ void EvaluationAccumulator::State::follow_origin(const EvaluationFrame& r) {
   previous.root_position -= shift;
   previous.sim_position -= shift;
   previous.origin = r.origin;
+  ground->shift(shift);
 }
 
 // Distance and facing to the simulation, timings, transitions, the responses.
@@ -505,6 +438,7 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.idle_head_speed_cm_s_mean = s.idle_head.value();
   m.idle_head_frames = s.idle_head.count;
   m.toe_height_min_cm = std::isfinite(s.toe_height_min) ? 100.0 * s.toe_height_min : 0.0;
+  m.ground = s.ground->metrics();
   return m;
 }
 
@@ -517,6 +451,7 @@ std::string csv_header(const Database& db) {
   for (const std::string& name : db.skeleton().names()) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
+  h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck");
   return h;
 }
 
@@ -536,6 +471,9 @@ std::string csv_row(const EvaluationFrame& r) {
     std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", p.x, p.y, p.z);
     row += buffer;
   }
+  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%d", r.toe_ground[0], r.toe_ground[1],
+                r.hips_ground, r.wall_depth, r.stuck ? 1 : 0);
+  row += buffer;
   return row;
 }
 
@@ -567,6 +505,82 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   return r;
 }
 
+// What the world says about each frame's pose (ground_metrics.hpp): the ground under the toes
+// and the hips, the deepest joint inside a wall, whether the simulation object was stuck. Its
+// buffers are sized once; without a world it leaves the frame's flat-ground defaults.
+class WorldReadings {
+ public:
+  WorldReadings(const WorldQueries* world, const JointRoleIndices& roles, size_t joints)
+      : world_(world), roles_(roles), sweeps_(joints), hits_(joints), joints_(joints) {
+    toes_[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
+    toes_[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+  }
+
+  void read(const Controller& controller, float dt, EvaluationFrame& r) {
+    if (!world_) return;
+    const ControllerDebug& d = controller.debug();
+    read_ground(d, r);
+    read_walls(controller, d, r);
+    const float moved = horizontal_distance(d.simulation_position, previous_sim_) / dt;
+    const glm::vec3 along =
+        r.desired_velocity -
+        d.simulation_contact * glm::dot(r.desired_velocity, d.simulation_contact);
+    r.stuck = d.simulation_blocked && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed;
+    previous_sim_ = d.simulation_position;
+  }
+
+ private:
+  // The toes' and hips' ground, probed from a metre above them (a joint with no ground under it
+  // within 3 m takes the ground under the root).
+  void read_ground(const ControllerDebug& d, EvaluationFrame& r) {
+    const int joints[3] = {toes_[0], toes_[1], roles_.hips};
+    GroundProbe probes[3];
+    GroundHit hits[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3 p =
+          joints[k] >= 0 ? r.joints[static_cast<size_t>(joints[k])] : r.root_position;
+      probes[k] = GroundProbe{p + glm::vec3(0.0f, 1.0f, 0.0f), 3.0f, 0.0f};
+    }
+    world_->probe_ground(r.origin, probes, hits);
+    float* out[3] = {&r.toe_ground[0], &r.toe_ground[1], &r.hips_ground};
+    for (int k = 0; k < 3; ++k) {
+      *out[k] = hits[k].hit && std::isfinite(hits[k].point.y) ? hits[k].point.y : d.ground_height;
+    }
+  }
+
+  // The deepest any joint higher than a step above the ground is inside a wall: a small sphere
+  // swept from above the root, at the joint's height, to the joint; what lies beyond the first
+  // contact is inside. Lower joints meet the ground's slopes and steps, not walls, and are the
+  // penetration metrics' to judge.
+  void read_walls(const Controller& controller, const ControllerDebug& d, EvaluationFrame& r) {
+    constexpr float kRadius = 0.01f;
+    const float above = d.ground_height + controller.settings().step_height;
+    size_t count = 0;
+    for (size_t j = 1; j < joints_; ++j) {
+      const glm::vec3& p = r.joints[j];
+      if (p.y < above || horizontal_distance(p, r.root_position) < 1e-4f) continue;
+      const glm::vec3 from(r.root_position.x, p.y - kRadius, r.root_position.z);
+      sweeps_[count++] = ShapeSweep{from, glm::vec3(p.x, p.y - kRadius, p.z), kRadius, 2 * kRadius};
+    }
+    if (count == 0) return;
+    world_->sweep(r.origin, std::span(sweeps_).first(count), std::span(hits_).first(count));
+    for (size_t k = 0; k < count; ++k) {
+      if (!hits_[k].hit || !std::isfinite(hits_[k].fraction)) continue;
+      const float length = horizontal_distance(sweeps_[k].to, sweeps_[k].from);
+      r.wall_depth =
+          std::max(r.wall_depth, (1.0f - std::clamp(hits_[k].fraction, 0.0f, 1.0f)) * length);
+    }
+  }
+
+  const WorldQueries* world_;
+  JointRoleIndices roles_;
+  int toes_[2] = {-1, -1};
+  std::vector<ShapeSweep> sweeps_;
+  std::vector<SweepHit> hits_;
+  size_t joints_ = 0;
+  glm::vec3 previous_sim_{0.0f};
+};
+
 // The transition figures against the database's own acceleration at the same dt.
 void compare_with_database(const ControllerDatabase& database, const EvaluationOptions& options,
                            EvaluationMetrics& m) {
@@ -582,6 +596,13 @@ void compare_with_database(const ControllerDatabase& database, const EvaluationO
       m.database_accel_p99_same_sampling > 0.0
           ? m.transition_accel_p99 / m.database_accel_p99_same_sampling
           : 0.0;
+}
+
+// The database's own geometric skating at the run's dt, over every clip: a run plays
+// locomotion, actions and idle alike, and its standing frames count as the data's do.
+void compare_skating_with_database(const ControllerDatabase& database, float dt,
+                                   EvaluationMetrics& m) {
+  m.foot_skate_geom_data_cm_s_mean = database_geometric_skate(database.database(), dt, 0);
 }
 
 }  // namespace
@@ -637,6 +658,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   Result<Controller> made = Controller::create(database, options.settings);
   if (!made) return Error{made.message()};
   Controller& controller = *made;
+  controller.set_world(options.world);
   // A controller is created at the world origin; only a start elsewhere is a teleport, so a
   // run from the origin is the same run it always was.
   if (options.start != glm::dvec2(0.0)) {
@@ -648,6 +670,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   if (options.dump) *options.dump << csv_header(db) << "\n";
   EvaluationAccumulator accumulator(db.roles(), joints, dt);
   std::vector<glm::vec3> positions(joints);
+  WorldReadings world(options.world, db.roles(), joints);
   using Clock = std::chrono::steady_clock;
   for (int f = 0; f < *frame_count; ++f) {
     const float t = static_cast<float>(f + 1) * dt;
@@ -655,7 +678,8 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     const Clock::time_point start = Clock::now();
     controller.update(dt, input);
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    const EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
+    EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
+    world.read(controller, dt, frame);
     accumulator.add(frame);
     if (options.dump) *options.dump << csv_row(frame) << "\n";
     if (options.on_frame) options.on_frame(frame);
@@ -663,6 +687,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   EvaluationResult result;
   result.metrics = accumulator.metrics();
   compare_with_database(*database, options, result.metrics);
+  compare_skating_with_database(*database, dt, result.metrics);
   return result;
 }
 

@@ -163,8 +163,9 @@ struct RunColumns {
   size_t joints = 0;
   std::vector<double> t, positions, root, root_yaw, simulation, simulation_yaw;
   std::vector<double> desired_velocity, desired_yaw;
-  std::vector<uint8_t> transition, contacts;
+  std::vector<uint8_t> transition, contacts, stuck;
   std::vector<int32_t> clip, frame;
+  std::vector<double> toe_ground, hips_ground, wall_depth;
 
   static void push(std::vector<double>& out, const glm::dvec3& p) {
     out.insert(out.end(), {p.x, p.y, p.z});
@@ -183,6 +184,10 @@ struct RunColumns {
     contacts.insert(contacts.end(), {uint8_t{r.contact[0]}, uint8_t{r.contact[1]}});
     clip.push_back(r.clip);
     frame.push_back(r.frame);
+    toe_ground.insert(toe_ground.end(), {r.toe_ground[0], r.toe_ground[1]});
+    hips_ground.push_back(r.hips_ground);
+    wall_depth.push_back(r.wall_depth);
+    stuck.push_back(r.stuck ? 1 : 0);
   }
 
   py::dict arrays() && {
@@ -201,6 +206,10 @@ struct RunColumns {
     out["contacts"] = take(std::move(contacts), {n, 2}).attr("astype")("bool");
     out["clip"] = take(std::move(clip), {n});
     out["frame"] = take(std::move(frame), {n});
+    out["toe_ground"] = take(std::move(toe_ground), {n, 2});
+    out["hips_ground"] = take(std::move(hips_ground), {n});
+    out["wall_depth"] = take(std::move(wall_depth), {n});
+    out["stuck"] = take(std::move(stuck), {n}).attr("astype")("bool");
     return out;
   }
 };
@@ -247,7 +256,8 @@ void bind_runs(py::module_& m) {
         "returns every frame as numpy arrays: t (frames,), positions (frames, joints, 3) world "
         "metres, root and simulation (frames, 3) with root_yaw_deg and simulation_yaw_deg, "
         "desired_velocity (frames, 3) and desired_yaw_deg, transition (frames,) and contacts "
-        "(frames, 2) bool, clip and frame (frames,) int32: the columns of mm eval --dump.");
+        "(frames, 2) bool, clip and frame (frames,) int32, toe_ground (frames, 2), hips_ground and "
+        "wall_depth (frames,) metres and stuck (frames,) bool: the columns of mm eval --dump.");
   m.def("evaluate", &evaluate, py::arg("database"), py::arg("script"),
         py::arg("dt") = kDefaultRunDt, py::arg("ik") = true, py::arg("seconds") = 0.0f,
         py::arg("start") = std::pair<double, double>{0.0, 0.0},

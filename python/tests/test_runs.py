@@ -53,6 +53,11 @@ def test_run_script_equals_the_command_line_dump(database, database_path, mm_too
     assert np.array_equal(run["contacts"][:, 1], dump["contact_r"] == 1)
     assert np.array_equal(run["clip"], dump["clip"].astype(np.int32))
     assert np.array_equal(run["frame"], dump["frame"].astype(np.int32))
+    np.testing.assert_allclose(run["toe_ground"][:, 0], dump["toe_ground_l"], **close)
+    np.testing.assert_allclose(run["toe_ground"][:, 1], dump["toe_ground_r"], **close)
+    np.testing.assert_allclose(run["hips_ground"], dump["hips_ground"], **close)
+    np.testing.assert_allclose(run["wall_depth"], dump["wall_depth"], **close)
+    assert np.array_equal(run["stuck"], dump["stuck"] == 1)
     positions = run["positions"]
     assert positions.shape == (frames, database.joint_count, 3)
     for j, name in enumerate(database.joint_names):

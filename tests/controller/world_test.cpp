@@ -12,6 +12,7 @@
 #include "analytic_world.hpp"
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/programs/evaluation.hpp"
 #include "mm/runtime/finite.hpp"
 
 namespace mm {
@@ -174,6 +175,57 @@ TEST(ControllerWorld, TheWorldSettingsAreCheckedAndSetByName) {
   EXPECT_EQ(settings.validate().message(),
             "controller settings: max_slope must be a number in [0.000000, 1.500000], found "
             "2.000000");
+}
+
+}  // namespace
+}  // namespace mm
+
+namespace mm {
+namespace {
+
+// mm eval's metrics in a world (ground_metrics.hpp): measured against the world's ground, they
+// read on a level what they read on the flat plane where the level is flat.
+TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
+  const auto shared = test::normal_controller_database();
+  InputScript script(
+      {ScriptEvent{0.0f, push_toward(0.0f), ""}, ScriptEvent{8.0f, ControllerInput{}, ""}});
+  EvaluationOptions flat_options;
+  flat_options.seconds = 10.0f;
+  const Result<EvaluationResult> flat = evaluate_script(shared, script, flat_options);
+  ASSERT_TRUE(flat.ok()) << flat.message();
+
+  AnalyticWorld raised;  // the same flat ground, a metre up
+  raised.height = [](double, double) { return 1.0; };
+  EvaluationOptions options = flat_options;
+  options.world = &raised;
+  const Result<EvaluationResult> up = evaluate_script(shared, script, options);
+  ASSERT_TRUE(up.ok()) << up.message();
+  const GroundMetrics& a = flat->metrics.ground;
+  const GroundMetrics& b = up->metrics.ground;
+  EXPECT_NEAR(b.hips_height_cm_mean, a.hips_height_cm_mean, 0.5);
+  EXPECT_NEAR(b.toe_clearance_cm_min, a.toe_clearance_cm_min, 0.5);
+  EXPECT_NEAR(b.foot_skate_geom_cm_s_mean, a.foot_skate_geom_cm_s_mean, 0.5);
+  EXPECT_GT(a.hips_height_cm_mean, 70.0);
+  EXPECT_EQ(b.wall_depth_cm_max, 0.0);
+  EXPECT_EQ(b.stuck_s, 0.0);
+
+  AnalyticWorld walled;
+  walled.boxes.push_back(wall_across_z(4.0f));
+  options.world = &walled;
+  const Result<EvaluationResult> wall = evaluate_script(shared, script, options);
+  ASSERT_TRUE(wall.ok()) << wall.message();
+  // Head-on there is nothing to slide along: never stuck; and no joint more than 2 cm into the
+  // wall.
+  EXPECT_EQ(wall->metrics.ground.stuck_s, 0.0);
+  EXPECT_LT(wall->metrics.ground.wall_depth_cm_max, 2.0);
+
+  // A wall through the character where it stands: the depth is seen.
+  AnalyticWorld through;
+  through.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 0.3f), glm::vec2(2.0f, 0.15f), 0.0f, 3.0f});
+  options.world = &through;
+  const Result<EvaluationResult> inside = evaluate_script(shared, script, options);
+  ASSERT_TRUE(inside.ok()) << inside.message();
+  EXPECT_GT(inside->metrics.ground.wall_depth_cm_max, 2.0);
 }
 
 }  // namespace

@@ -67,8 +67,9 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
   app.add_option(
          "--dump", out.dump_path,
          "one CSV row per frame (one script only): t, simulation, root, desired motion, "
-         "transition, contacts, the playing clip (index) and database frame, then every joint's "
-         "global position")
+         "transition, contacts, the playing clip (index) and database frame, every joint's "
+         "global position, then the ground under the toes and the hips, the wall depth (m) "
+         "and whether the simulation was stuck")
       ->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (const auto start = parse_number_pair(out.start)) {
@@ -101,19 +102,21 @@ void print_table_row(const std::string& name, const EvaluationMetrics& m) {
 
 // The body metrics of issue 17, a second table: the first has no room left.
 void print_body_table_header() {
-  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "turn99", "turnmax",
-              "pivot", "sturns", "unsettl", "sturn_s", "sturn_e", "sturn_r", "strafe", "idlehd",
-              "toemin");
-  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "deg/s", "deg/s", "deg/s",
-              "", "", "s", "deg", "deg/s", "deg", "cm/s", "cm");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "script", "turn99",
+              "turnmax", "pivot", "sturns", "unsettl", "sturn_s", "sturn_e", "sturn_r", "strafe",
+              "idlehd", "toemin", "geomsk", "geomdat");
+  std::printf("%-22s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s\n", "", "deg/s", "deg/s",
+              "deg/s", "", "", "s", "deg", "deg/s", "deg", "cm/s", "cm", "cm/s", "cm/s");
 }
 
 void print_body_table_row(const std::string& name, const EvaluationMetrics& m) {
-  std::printf("%-22s %7.1f %7.1f %7.2f %7d %7d %7.3f %7.2f %7.1f %7.2f %7.3f %7.2f\n", name.c_str(),
-              m.body_turn_rate_deg_s_p99, m.body_turn_rate_deg_s_max, m.foot_pivot_deg_s_mean,
-              m.stand_turns, m.stand_turn_unsettled, m.stand_turn_response_s,
-              m.stand_turn_final_error_deg_mean, m.stand_turn_peak_rate_deg_s_max,
-              m.strafe_chest_error_deg_mean, m.idle_head_speed_cm_s_mean, m.toe_height_min_cm);
+  std::printf("%-22s %7.1f %7.1f %7.2f %7d %7d %7.3f %7.2f %7.1f %7.2f %7.3f %7.2f %7.2f %7.2f\n",
+              name.c_str(), m.body_turn_rate_deg_s_p99, m.body_turn_rate_deg_s_max,
+              m.foot_pivot_deg_s_mean, m.stand_turns, m.stand_turn_unsettled,
+              m.stand_turn_response_s, m.stand_turn_final_error_deg_mean,
+              m.stand_turn_peak_rate_deg_s_max, m.strafe_chest_error_deg_mean,
+              m.idle_head_speed_cm_s_mean, m.toe_height_min_cm, m.ground.foot_skate_geom_cm_s_mean,
+              m.foot_skate_geom_data_cm_s_mean);
 }
 
 void print_body_metrics(const EvaluationMetrics& m) {
@@ -131,6 +134,25 @@ void print_body_metrics(const EvaluationMetrics& m) {
   std::printf("idle_head_speed_cm_s_mean   %10.3f   (%d idle frames)\n",
               m.idle_head_speed_cm_s_mean, m.idle_head_frames);
   std::printf("toe_height_min_cm           %10.3f\n", m.toe_height_min_cm);
+}
+
+// Feet and body against the ground (ground_metrics.hpp).
+void print_ground_metrics(const EvaluationMetrics& m) {
+  const GroundMetrics& g = m.ground;
+  std::printf("foot_skate_geom_cm_s_mean   %10.3f   (%d toe frames; the data's own %.3f)\n",
+              g.foot_skate_geom_cm_s_mean, g.foot_skate_geom_frames,
+              m.foot_skate_geom_data_cm_s_mean);
+  std::printf("toe_clearance_cm_min        %10.3f   (p1 %.3f)\n", g.toe_clearance_cm_min,
+              g.toe_clearance_cm_p1);
+  std::printf("foot_penetration_cm_mean    %10.3f   (max %.3f)\n", g.foot_penetration_cm_mean,
+              g.foot_penetration_cm_max);
+  std::printf("foot_float_cm_mean          %10.3f\n", g.foot_float_cm_mean);
+  std::printf("hips_height_cm_mean         %10.3f   (std %.3f)\n", g.hips_height_cm_mean,
+              g.hips_height_cm_std);
+  std::printf("hips_vertical_accel_p99_m_s2 %9.3f\n", g.hips_vertical_accel_p99_m_s2);
+  std::printf("knee_overextension_frames   %10d\n", g.knee_overextension_frames);
+  std::printf("wall_depth_cm_max           %10.3f\n", g.wall_depth_cm_max);
+  std::printf("stuck_s                     %10.3f\n", g.stuck_s);
 }
 
 void print_metrics(const EvaluationMetrics& m) {
@@ -155,6 +177,7 @@ void print_metrics(const EvaluationMetrics& m) {
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
   print_body_metrics(m);
+  print_ground_metrics(m);
 }
 
 int run_eval(const std::vector<std::string>& args) {

@@ -67,10 +67,10 @@ class CharacterMover {
   MoveResult move(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
                   const glm::vec3& start, const glm::vec3& goal);
 
-  // The ground under `position`, probed from step_height above it down to max_step_down below
-  // it; false when there is no walkable ground within reach.
+  // The walkable ground under `position`, probed from `above` metres above it down to
+  // max_step_down below it; false when there is none within reach.
   bool ground(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
-              const glm::vec3& position, GroundHit& hit);
+              const glm::vec3& position, float above, GroundHit& hit);
 
   // Answers ignored because they failed the checks (world.hpp), since creation.
   int64_t rejected() const { return rejected_; }

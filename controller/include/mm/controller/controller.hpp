@@ -356,8 +356,10 @@ class Controller {
 
   // Places the character and its simulation object (cold; clears any transition).
   void teleport(const glm::vec3& position, float yaw);
-  // The same from a double-precision world position (only x and z count: the ground is y = 0);
-  // also moves origin() to the character.
+  // The same from a double-precision world position (only x and z count on the flat plane; in a
+  // world, the character stands on the highest walkable ground from character_height above
+  // the position's height down to max_step_down below it); also moves origin() to the
+  // character.
   void teleport_world(const glm::dvec3& position, float yaw);
 
   // Global (model = world) transforms of every database joint after the last update, in float:

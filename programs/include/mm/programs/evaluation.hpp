@@ -78,6 +78,9 @@
 //   them;
 // - toe_height_min_cm: the lowest height either toe joint reaches over the run (the foot joint
 //   where a side has no toe role, as for foot skating), every frame; 0 for no frames.
+// - the ground metrics (foot_skate_geom_cm_s_mean, toe clearance, penetration and float, the
+//   hips' height and vertical acceleration, straight knees, wall depth, time stuck): defined in
+//   ground_metrics.hpp, measured against the world's ground when the run has a world.
 // "Has not changed for S seconds": the value has stayed within a tolerance (kFacingTolerance
 // for the desired facing, kVelocityTolerance as a vector for the desired velocity) of the value
 // it was last held at for at least S seconds, counting this frame's dt (as the stand time
@@ -95,7 +98,9 @@
 
 #include "mm/controller/controller.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/controller/world.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "mm/programs/ground_metrics.hpp"
 #include "mm/runtime/result.hpp"
 
 namespace mm {
@@ -167,6 +172,10 @@ struct EvaluationMetrics {
   double idle_head_speed_cm_s_mean = 0.0;
   int idle_head_frames = 0;
   double toe_height_min_cm = 0.0;
+  // Feet and body against the ground (ground_metrics.hpp), and the database's own geometric
+  // skating at the run's dt, the floor foot_skate_geom_cm_s_mean is read against.
+  GroundMetrics ground;
+  double foot_skate_geom_data_cm_s_mean = 0.0;
   int frames = 0;
   double seconds = 0.0;
 };
@@ -191,6 +200,13 @@ struct EvaluationFrame {
   double search_seconds = 0.0;
   // Every joint's global position, indexed like the skeleton; read during add() only.
   std::span<const glm::vec3> joints;
+  // The ground under the toes (left, right) and the hips (world y; 0 on the flat plane), the
+  // deepest a joint is inside a wall (m) and whether the simulation object was stuck
+  // (ground_metrics.hpp; from the world, else 0 and false).
+  float toe_ground[2] = {0.0f, 0.0f};
+  float hips_ground = 0.0f;
+  float wall_depth = 0.0f;
+  bool stuck = false;
 };
 
 // The metrics of a run, fed one frame at a time. Holds the previous frames it needs, running
@@ -224,6 +240,9 @@ struct EvaluationOptions {
   // run may take at most kMaxRunFrames updates (script.hpp).
   float seconds = 0.0f;
   ControllerSettings settings;
+  // The game's world the controller runs in (world.hpp; not owned), and the ground metrics are
+  // measured against; null: the flat plane.
+  const WorldQueries* world = nullptr;
   // Where the character stands at t = 0 (world x and z, metres; `mm eval --start X,Z`), facing
   // +Z. The dump's positions are world positions, so they include it.
   glm::dvec2 start{0.0};

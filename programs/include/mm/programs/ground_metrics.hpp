@@ -1,0 +1,103 @@
+#pragma once
+// The metrics of feet and body against the ground (issues 28 and 29), for `mm eval`: on the flat
+// plane the ground is y = 0; in a world (EvaluationOptions::world) it is what the world's ground
+// probe finds under each joint. Fed one frame at a time, like EvaluationAccumulator, which owns
+// one and reports its metrics with the others.
+//
+// Definitions (heights relative to the ground under the joint; "planted by geometry": a toe
+// below kGeomPlantedHeight above its ground and horizontally slower than kGeomPlantedSpeed, on
+// this frame and the previous one):
+// - foot_skate_geom_cm_s_mean: the horizontal speed of planted-by-geometry toes, over both
+//   feet; unlike foot_skate_cm_s_mean it does not trust the contact labels, so it sees a foot
+//   that slides while its label is off (beside it, the database's own value under the same
+//   rule at the run's time step: foot_skate_geom_data_cm_s_mean, evaluation.hpp);
+// - toe_clearance_cm_min / _p1: the lower toe's height above its ground, every frame (nearest
+//   rank percentile);
+// - foot_penetration_cm_mean / _max: how deep a toe is below its ground (0 when above), over
+//   every frame and both toes (PhysDiff's penetration);
+// - foot_float_cm_mean: the height above its ground of a toe whose contact label is on
+//   (PhysDiff's float: a planted foot hovering);
+// - hips_height_cm_mean / _std: the hips' height above the ground under them;
+//   hips_vertical_accel_p99_m_s2: the p99 of the hips' vertical acceleration (second
+//   differences of their height above the world's y = 0);
+// - knee_overextension_frames: frames where either knee (upper leg, lower leg, foot) is within
+//   kStraightKneeDegrees of straight;
+// - wall_depth_cm_max: the deepest any joint is inside a wall (EvaluationFrame::wall_depth,
+//   from the world's sweeps; 0 without a world);
+// - stuck_s: time the simulation object was blocked while the stick pushed at least
+//   kStuckAlongSpeed along the obstacle and it moved slower than kStuckSpeed: stuck where it
+//   could have slid.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include <glm/glm.hpp>
+
+#include "mm/database/database.hpp"
+#include "mm/database/joint_roles.hpp"
+
+namespace mm {
+
+inline constexpr float kGeomPlantedHeight = 0.06f;  // m
+inline constexpr float kGeomPlantedSpeed = 0.35f;   // m/s, horizontal
+inline constexpr float kStraightKneeDegrees = 1.0f;
+inline constexpr float kStuckAlongSpeed = 0.2f;  // m/s of desired velocity along the obstacle
+inline constexpr float kStuckSpeed = 0.05f;      // m/s
+
+struct GroundMetrics {
+  double foot_skate_geom_cm_s_mean = 0.0;
+  int foot_skate_geom_frames = 0;  // toe samples counted
+  double toe_clearance_cm_min = 0.0;
+  double toe_clearance_cm_p1 = 0.0;
+  double foot_penetration_cm_mean = 0.0;
+  double foot_penetration_cm_max = 0.0;
+  double foot_float_cm_mean = 0.0;
+  double hips_height_cm_mean = 0.0;
+  double hips_height_cm_std = 0.0;
+  double hips_vertical_accel_p99_m_s2 = 0.0;
+  int knee_overextension_frames = 0;
+  double wall_depth_cm_max = 0.0;
+  double stuck_s = 0.0;
+};
+
+// What one frame gives the ground metrics: joint positions (world y; any horizontal frame, as
+// long as consecutive frames share it), the ground's height under the toes and the hips, the
+// contact labels, and from the world the wall depth and whether the simulation was stuck.
+struct GroundFrame {
+  std::span<const glm::vec3> joints;
+  float toe_ground[2] = {0.0f, 0.0f};  // left, right
+  float hips_ground = 0.0f;
+  bool contact[2] = {false, false};
+  float wall_depth = 0.0f;  // m
+  bool stuck = false;
+};
+
+class GroundAccumulator {
+ public:
+  GroundAccumulator(const JointRoleIndices& roles, float dt);
+  ~GroundAccumulator();
+  GroundAccumulator(const GroundAccumulator&) = delete;
+  GroundAccumulator& operator=(const GroundAccumulator&) = delete;
+
+  void add(const GroundFrame& frame);
+  // The horizontal frame moved by `by` (a rebased origin): what is kept of the previous frame
+  // moves with it.
+  void shift(const glm::vec3& by);
+  GroundMetrics metrics() const;
+
+  // The toe (or foot where a side has no toe) joint of each side, -1 for none.
+  int toe(int side) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// The database's own geometric skating: every clip that carries none of `excluded_tags` played
+// straight through at `dt` (linear interpolation between frames, as database_acceleration_p99)
+// on the flat ground, under the rule above (cm/s).
+double database_geometric_skate(const Database& db, float dt, uint64_t excluded_tags);
+
+}  // namespace mm

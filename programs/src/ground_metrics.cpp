@@ -1,0 +1,195 @@
+// Feet and body against the ground (definitions in ground_metrics.hpp).
+
+#include "mm/programs/ground_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mm/database/sampling.hpp"
+#include "mm/runtime/float_to_integer.hpp"
+#include "mm/runtime/pose.hpp"
+#include "statistics.hpp"
+
+namespace mm {
+
+using detail::LinearHistogram;
+using detail::PercentileHistogram;
+using detail::RunningMean;
+
+namespace {
+
+// A toe planted by geometry on two consecutive frames (ground_metrics.hpp), and its speed.
+struct GeomPlant {
+  bool low_and_slow[2] = {false, false};  // on the previous frame
+  RunningMean speed_cm_s;
+
+  // `height` above its ground now, `speed` horizontally (m/s) from the previous frame.
+  void add(int side, float height, float speed) {
+    const bool now = height < kGeomPlantedHeight && speed < kGeomPlantedSpeed;
+    if (now && low_and_slow[side]) speed_cm_s.add(100.0 * speed);
+    low_and_slow[side] = now;
+  }
+};
+
+float horizontal_speed(const glm::vec3& now, const glm::vec3& before, float dt) {
+  return std::hypot(now.x - before.x, now.z - before.z) / dt;
+}
+
+// The knee's angle away from straight (degrees): 180 minus the angle at the knee between the
+// thigh and the shin.
+double knee_bend_deg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec3& ankle) {
+  const glm::vec3 thigh = hip - knee, shin = ankle - knee;
+  const float lengths = glm::length(thigh) * glm::length(shin);
+  if (lengths <= 0.0f) return 180.0;
+  const double cosine = std::clamp(glm::dot(thigh, shin) / lengths, -1.0f, 1.0f);
+  return 180.0 - glm::degrees(std::acos(cosine));
+}
+
+}  // namespace
+
+struct GroundAccumulator::State {
+  JointRoleIndices roles;
+  float dt = 0.0f;
+  int toes[2] = {-1, -1};
+  int frames = 0;
+  std::vector<glm::vec3> previous_toes = std::vector<glm::vec3>(2);
+  float hips_heights[2] = {0.0f, 0.0f};  // the hips' world y, two and one frames back
+
+  GeomPlant plant;
+  float clearance_min = INFINITY;
+  LinearHistogram clearance{-100.0, 100.0, 4000};  // cm: 0.5 mm bins over +-1 m
+  RunningMean penetration, floating, hips_height;
+  double penetration_max = 0.0;
+  double hips_height_squares = 0.0;
+  PercentileHistogram hips_accelerations;
+  int straight_knees = 0;
+  double wall_depth_max = 0.0;
+  int stuck_frames = 0;
+};
+
+GroundAccumulator::GroundAccumulator(const JointRoleIndices& roles, float dt)
+    : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.roles = roles;
+  s.dt = dt;
+  s.toes[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
+  s.toes[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+}
+
+GroundAccumulator::~GroundAccumulator() = default;
+
+void GroundAccumulator::shift(const glm::vec3& by) {
+  for (glm::vec3& toe : state_->previous_toes) toe -= by;
+}
+
+int GroundAccumulator::toe(int side) const {
+  return state_->toes[side != 0 ? 1 : 0];
+}
+
+void GroundAccumulator::add(const GroundFrame& r) {
+  State& s = *state_;
+  float lowest = INFINITY;
+  for (int side = 0; side < 2; ++side) {
+    if (s.toes[side] < 0) continue;
+    const glm::vec3& toe = r.joints[static_cast<size_t>(s.toes[side])];
+    const float height = toe.y - r.toe_ground[side];
+    lowest = std::min(lowest, height);
+    s.penetration.add(100.0 * std::max(0.0f, -height));
+    s.penetration_max = std::max(s.penetration_max, 100.0 * std::max(0.0f, -height));
+    if (r.contact[side]) s.floating.add(100.0 * std::max(0.0f, height));
+    if (s.frames > 0) s.plant.add(side, height, horizontal_speed(toe, s.previous_toes[side], s.dt));
+    s.previous_toes[side] = toe;
+  }
+  if (std::isfinite(lowest)) {
+    s.clearance_min = std::min(s.clearance_min, lowest);
+    s.clearance.add(100.0 * lowest);
+  }
+  const JointRoleIndices& roles = s.roles;
+  if (roles.hips >= 0) {
+    const float y = r.joints[static_cast<size_t>(roles.hips)].y;
+    const double height = 100.0 * (y - r.hips_ground);
+    s.hips_height.add(height);
+    s.hips_height_squares += height * height;
+    if (s.frames >= 2) {
+      s.hips_accelerations.add(std::abs(y - 2.0f * s.hips_heights[1] + s.hips_heights[0]) /
+                               (s.dt * s.dt));
+    }
+    s.hips_heights[0] = s.hips_heights[1];
+    s.hips_heights[1] = y;
+  }
+  const int legs[2][3] = {{roles.left_upper_leg, roles.left_lower_leg, roles.left_foot},
+                          {roles.right_upper_leg, roles.right_lower_leg, roles.right_foot}};
+  bool straight = false;
+  for (const auto& leg : legs) {
+    if (leg[0] < 0 || leg[1] < 0 || leg[2] < 0) continue;
+    straight =
+        straight ||
+        knee_bend_deg(r.joints[static_cast<size_t>(leg[0])], r.joints[static_cast<size_t>(leg[1])],
+                      r.joints[static_cast<size_t>(leg[2])]) < kStraightKneeDegrees;
+  }
+  s.straight_knees += straight ? 1 : 0;
+  s.wall_depth_max = std::max(s.wall_depth_max, 100.0 * r.wall_depth);
+  s.stuck_frames += r.stuck ? 1 : 0;
+  ++s.frames;
+}
+
+GroundMetrics GroundAccumulator::metrics() const {
+  const State& s = *state_;
+  GroundMetrics m;
+  m.foot_skate_geom_cm_s_mean = s.plant.speed_cm_s.value();
+  m.foot_skate_geom_frames = s.plant.speed_cm_s.count;
+  m.toe_clearance_cm_min = std::isfinite(s.clearance_min) ? 100.0 * s.clearance_min : 0.0;
+  m.toe_clearance_cm_p1 = s.clearance.percentile(1.0);
+  m.foot_penetration_cm_mean = s.penetration.value();
+  m.foot_penetration_cm_max = s.penetration_max;
+  m.foot_float_cm_mean = s.floating.value();
+  m.hips_height_cm_mean = s.hips_height.value();
+  if (s.hips_height.count > 0) {
+    const double mean = s.hips_height.value();
+    m.hips_height_cm_std =
+        std::sqrt(std::max(0.0, s.hips_height_squares / s.hips_height.count - mean * mean));
+  }
+  m.hips_vertical_accel_p99_m_s2 = s.hips_accelerations.percentile(99.0);
+  m.knee_overextension_frames = s.straight_knees;
+  m.wall_depth_cm_max = s.wall_depth_max;
+  m.stuck_s = s.stuck_frames * static_cast<double>(s.dt);
+  return m;
+}
+
+double database_geometric_skate(const Database& db, float dt, uint64_t excluded_tags) {
+  if (!(dt > 0.0f)) return 0.0;
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const int toes[2] = {db.roles().left_toe >= 0 ? db.roles().left_toe : db.roles().left_foot,
+                       db.roles().right_toe >= 0 ? db.roles().right_toe : db.roles().right_foot};
+  std::vector<Transform> local(joints), global(joints);
+  GeomPlant plant;
+  for (const ClipRange& clip : db.clips()) {
+    if (clip.tags & excluded_tags) continue;
+    const float duration = static_cast<float>(clip.frame_count() - 1) * db.frame_time();
+    const int64_t steps = clamped_integer<int64_t>(std::floor(duration / dt)) + 1;
+    glm::vec3 previous[2];
+    for (int64_t step = 0; step < steps; ++step) {
+      const float x = static_cast<float>(step) * dt / db.frame_time();
+      const int i0 = std::min(clamped_integer<int>(std::floor(x)), clip.frame_count() - 1);
+      const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+      for (size_t j = 0; j < joints; ++j) {
+        local[j] =
+            sample_database_joint(db, clip.start + i0, clip.start + i1, x - static_cast<float>(i0),
+                                  j, false, InterpolationMethod::Nlerp);
+      }
+      forward_kinematics(db.skeleton().parents(), local, global);
+      for (int side = 0; side < 2; ++side) {
+        if (toes[side] < 0) continue;
+        const glm::vec3 toe = global[static_cast<size_t>(toes[side])].translation;
+        // A clip's first step has no previous one: not low and slow, so it starts no sample.
+        plant.add(side, step == 0 ? INFINITY : toe.y,
+                  step == 0 ? 0.0f : horizontal_speed(toe, previous[side], dt));
+        previous[side] = toe;
+      }
+    }
+  }
+  return plant.speed_cm_s.value();
+}
+
+}  // namespace mm

@@ -1,0 +1,139 @@
+// The ground metrics (ground_metrics.hpp) on synthetic frames whose answers are known.
+
+#include "mm/programs/ground_metrics.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace mm {
+namespace {
+
+// Joints: 0 root, 1 hips, 2 left upper leg, 3 left lower leg, 4 left foot, 5 left toe, 6 right
+// toe (the right leg has no knee: it never counts as straight).
+constexpr size_t kJoints = 7;
+constexpr float kDt = 0.1f;
+
+JointRoleIndices roles() {
+  JointRoleIndices r;
+  r.hips = 1;
+  r.left_upper_leg = 2;
+  r.left_lower_leg = 3;
+  r.left_foot = 4;
+  r.left_toe = 5;
+  r.right_toe = 6;
+  return r;
+}
+
+// A bent left leg, both toes at `toe_y`, the left toe at x = left_x.
+std::vector<glm::vec3> pose(float left_x, float toe_y, float hips_y = 0.9f) {
+  return {glm::vec3(0.0f),
+          glm::vec3(0.0f, hips_y, 0.0f),
+          glm::vec3(0.1f, 0.9f, 0.0f),
+          glm::vec3(0.1f, 0.5f, 0.1f),
+          glm::vec3(0.1f, 0.1f, 0.0f),
+          glm::vec3(left_x, toe_y, 0.1f),
+          glm::vec3(-0.1f, toe_y, 0.1f)};
+}
+
+TEST(GroundMetrics, GeometricSkatingCountsLowSlowToesWhateverTheirLabels) {
+  GroundAccumulator a(roles(), kDt);
+  // The left toe slides at 0.2 m/s, 2 cm up, for 10 frames; the right one stands still.
+  for (int f = 0; f < 10; ++f) {
+    const std::vector<glm::vec3> joints = pose(0.02f * f, 0.02f);
+    GroundFrame frame;
+    frame.joints = joints;
+    a.add(frame);
+  }
+  // Then the left toe too fast (0.5 m/s) and the right toe too high (7 cm): nothing counts.
+  for (int f = 10; f < 15; ++f) {
+    const std::vector<glm::vec3> joints = pose(0.2f + 0.05f * (f - 10), 0.07f);
+    GroundFrame frame;
+    frame.joints = joints;
+    a.add(frame);
+  }
+  const GroundMetrics m = a.metrics();
+  // Frames 2..9 have both toes low and slow now and before: 8 samples each.
+  EXPECT_EQ(m.foot_skate_geom_frames, 16);
+  EXPECT_NEAR(m.foot_skate_geom_cm_s_mean, (8 * 20.0 + 8 * 0.0) / 16, 1e-3);
+}
+
+TEST(GroundMetrics, ClearancePenetrationAndFloatAreAgainstTheGroundUnderEachToe) {
+  GroundAccumulator a(roles(), kDt);
+  const float toe_heights[4] = {0.52f, 0.49f, 0.55f, 0.53f};  // over ground at 0.5
+  for (int f = 0; f < 4; ++f) {
+    const std::vector<glm::vec3> joints = pose(0.0f, toe_heights[f]);
+    GroundFrame frame;
+    frame.joints = joints;
+    frame.toe_ground[0] = frame.toe_ground[1] = 0.5f;
+    frame.contact[0] = f == 2;  // a planted toe 5 cm up: floating
+    a.add(frame);
+  }
+  const GroundMetrics m = a.metrics();
+  EXPECT_NEAR(m.toe_clearance_cm_min, -1.0, 1e-3);
+  EXPECT_NEAR(m.toe_clearance_cm_p1, -1.0, 0.05);  // nearest rank: the lowest of 4
+  EXPECT_NEAR(m.foot_penetration_cm_max, 1.0, 1e-3);
+  EXPECT_NEAR(m.foot_penetration_cm_mean, 2.0 / 8.0, 1e-3);  // two toes 1 cm down of 8 samples
+  EXPECT_NEAR(m.foot_float_cm_mean, 5.0, 1e-3);
+}
+
+TEST(GroundMetrics, HipsHeightAboveTheirGroundAndVerticalAcceleration) {
+  GroundAccumulator a(roles(), kDt);
+  // The hips 0.9 m above a ground rising 1 cm a frame, accelerating upward at 2 m/s^2 on top.
+  for (int f = 0; f < 20; ++f) {
+    const float t = kDt * f;
+    const float ground = 0.01f * f;
+    const std::vector<glm::vec3> joints = pose(0.0f, 0.02f, ground + 0.9f + 0.5f * 2.0f * t * t);
+    GroundFrame frame;
+    frame.joints = joints;
+    frame.hips_ground = ground;
+    a.add(frame);
+  }
+  const GroundMetrics m = a.metrics();
+  EXPECT_NEAR(m.hips_vertical_accel_p99_m_s2, 2.0, 0.01);
+  double mean = 0.0, squares = 0.0;
+  for (int f = 0; f < 20; ++f) {
+    const double h = 100.0 * (0.9 + std::pow(kDt * f, 2));
+    mean += h / 20;
+    squares += h * h / 20;
+  }
+  EXPECT_NEAR(m.hips_height_cm_mean, mean, 1e-3);
+  EXPECT_NEAR(m.hips_height_cm_std, std::sqrt(squares - mean * mean), 1e-2);
+}
+
+TEST(GroundMetrics, StraightKneesWallDepthAndStuckTime) {
+  GroundAccumulator a(roles(), kDt);
+  for (int f = 0; f < 6; ++f) {
+    std::vector<glm::vec3> joints = pose(0.0f, 0.02f);
+    if (f < 2) joints[3] = glm::vec3(0.1f, 0.5f, 0.0f);  // hip, knee, ankle in a line
+    GroundFrame frame;
+    frame.joints = joints;
+    frame.wall_depth = 0.01f * f;
+    frame.stuck = f >= 3;
+    a.add(frame);
+  }
+  const GroundMetrics m = a.metrics();
+  EXPECT_EQ(m.knee_overextension_frames, 2);
+  EXPECT_NEAR(m.wall_depth_cm_max, 5.0, 1e-4);
+  EXPECT_NEAR(m.stuck_s, 3 * kDt, 1e-6);
+}
+
+TEST(GroundMetrics, AShiftedFrameIsNotASlide) {
+  GroundAccumulator a(roles(), kDt);
+  for (int f = 0; f < 6; ++f) {
+    // The origin moves by 8 m after frame 2; the toes stand still in the world.
+    const float shift = f >= 3 ? 8.0f : 0.0f;
+    if (f == 3) a.shift(glm::vec3(8.0f, 0.0f, 0.0f));
+    std::vector<glm::vec3> joints = pose(0.3f, 0.02f);
+    for (glm::vec3& joint : joints) joint.x -= shift;
+    GroundFrame frame;
+    frame.joints = joints;
+    a.add(frame);
+  }
+  EXPECT_EQ(a.metrics().foot_skate_geom_frames, 8);
+  EXPECT_NEAR(a.metrics().foot_skate_geom_cm_s_mean, 0.0, 1e-3);
+}
+
+}  // namespace
+}  // namespace mm
