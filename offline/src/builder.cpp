@@ -57,7 +57,23 @@ struct InputResult {
   std::vector<Clip> clips;
   JointRoleIndices roles;  // in the source skeleton
   uint64_t bytes = 0;
+  // The importer's warnings of its clips (Clip::warnings, each message once), taken before
+  // resampling makes new clips; they join BuildReport::warnings when the input is used.
+  std::vector<std::string> warnings;
 };
+
+// Moves the clips' import warnings into `warnings`, each message once (a glTF file's clips may
+// share one).
+void take_import_warnings(std::vector<Clip>& clips, std::vector<std::string>& warnings) {
+  for (Clip& clip : clips) {
+    for (std::string& w : clip.warnings) {
+      if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) {
+        warnings.push_back(std::move(w));
+      }
+    }
+    clip.warnings.clear();
+  }
+}
 
 // One unit of phase 2: a clip (or its mirror) and where its frames go in the database.
 struct ClipJob {
@@ -269,6 +285,7 @@ void import_inputs(BuildState& state, const Load& load) {
     if (!state.options.skip_bad && i > first_failure.load()) return;
     try {
       result.status = load(i, result);
+      take_import_warnings(result.clips, result.warnings);
       for (size_t c = 0; c < result.clips.size() && result.status; ++c) {
         result.status = prepare_clip(result.clips[c], state.input_names[i], state.options, result);
         if (result.status && c > 0 &&
@@ -329,6 +346,7 @@ Status prepare_target(BuildState& state) {
   if (!target) return Status::success();
   InputResult result;
   result.clips.assign(1, *target);
+  take_import_warnings(result.clips, state.rep.warnings);
   const std::string name = target_name(*target);
   if (Status s = result.clips[0].validate(); !s) return Error{name + ": " + s.message()};
   if (Status s = check_joint_map(target->skeleton, state.options.target_role_map); !s) {
@@ -399,6 +417,8 @@ Result<size_t> choose_reference_input(BuildState& state) {
       result.processed = false;
       continue;
     }
+    state.rep.warnings.insert(state.rep.warnings.end(), result.warnings.begin(),
+                              result.warnings.end());
     if (!reference_index) {
       reference_index = i;
       if (!reference) reference = &result;

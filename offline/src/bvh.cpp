@@ -544,11 +544,11 @@ class BvhParser {
       }
       if (p == end) break;
       if (frames == declared_frames_) {
-        return fail(line, "expected " + std::to_string(declared_frames_) +
-                              " frames as declared by 'Frames:' on line " +
-                              std::to_string(frames_line_) +
-                              ", found more: this line would be frame " +
-                              std::to_string(int64_t{frames} + 1));
+        // More frame lines than declared: the declared ones are the clip (as Blender and assimp
+        // read such files), the rest is only counted, and said once.
+        warn_extra_frame_lines(count_non_blank_lines(p, end), line);
+        p = end;
+        break;
       }
       if (p < lines_end) {
         if (auto error = parse_frame_line(p, line, frames, values.data(), false)) return error;
@@ -573,6 +573,28 @@ class BvhParser {
     p_ = p;
     line_ = line;
     return nullptr;
+  }
+
+  // The lines from p to `end` that hold anything but whitespace. One pass, nothing parsed.
+  static int64_t count_non_blank_lines(const char* p, const char* end) {
+    int64_t count = 0;
+    bool blank = true;
+    for (; p < end; ++p) {
+      if (*p == '\n') {
+        count += !blank;
+        blank = true;
+      } else if (!is_line_space(*p)) {
+        blank = false;
+      }
+    }
+    return count + !blank;
+  }
+
+  void warn_extra_frame_lines(int64_t count, int64_t first_line) {
+    warnings_.push_back(std::string(path_) + ":" + std::to_string(first_line) + ": ignored " +
+                        std::to_string(count) + (count == 1 ? " frame line" : " frame lines") +
+                        " beyond 'Frames: " + std::to_string(declared_frames_) + "' on line " +
+                        std::to_string(frames_line_));
   }
 
   // Reads exactly channel_total_ numbers from the line starting at p, which ends in '\n', and
@@ -680,6 +702,7 @@ class BvhParser {
     clip.frame_count = declared_frames_;
     clip.local = std::move(local_);
     clip.end_sites = std::move(end_sites_);
+    clip.warnings = std::move(warnings_);
     return clip;
   }
 
@@ -705,6 +728,7 @@ class BvhParser {
   std::vector<OpenJoint> open_;
   std::unordered_map<std::string_view, int64_t> joint_lines_;
   std::vector<Transform> local_;
+  std::vector<std::string> warnings_;  // becomes Clip::warnings
 };
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "database_helpers.hpp"
@@ -645,6 +646,48 @@ TEST(BuilderOptions, ClipsTooShortToMatchAreReported) {
   ASSERT_EQ(report.warnings.size(), 1u);
   EXPECT_NE(report.warnings[0].find("dataset-1_dash_normal_001"), std::string::npos);
   EXPECT_EQ(report.searchable_frames, db->clips()[1].frame_count() - 30);
+}
+
+// A BVH file with one frame line more than it declares (as assimp's Boxing_Toes.bvh): its
+// import warning leads BuildReport::warnings, once, from a file and from an in-memory clip.
+TEST(BuilderOptions, ImportWarningsOfTheClipsReachTheReport) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path path = dir / "walk_extra_line.bvh";
+  std::string text;
+  {
+    std::ifstream in(test::clip_path(kClips[0]), std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(text.back(), '\n');
+  const size_t last_line = text.rfind('\n', text.size() - 2) + 1;
+  text += text.substr(last_line);  // the last frame line again
+  std::ofstream(path, std::ios::binary) << text;
+  const int first_ignored_line = static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  const int frames_line =
+      1 + static_cast<int>(std::count(text.begin(), text.begin() + text.find("Frames:"), '\n'));
+  const std::string warning = path.string() + ":" + std::to_string(first_ignored_line) +
+                              ": ignored 1 frame line beyond 'Frames: 273' on line " +
+                              std::to_string(frames_line);
+
+  BuildOptions options;
+  options.idle_seconds = 0.0f;  // the build's own warnings are not the subject here
+  const fs::path inputs[] = {path};
+  BuildReport report;
+  Result<Database> db = build_database(inputs, options, &report);
+  ASSERT_TRUE(db) << db.message();
+  EXPECT_EQ(db->frame_count(), 273);
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_EQ(report.warnings[0], warning);
+  EXPECT_EQ(std::count(report.warnings.begin(), report.warnings.end(), warning), 1);
+
+  Result<Clip> clip = load_bvh(path);
+  ASSERT_TRUE(clip) << clip.message();
+  ASSERT_EQ(clip->warnings, std::vector<std::string>{warning});
+  db = build_database_from_clips(std::span(&*clip, 1), options, &report);
+  ASSERT_TRUE(db) << db.message();
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_EQ(report.warnings[0], warning);
+  EXPECT_EQ(std::count(report.warnings.begin(), report.warnings.end(), warning), 1);
 }
 
 TEST(BuilderOptions, GltfInputBuildsLikeTheBvhItCameFrom) {

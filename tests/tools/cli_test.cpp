@@ -206,6 +206,38 @@ TEST(Cli, ExportWritesAGlbThatImportsWithTheClipsFramesAndJoints) {
   EXPECT_EQ(run_mm("export " + quoted(dir / "missing.bvh") + " -o " + quoted(out)).exit_code, 1);
 }
 
+// A file with more frame lines than it declares (Debian's assimp-testmodels, installed by
+// scripts/setup.sh): `mm build` and `mm export` read its declared frames and say so once.
+TEST(Cli, BuildAndExportPrintAFilesImportWarningOnce) {
+  const fs::path source = "/usr/share/assimp/models/BVH/Boxing_Toes.bvh";
+  ASSERT_TRUE(fs::is_regular_file(source))
+      << source << " is missing: install Debian's assimp-testmodels (scripts/setup.sh)";
+  const std::string warning =
+      source.string() + ":3199: ignored 1 frame line beyond 'Frames: 3069' on line 128\n";
+  const auto count = [](const std::string& text, const std::string& part) {
+    size_t n = 0;
+    for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+    return n;
+  };
+  const fs::path dir = test::scratch_dir();
+  const CommandRun build =
+      run_mm("build " + quoted(source) + " --quiet -o " + quoted(dir / "boxing.mmdb"));
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  EXPECT_EQ(count(build.output, "mm build: warning: " + warning), 1u) << build.output;
+  EXPECT_EQ(count(build.output, "ignored"), 1u) << build.output;
+
+  const CommandRun run = run_mm("export " + quoted(source) + " -o " + quoted(dir / "boxing.glb"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(count(run.output, "mm export: warning: " + warning), 1u) << run.output;
+  EXPECT_EQ(count(run.output, "ignored"), 1u) << run.output;
+  GltfImportOptions at_100_hz;  // the file's own rate
+  at_100_hz.sample_rate = 100.0f;
+  Result<GltfAsset> asset = load_gltf(dir / "boxing.glb", at_100_hz);
+  ASSERT_TRUE(asset) << asset.message();
+  ASSERT_EQ(asset->clips.size(), 1u);
+  EXPECT_EQ(asset->clips[0].frame_count, 3069);
+}
+
 // `mm export --body`: the database clip with the generated body, reloadable as a skinned mesh
 // over every joint; the weight method is chosen by name; a BVH input or an unknown method is
 // a usage error.

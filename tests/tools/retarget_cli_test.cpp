@@ -148,6 +148,25 @@ TEST(RetargetCli, RateResamplesTheResultOverTheSameDuration) {
   EXPECT_NEAR(written.duration(), source.duration(), 1e-4f);
 }
 
+// Debian's assimp-testmodels (installed by scripts/setup.sh): "Frames: 3069" on line 128, then
+// 3070 frame lines. Read as Blender and assimp read it, with one warning for the extra line.
+TEST(RetargetCli, AFileWithMoreFrameLinesThanDeclaredIsRetargetedWithOneWarning) {
+  const fs::path source = "/usr/share/assimp/models/BVH/Boxing_Toes.bvh";
+  ASSERT_TRUE(fs::is_regular_file(source))
+      << source << " is missing: install Debian's assimp-testmodels (scripts/setup.sh)";
+  const fs::path out = test::scratch_dir() / "boxing_on_bandai.bvh";
+  const CommandRun run = retarget(source, bandai_walk(), out);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(count_lines_starting(run.output, "mm retarget: warning: "), 1u) << run.output;
+  EXPECT_EQ(count_lines_starting(run.output,
+                                 "mm retarget: warning: " + source.string() +
+                                     ":3199: ignored 1 frame line beyond 'Frames: 3069' on line "
+                                     "128\n"),
+            1u)
+      << run.output;
+  EXPECT_EQ(in_file_units(out).frame_count, 3069);
+}
+
 TEST(RetargetCli, MistakesAUserCanFixAreNamed) {
   const fs::path dir = test::scratch_dir();
   const fs::path out = dir / "out.bvh";

@@ -256,6 +256,7 @@ Status read_skeleton_files(Arguments& arguments) {
     read.bvh_scale = options.bvh.scale;
     Result<MotionFile> target = read_motion_file(arguments.target_file, read);
     if (!target) return Error{target.message()};
+    // Its import warnings reach BuildReport::warnings, which print_warnings prints.
     options.target = std::move(target->clip);
   }
   return Status::success();

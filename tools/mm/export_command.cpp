@@ -147,6 +147,7 @@ Result<std::string> export_from_gltf(const Arguments& arguments) {
   Result<size_t> clip = select_clip_in(asset->clips, arguments);
   if (!clip) return Error{clip.message()};
   const Clip& c = asset->clips[*clip];
+  print_import_warnings("mm export", c);
   if (Status written = save_gltf(c, arguments.output); !written) return Error{written.message()};
   return clip_description(c.name, c.frame_count, c.joint_count());
 }
@@ -154,6 +155,7 @@ Result<std::string> export_from_gltf(const Arguments& arguments) {
 Result<std::string> export_from_bvh(const Arguments& arguments) {
   Result<Clip> clip = load_bvh(arguments.input, arguments.bvh);
   if (!clip) return Error{clip.message()};
+  print_import_warnings("mm export", *clip);
   const std::string& selector = arguments.clip_selector;
   if (!selector.empty() && selector != "0" && selector != clip->name) {
     return Error{arguments.input + ": a BVH file holds one clip, '" + clip->name + "' (index 0)"};

@@ -1,6 +1,7 @@
 #include "motion_files.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <utility>
 
@@ -153,6 +154,11 @@ Result<MotionFile> read_motion_file(const std::string& path, const MotionFileOpt
     return Error{path + ": a BVH file holds one clip (index 0)"};
   }
   return read_bvh(path, options.bvh_scale);
+}
+
+void print_import_warnings(const char* command, const Clip& clip) {
+  for (const std::string& w : clip.warnings)
+    std::fprintf(stderr, "%s: warning: %s\n", command, w.c_str());
 }
 
 Result<size_t> select_clip(const std::string& selector, const std::vector<std::string>& names,

@@ -54,6 +54,10 @@ bool is_motion_file_name(const std::string& path, bool allow_database);
 // of its rest pose. Errors name the file.
 Result<MotionFile> read_motion_file(const std::string& path, const MotionFileOptions& options);
 
+// Prints what the importer accepted but ignored in a file (Clip::warnings) to stderr, one
+// "<command>: warning: <warning>" line each, as `mm build` prints its report's warnings.
+void print_import_warnings(const char* command, const Clip& clip);
+
 // The index of the clip `selector` names among `names` (an index or an exact name; empty: 0),
 // or an error naming `file` and listing what exists.
 Result<size_t> select_clip(const std::string& selector, const std::vector<std::string>& names,

@@ -153,10 +153,12 @@ Status retarget(const Arguments& arguments) {
   if (arguments.rate > 0.0f) source_options.gltf_rate = arguments.rate;
   Result<MotionFile> source = read_motion_file(arguments.source, source_options);
   if (!source) return Error{source.message()};
+  print_import_warnings("mm retarget", source->clip);
   MotionFileOptions target_options;
   target_options.allow_database = true;
   Result<MotionFile> target = read_motion_file(arguments.target, target_options);
   if (!target) return Error{target.message()};
+  print_import_warnings("mm retarget", target->clip);
 
   Result<RetargetSkeleton> from = describe(*source, arguments.map_file, arguments.rest_frame);
   if (!from) return Error{from.message()};

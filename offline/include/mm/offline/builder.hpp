@@ -5,10 +5,11 @@
 // import (BVH or glTF), validate, resample to the database rate, find the joint roles. 2, in
 // input order: refuse failed inputs, retarget the clips of skeletons other than the first
 // input's (or BuildOptions::target's) onto it (retarget.hpp; one line per source skeleton in the
-// report), lay out the clip ranges (a mirrored copy right after its original), their tags and the
-// database arrays. 3, parallel over clips, each worker with its own reusable buffers: preprocess
-// (simulation root, velocities, contacts; see preprocess.hpp) and extract the raw features
-// (feature_extraction.hpp) straight into the database arrays at the clip's frames. 4:
+// report), pass the import warnings (Clip::warnings) of the target and of every input used on to
+// BuildReport::warnings, lay out the clip ranges (a mirrored copy right after its original), their
+// tags and the database arrays. 3, parallel over clips, each worker with its own reusable buffers:
+// preprocess (simulation root, velocities, contacts; see preprocess.hpp) and extract the raw
+// features (feature_extraction.hpp) straight into the database arrays at the clip's frames. 4:
 // normalize the features over the searchable frames of the whole database and validate the
 // result. Every per-clip step is independent of the others and the statistics are summed in
 // frame order, so the output is byte-for-byte the same whatever the number of threads.
@@ -116,7 +117,7 @@ struct BuildReport {
   int idle_frames = 0;                // frames of the idle clip, 0 when there is none
   std::string idle_source_clip;       // the clip whose frame the idle clip holds
   int idle_source_frame = -1;         // that frame, counted from the start of its clip
-  std::vector<std::string> warnings;  // e.g. feature channels that do not vary, no idle clip
+  std::vector<std::string> warnings;  // import warnings (Clip::warnings) first, then the build's
   // One line per source skeleton retargeted onto the database's: its first input, clips,
   // joints matched, scale and the database joints left at rest.
   std::vector<std::string> retargeted;

@@ -15,10 +15,15 @@
 // - Any channel order per joint, 0 to 6 channels (each channel name at most once), position and
 //   rotation channels interleaved freely; tabs or spaces; LF or CRLF line ends.
 //
-// The MOTION section holds exactly one frame per line (blank lines are skipped). Malformed
-// input is refused with "<file>:<line>: expected ..., found ..." rather than repaired. The
-// parser is iterative (no recursion, whatever the hierarchy depth), never hangs, and never
-// allocates more frame storage than the remaining bytes could fill.
+// The MOTION section holds one frame per line (blank lines are skipped). Fewer frame lines than
+// "Frames:" declares is an error. More is accepted, as Blender and assimp accept it (assimp's
+// own Boxing_Toes.bvh declares 3069 frames and holds 3070): the declared frames are read, the
+// non-blank lines after them are counted but not parsed (whatever they hold), and the clip gets
+// one warning in Clip::warnings: "<file>:<line>: ignored N frame line(s) beyond 'Frames: M' on
+// line L", <line> being the first ignored line. Malformed input is refused with
+// "<file>:<line>: expected ..., found ..." rather than repaired. The parser is iterative (no
+// recursion, whatever the hierarchy depth), never hangs, and never allocates more frame storage
+// than the remaining bytes could fill.
 
 #include <filesystem>
 #include <string>
@@ -43,7 +48,8 @@ struct BvhOptions {
 float bvh_units_to_metres(float extent);
 
 // Parses the whole text of a BVH file. path_for_messages names the file in error messages and
-// becomes the clip's source_path; its stem becomes the clip's name.
+// warnings and becomes the clip's source_path; its stem becomes the clip's name. What was
+// accepted but ignored is in the clip's warnings (see above).
 Result<Clip> parse_bvh(std::string_view text, std::string_view path_for_messages,
                        const BvhOptions& options = {});
 

@@ -26,6 +26,12 @@ struct Clip {
   // Per joint: the offset of its End Site (a BVH leaf's tip, metres, in the joint's frame), zero
   // where it has none. Empty when the importer knows of none (glTF).
   std::vector<glm::vec3> end_sites;
+  // What the importer accepted but ignored, one message per kind of problem per file, each
+  // naming the file and line ("<file>:<line>: ..."), e.g. BVH frame lines beyond "Frames:";
+  // empty for a clean file. Only importers fill it: clips made from this one (resample_clip,
+  // retarget_clip, mirror_clip) start without. The builder passes the warnings of every clip it
+  // imports or is given on to BuildReport::warnings, and the `mm` commands print them.
+  std::vector<std::string> warnings;
 
   int joint_count() const { return skeleton.joint_count(); }
   float duration() const { return frame_count > 1 ? (frame_count - 1) * frame_time : 0.0f; }
