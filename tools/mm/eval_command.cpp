@@ -64,12 +64,11 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "also write the metrics as JSON (one script: the keys at the top level; "
                  "several: a list under \"runs\")")
       ->type_name("FILE");
-  app.add_option(
-         "--dump", out.dump_path,
-         "one CSV row per frame (one script only): t, simulation, root, desired motion, "
-         "transition, contacts, the playing clip (index) and database frame, every joint's "
-         "global position, then the ground under the toes and the hips, the wall depth (m) "
-         "and whether the simulation was stuck")
+  app.add_option("--dump", out.dump_path,
+                 "one CSV row per frame (one script only): t, simulation, root, desired motion, "
+                 "transition, contacts, the playing clip (index) and database frame, every joint's "
+                 "global position, then the ground under the toes and the hips, the wall depth (m) "
+                 "and whether the simulation was stuck")
       ->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (const auto start = parse_number_pair(out.start)) {
