@@ -21,6 +21,17 @@ scripts=()
 for f in scripts/input/*.txt; do scripts+=(--script "$f"); done
 "$mm" eval --db out/database.mmdb "${scripts[@]}" --json out/eval.json
 
+# The test course (data/levels/course.glb, docs/world-levels.md): every lane walked along with
+# scripts/input/course-walk.txt, measured against the level's ground (one JSON per lane).
+printf '\n=== 2/4 (continued) The test course (mm eval --world, every lane) ===\n'
+for lane in ramp_10:1 ramp_20:4 ramp_30:7 stairs:10 rough:13.5 wall_head_on:17.5 wall_30:22 \
+            box_low:28 box_high:31; do
+  printf -- '--- %s\n' "${lane%%:*}"
+  "$mm" eval --db out/database.mmdb --script scripts/input/course-walk.txt \
+    --world data/levels/course.glb --start "${lane##*:},0" --json "out/course-${lane%%:*}.json" |
+    grep -E '^(foot_skate_geom|toe_clearance|foot_penetration|hips_|wall_depth|stuck|update_us)'
+done
+
 # Two minutes of game time: the steady state of a long run, whose last 20 s the table compares
 # with the first (a cost that creeps up as the characters' state ages shows in that ratio).
 printf '\n=== 3/4 Crowd benchmark (mm crowd-bench, 1500 characters, 120 s at 60 Hz) ===\n'
@@ -29,4 +40,4 @@ printf '\n=== 3/4 Crowd benchmark (mm crowd-bench, 1500 characters, 120 s at 60 
 printf '\n=== 4/4 Search benchmark (every method, 2000 queries, noise 0.1) ===\n'
 "$mm" search-bench --db out/database.mmdb --queries 2000 --noise 0.1 --json out/search-bench.json
 
-printf '\nDone: out/eval.json, out/crowd-bench.json, out/search-bench.json\n'
+printf '\nDone: out/eval.json, out/course-<lane>.json, out/crowd-bench.json, out/search-bench.json\n'

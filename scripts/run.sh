@@ -5,7 +5,8 @@
 # - with a display: opens mm-viewer (gamepad or keyboard; its --help lists the controls);
 # - without one: runs the viewer headless on scripts/input/showcase.txt (walk, turn, run, stop
 #   and stand, walk back, strafe), writing a screenshot every 1.5 s, the last frame and a
-#   top-down plot of the run, then measures the same script with `mm eval`.
+#   top-down plot of the run, then measures the same script with `mm eval`; then walks three
+#   lanes of the test course (stairs, a 20-degree ramp, a wall at 30 degrees) the same way.
 # Everything goes to out/. Set MM_HEADLESS=1 to run headless even with a display.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -46,7 +47,24 @@ rm -f out/viewer/*.png
 printf '\n=== The same script measured (mm eval, dt 1/60, IK on) ===\n'
 "$mm" eval --db out/database.mmdb --script "$script" --json out/viewer/eval.json
 
+# The test course (data/levels/course.glb, docs/world-levels.md): three of its lanes walked
+# straight along, each rendered and measured against the level's ground.
+for lane in stairs:10 ramp_20:4 wall_30:22; do
+  name=${lane%%:*}
+  x=${lane##*:}
+  printf '\n=== The test course, lane %s (x = %s): mm-viewer headless and mm eval --world ===\n' \
+    "$name" "$x"
+  "$viewer" --db out/database.mmdb --headless --script scripts/input/course-walk.txt \
+    --world data/levels/course.glb --start "$x,0" --every 60 \
+    --screenshot "out/viewer/course-$name.png" --plot "out/viewer/course-$name-plot.png"
+  "$mm" eval --db out/database.mmdb --script scripts/input/course-walk.txt \
+    --world data/levels/course.glb --start "$x,0" --json "out/viewer/course-$name.json" |
+    grep -E '^(root_sim|foot_skate|toe_clearance|foot_penetration|hips_|wall_depth|stuck|update_us)'
+done
+
 printf '\nDone. In out/viewer/: showcase-<frame>.png every 1.5 s of the run and showcase.png (the\n'
-printf 'last frame), plot.png (the whole run from above), eval.json (the metrics printed above).\n'
+printf 'last frame), plot.png (the whole run from above), eval.json (the metrics printed above);\n'
+printf 'course-<lane>-<frame>.png every second on the test course (stairs, the 20-degree ramp, the\n'
+printf 'wall at 30 degrees), course-<lane>-plot.png and course-<lane>.json.\n'
 printf 'With a display, scripts/run.sh opens the interactive viewer instead; scripts/bench.sh runs\n'
 printf 'every shipped script, the crowd and the search benchmarks.\n'

@@ -6,7 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # The python3-* and pybind11 packages build and test the Python module (python/);
-# assimp-testmodels holds real-world BVH files the importer's tests read.
+# assimp-testmodels holds real-world BVH files the importer's tests read; Bullet answers the
+# world's queries in the tools and the viewer (world/), never in the libraries a game links.
 packages=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libeigen3-dev libtinygltf-dev libflann-dev nlohmann-json3-dev libstb-dev
@@ -14,7 +15,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang clang-format libclang-rt-14-dev xz-utils
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
-  assimp-testmodels
+  assimp-testmodels libbullet-dev
 )
 missing=()
 for p in "${packages[@]}"; do

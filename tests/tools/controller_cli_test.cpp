@@ -322,5 +322,35 @@ TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 
+// `mm eval --world`: the run in the shipped course (Bullet), measured against its ground; a level
+// that cannot be read is refused naming the file.
+TEST(ControllerCli, EvalRunsInALevelAndRefusesABadOne) {
+  const fs::path dir = fs::path(MM_BINARY_DIR) / "test-scratch" /
+                       ("controller-cli-world-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const fs::path course = fs::path(MM_SOURCE_DIR) / "data/levels/course.glb";
+  const fs::path script = fs::path(MM_SOURCE_DIR) / "scripts/input/course-walk.txt";
+  const fs::path json = dir / "wall.json";
+  // The lane of the wall across it: the character walks into it and stands.
+  const CommandRun run = run_mm("eval --db " + test::quoted(small_database()) + " --script " +
+                                test::quoted(script) + " --world " + test::quoted(course) +
+                                " --start 17.5,0 --json " + test::quoted(json));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find(", world " + course.string()), std::string::npos) << run.output;
+  const nlohmann::json metrics = nlohmann::json::parse(read_text(json));
+  EXPECT_EQ(metrics["world"], course.string());
+  EXPECT_LT(metrics["wall_depth_cm_max"].get<double>(), 2.0);
+  EXPECT_GT(metrics["toe_clearance_cm_min"].get<double>(), 0.0);  // flat where the wall is
+
+  const fs::path bad = write_script(dir, "bad.glb", "not a glTF file");
+  const CommandRun refused =
+      run_mm("eval --db " + test::quoted(small_database()) + " --script " + test::quoted(script) +
+             " --world " + test::quoted(bad));
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_NE(refused.output.find("mm eval: " + bad.string()), std::string::npos) << refused.output;
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+}
+
 }  // namespace
 }  // namespace mm

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,8 @@
 #include "mm/programs/evaluation_json.hpp"
 #include "mm/programs/number_parsing.hpp"
 #include "mm/programs/shared_options.hpp"
+#include "mm/world/bullet_world.hpp"
+#include "mm/world/level.hpp"
 
 namespace mm::cli {
 namespace {
@@ -27,6 +30,7 @@ struct Arguments {
   std::string json_path;
   std::string dump_path;
   std::string start;  // "X,Z", validated by the parser
+  std::string world_path;
 };
 
 // --start farther than this (m) is a typo, not a world: even a planet is smaller.
@@ -60,6 +64,11 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "the dump's positions include it")
       ->type_name("X,Z")
       ->check(number_pair_in("X,Z", -kMaxStartMetres, kMaxStartMetres));
+  app.add_option("--world", out.world_path,
+                 "a level (.gltf or .glb, Y up, metres; every mesh is static collision geometry) "
+                 "the controller runs in, through Bullet (docs/world.md); the ground metrics are "
+                 "measured against its surfaces")
+      ->type_name("LEVEL");
   app.add_option("--json", out.json_path,
                  "also write the metrics as JSON (one script: the keys at the top level; "
                  "several: a list under \"runs\")")
@@ -189,6 +198,23 @@ int run_eval(const std::vector<std::string>& args) {
     return 1;
   }
 
+  // The level and its Bullet world, for the whole run.
+  std::optional<BulletWorld> world;
+  if (!arguments.world_path.empty()) {
+    Result<Level> level = load_level(arguments.world_path);
+    if (!level) {
+      std::fprintf(stderr, "mm eval: %s\n", level.message().c_str());
+      return 1;
+    }
+    Result<BulletWorld> made = BulletWorld::create(*level);
+    if (!made) {
+      std::fprintf(stderr, "mm eval: %s\n", made.message().c_str());
+      return 1;
+    }
+    world.emplace(std::move(made).value());
+    arguments.options.world = &*world;
+  }
+
   // Opened before the run, which writes its rows as it goes.
   std::ofstream dump;
   if (!arguments.dump_path.empty()) {
@@ -217,15 +243,17 @@ int run_eval(const std::vector<std::string>& args) {
       return 1;
     }
     const std::string name = std::filesystem::path(path).stem().string();
-    const nlohmann::json json = evaluation_run_json(result->metrics, path, arguments.options);
+    nlohmann::json json = evaluation_run_json(result->metrics, path, arguments.options);
+    if (world) json["world"] = arguments.world_path;
     if (table) {
       print_table_row(name, result->metrics);
       rows.emplace_back(name, result->metrics);
       runs.push_back(json);
     } else {
-      std::printf("script %s, dt %.5f s, IK %s, %d frames (%.1f s)\n", path.c_str(),
+      std::printf("script %s, dt %.5f s, IK %s, %d frames (%.1f s)%s%s\n", path.c_str(),
                   arguments.options.dt, arguments.options.settings.ik_enabled ? "on" : "off",
-                  result->metrics.frames, result->metrics.seconds);
+                  result->metrics.frames, result->metrics.seconds, world ? ", world " : "",
+                  world ? arguments.world_path.c_str() : "");
       print_metrics(result->metrics);
       single = json;
     }

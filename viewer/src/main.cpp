@@ -2,11 +2,15 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "body_source.hpp"
 #include "database_source.hpp"
+#include "mm/programs/number_parsing.hpp"
+#include "mm/world/bullet_world.hpp"
+#include "mm/world/level.hpp"
 #include "run_loops.hpp"
 #include "viewer_options.hpp"
 
@@ -16,6 +20,25 @@ bool has_display() {
   const char* x11 = std::getenv("DISPLAY");
   const char* wayland = std::getenv("WAYLAND_DISPLAY");
   return (x11 && *x11) || (wayland && *wayland);
+}
+
+// The level at `path` as a Bullet world, given to the scene with its triangles to draw.
+mm::Result<std::unique_ptr<mm::BulletWorld>> open_world(const std::string& path,
+                                                        mm::viewer::Scene& scene) {
+  mm::Result<mm::Level> level = mm::load_level(path);
+  if (!level) return level.error();
+  mm::Result<mm::BulletWorld> made = mm::BulletWorld::create(*level);
+  if (!made) return made.error();
+  auto world = std::make_unique<mm::BulletWorld>(std::move(made).value());
+  // Drawn in float world coordinates: the level's own origin added in double, rounded once.
+  std::vector<glm::vec3> positions;
+  positions.reserve(level->positions.size());
+  for (const glm::vec3& p : level->positions) {
+    positions.emplace_back(level->origin + glm::dvec3(p));
+  }
+  scene.set_level(world.get(), std::move(positions), std::move(level->indices));
+  std::printf("mm-viewer: level %s, %zu triangles\n", path.c_str(), level->triangle_count());
+  return world;
 }
 
 }  // namespace
@@ -50,6 +73,19 @@ int main(int argc, char** argv) {
   if (!scene) {
     std::fprintf(stderr, "mm-viewer: %s\n", scene.message().c_str());
     return 1;
+  }
+  // The level's world lives as long as the scene that queries it.
+  std::unique_ptr<mm::BulletWorld> world;
+  if (!options.world_path.empty()) {
+    mm::Result<std::unique_ptr<mm::BulletWorld>> made = open_world(options.world_path, **scene);
+    if (!made) {
+      std::fprintf(stderr, "mm-viewer: %s\n", made.message().c_str());
+      return 1;
+    }
+    world = std::move(*made);
+  }
+  if (const auto start = mm::cli::parse_number_pair(options.start)) {
+    (*scene)->controller().teleport_world(glm::dvec3(start->first, 0.0, start->second), 0.0f);
   }
   return options.headless ? run_headless(options, **scene) : run_windowed(options, **scene);
 }

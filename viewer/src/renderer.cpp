@@ -2,6 +2,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -209,6 +210,17 @@ Status Renderer::build() {
   glEnableVertexAttribArray(0);
   glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
 
+  // The level: positions and flat normals interleaved, three vertices a triangle.
+  glGenVertexArrays(1, &level_vao_);
+  glBindVertexArray(level_vao_);
+  glGenBuffers(1, &level_vbo_);
+  glBindBuffer(GL_ARRAY_BUFFER, level_vbo_);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 2 * sizeof(glm::vec3), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 2 * sizeof(glm::vec3),
+                        reinterpret_cast<void*>(sizeof(glm::vec3)));
+
   glGenVertexArrays(1, &line_vao_);
   glBindVertexArray(line_vao_);
   glGenBuffers(1, &line_vbo_);
@@ -240,7 +252,10 @@ Renderer& Renderer::operator=(Renderer&& other) noexcept {
   ground_vbo_ = std::exchange(other.ground_vbo_, 0);
   line_vao_ = std::exchange(other.line_vao_, 0);
   line_vbo_ = std::exchange(other.line_vbo_, 0);
+  level_vao_ = std::exchange(other.level_vao_, 0);
+  level_vbo_ = std::exchange(other.level_vbo_, 0);
   body_index_count_ = std::exchange(other.body_index_count_, 0);
+  level_vertex_count_ = std::exchange(other.level_vertex_count_, 0);
   return *this;
 }
 
@@ -253,11 +268,12 @@ void Renderer::release() {
   for (GLuint program : {mesh_program_, ground_program_, line_program_}) {
     if (program) glDeleteProgram(program);
   }
-  const GLuint buffers[] = {body_positions_, body_normals_, body_indices_, ground_vbo_, line_vbo_};
-  const GLuint arrays[] = {body_vao_, ground_vao_, line_vao_};
+  const GLuint buffers[] = {body_positions_, body_normals_, body_indices_,
+                            ground_vbo_,     line_vbo_,     level_vbo_};
+  const GLuint arrays[] = {body_vao_, ground_vao_, line_vao_, level_vao_};
   if (mesh_program_) {
-    glDeleteBuffers(5, buffers);
-    glDeleteVertexArrays(3, arrays);
+    glDeleteBuffers(6, buffers);
+    glDeleteVertexArrays(4, arrays);
   }
   mesh_program_ = ground_program_ = line_program_ = 0;
 }
@@ -269,6 +285,43 @@ void Renderer::set_body_triangles(std::span<const uint32_t> indices) {
                indices.data(), GL_STATIC_DRAW);
   glBindVertexArray(0);
   body_index_count_ = static_cast<int>(indices.size());
+}
+
+void Renderer::set_level(std::span<const glm::vec3> positions, std::span<const uint32_t> indices) {
+  std::vector<glm::vec3> vertices;
+  vertices.reserve(indices.size() * 2);
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const glm::vec3& a = positions[indices[t]];
+    const glm::vec3& b = positions[indices[t + 1]];
+    const glm::vec3& c = positions[indices[t + 2]];
+    glm::vec3 normal = glm::cross(b - a, c - a);
+    const float length = glm::length(normal);
+    normal = length > 0.0f ? normal / length : glm::vec3(0.0f, 1.0f, 0.0f);
+    for (const glm::vec3* p : {&a, &b, &c}) {
+      vertices.push_back(*p);
+      vertices.push_back(normal);
+    }
+  }
+  glBindVertexArray(level_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, level_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(glm::vec3)),
+               vertices.data(), GL_STATIC_DRAW);
+  glBindVertexArray(0);
+  level_vertex_count_ = static_cast<int>(vertices.size() / 2);
+}
+
+void Renderer::draw_level(const CameraMatrices& camera) {
+  if (level_vertex_count_ == 0) return;
+  glUseProgram(mesh_program_);
+  set_matrix(mesh_program_, "view_projection", camera.projection * camera.view);
+  set_matrix(mesh_program_, "model", glm::mat4(1.0f));
+  set_vec3(mesh_program_, "light_direction", kLightDirection);
+  set_vec3(mesh_program_, "eye", camera.eye);
+  set_vec3(mesh_program_, "colour", glm::vec3(0.62f, 0.60f, 0.56f));
+  glUniform1f(uniform(mesh_program_, "shadow"), 0.0f);
+  glBindVertexArray(level_vao_);
+  glDrawArrays(GL_TRIANGLES, 0, level_vertex_count_);
+  glBindVertexArray(0);
 }
 
 void Renderer::begin(unsigned framebuffer, int width, int height) {
@@ -293,7 +346,8 @@ void Renderer::draw_ground(const CameraMatrices& camera, const glm::vec3& focus)
 }
 
 void Renderer::draw_body(const CameraMatrices& camera, std::span<const glm::vec3> positions,
-                         std::span<const glm::vec3> normals, const glm::vec3& colour) {
+                         std::span<const glm::vec3> normals, const glm::vec3& colour,
+                         float ground_height) {
   if (body_index_count_ == 0 || positions.empty()) return;
   glBindVertexArray(body_vao_);
   glBindBuffer(GL_ARRAY_BUFFER, body_positions_);
@@ -310,7 +364,7 @@ void Renderer::draw_body(const CameraMatrices& camera, std::span<const glm::vec3
 
   // The shadow first: flattened, blended, and each pixel darkened once (stencil), just above
   // the ground so it does not fight the ground's depth.
-  set_matrix(mesh_program_, "model", shadow_projection(kLightDirection, 0.002f));
+  set_matrix(mesh_program_, "model", shadow_projection(kLightDirection, ground_height + 0.002f));
   glUniform1f(uniform(mesh_program_, "shadow"), 1.0f);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);

@@ -89,11 +89,22 @@ void Scene::draw(Renderer& renderer, const GlContext& context, const OrbitCamera
   context.framebuffer_size(width, height);
   const CameraMatrices matrices = camera.matrices(width, height);
   renderer.begin(context.framebuffer(), width, height);
-  renderer.draw_ground(matrices, camera.target);
+  if (world_) {
+    if (!level_uploaded_) {
+      renderer.set_level(level_positions_, level_indices_);
+      level_uploaded_ = true;
+    }
+    renderer.draw_level(matrices);
+  } else {
+    renderer.draw_ground(matrices, camera.target);
+  }
   lines_.clear();
   draw_controller_debug(*controller_, toggles, lines_);
   renderer.draw_lines(matrices, lines_, false);
-  if (show_body) renderer.draw_body(matrices, body_.positions(), body_.normals(), kBodyColour);
+  if (show_body) {
+    renderer.draw_body(matrices, body_.positions(), body_.normals(), kBodyColour,
+                       controller_->debug().ground_height);
+  }
   if (toggles.skeleton || !show_body || body_.positions().empty()) {
     lines_.clear();
     draw_skeleton(*controller_, lines_);
@@ -135,12 +146,22 @@ Status Scene::set_channel_weight(int channel, float weight) {
       make_controller(*shared, controller_->settings());
   if (!controller) return Error{controller.message()};
   const Transform root = controller_->root_transform();
+  (*controller)->set_world(world_);
   (*controller)->teleport(root.translation, quat_yaw(root.rotation));
   database_ = std::move(reweighted);
   shared_ = std::move(*shared);
   controller_ = std::move(*controller);
   last_transitions_ = 0;
   return Status::success();
+}
+
+void Scene::set_level(const WorldQueries* world, std::vector<glm::vec3> positions,
+                      std::vector<uint32_t> indices) {
+  world_ = world;
+  level_positions_ = std::move(positions);
+  level_indices_ = std::move(indices);
+  level_uploaded_ = false;
+  controller_->set_world(world_);
 }
 
 Status Scene::set_weight_method(WeightMethod method) {

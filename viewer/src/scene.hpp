@@ -65,6 +65,11 @@ class Scene {
   Status set_channel_weight(int channel, float weight);
   // The body's weights by another method (fails when the body's weights are fixed).
   Status set_weight_method(WeightMethod method);
+  // A level: the world the controller moves through (not owned: it must outlive the scene) and
+  // its triangles to draw instead of the ground grid (world positions, three indices a
+  // triangle). The character is placed on its ground where it stands.
+  void set_level(const WorldQueries* world, std::vector<glm::vec3> positions,
+                 std::vector<uint32_t> indices);
 
  private:
   explicit Scene(SkinnedMesh body) : body_(std::move(body)) {}
@@ -81,6 +86,11 @@ class Scene {
   float time_ = 0.0f;
   int last_transitions_ = 0;
   DebugLines lines_;
+  // The level (set_level), uploaded to the renderer on the first draw after it is set.
+  const WorldQueries* world_ = nullptr;
+  std::vector<glm::vec3> level_positions_;
+  std::vector<uint32_t> level_indices_;
+  bool level_uploaded_ = false;
 };
 
 }  // namespace mm::viewer

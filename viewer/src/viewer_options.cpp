@@ -72,6 +72,15 @@ void add_file_options(CLI::App& app, ViewerOptions& out) {
   app.add_option("--record", out.record_path,
                  "record the live input into FILE (the same format) until the window closes")
       ->type_name("FILE");
+  app.add_option("--world", out.world_path,
+                 "a level (.gltf or .glb, Y up, metres; every mesh is static collision "
+                 "geometry) the character runs in, through Bullet, drawn instead of the grid "
+                 "(data/levels/course.glb: the test course, docs/world-levels.md)")
+      ->type_name("LEVEL");
+  app.add_option("--start", out.start,
+                 "where the character stands first, world X and Z in metres (default 0,0)")
+      ->type_name("X,Z")
+      ->check(cli::number_pair_in("X,Z", -1e7, 1e7));
 }
 
 // How the character looks and moves.

@@ -19,6 +19,8 @@ struct ViewerOptions {
   SkinningMethod skinning = SkinningMethod::DualQuaternion;
   std::string script_path;  // replay instead of live input
   std::string record_path;  // record the live input into this script file
+  std::string world_path;   // --world: a level the character runs in (docs/world.md)
+  std::string start;        // --start X,Z: where the character stands first (world metres)
   ControllerSettings settings;
   bool headless = false;
   int frames = 0;  // 0: windowed runs until closed; headless runs the script and 2 s more

@@ -1,0 +1,509 @@
+// The test course (mm/world/course.hpp): its parts, their meshes, the .glb and the table.
+
+#include "mm/world/course.hpp"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace mm {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// The layout (metres, degrees). Lanes run along +Z from kLaneStart, side by side along +X, each
+// part a metre or more from the next so that a walk across one never touches another.
+
+constexpr double kLaneStart = 3.0;
+
+constexpr double kGroundLow[2] = {-3.0, -3.0};  // x, z
+constexpr double kGroundHigh[2] = {35.0, 20.0};
+
+// Ramps: up, a plateau, down, all kRampWidth wide.
+struct Ramp {
+  const char* name;
+  double degrees;
+  double x;  // the lane's low x
+};
+constexpr Ramp kRamps[] = {{"ramp_10", 10.0, 0.0}, {"ramp_20", 20.0, 3.0}, {"ramp_30", 30.0, 6.0}};
+constexpr double kRampWidth = 2.0;
+constexpr double kRampRise = 1.0;
+constexpr double kRampPlateau = 2.0;
+
+// Stairs: kSteps risers up to a landing, as many down.
+constexpr double kStairsX = 9.0;
+constexpr double kStairsWidth = 2.0;
+constexpr int kSteps = 6;
+constexpr double kRiser = 0.17;
+constexpr double kTread = 0.30;
+constexpr double kLanding = 1.5;
+
+// The rough patch: a smooth height field sampled every kRoughCell.
+constexpr double kRoughX = 12.0;
+constexpr double kRoughWidth = 3.0;
+constexpr double kRoughLength = 6.0;
+constexpr double kRoughCell = 0.1;
+constexpr int kRoughColumns = 30;  // kRoughWidth / kRoughCell
+constexpr int kRoughRows = 60;     // kRoughLength / kRoughCell
+
+// Walls and boxes.
+constexpr double kWallHeight = 2.0;
+constexpr double kWallThickness = 0.3;
+constexpr double kHeadOnX[2] = {16.0, 19.0};
+constexpr double kHeadOnZ = 8.0;                 // its face
+constexpr double kTurnedStart[2] = {20.5, 5.0};  // x, z: one end of its face
+constexpr double kTurnedLength = 6.0;
+constexpr double kTurnedDegrees = 30.0;  // from +Z toward +X
+constexpr double kTurnedWalkX = 22.0;    // a walk along +Z here meets its face mid-length
+constexpr double kBoxSide = 1.0;
+struct Box {
+  const char* name;
+  double x;  // low x
+  double top;
+};
+constexpr Box kBoxes[] = {{"box_low", 27.5, 0.3}, {"box_high", 30.5, 1.2}};
+constexpr double kBoxZ = 6.0;
+
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
+
+double ramp_run(const Ramp& ramp) {
+  return kRampRise / std::tan(radians(ramp.degrees));
+}
+
+double ramp_length(const Ramp& ramp) {
+  return 2.0 * ramp_run(ramp) + kRampPlateau;
+}
+
+// The height of a ramp's profile `along` metres from its start.
+double ramp_height(const Ramp& ramp, double along) {
+  const double run = ramp_run(ramp);
+  if (along <= 0.0 || along >= ramp_length(ramp)) return 0.0;
+  if (along < run) return kRampRise * along / run;
+  if (along <= run + kRampPlateau) return kRampRise;
+  return kRampRise * (ramp_length(ramp) - along) / run;
+}
+
+double stairs_length() {
+  return 2.0 * (kSteps - 1) * kTread + kLanding;
+}
+
+// The height of the stairs `along` metres from the first riser.
+double stairs_height(double along) {
+  if (along < 0.0 || along > stairs_length()) return 0.0;
+  const double up = (kSteps - 1) * kTread;
+  if (along < up) return kRiser * (std::floor(along / kTread) + 1.0);
+  if (along <= up + kLanding) return kRiser * kSteps;
+  return kRiser * (kSteps - 1 - std::floor((along - up - kLanding) / kTread));
+}
+
+// The rough patch's height field at (u, v) metres into it: bumps on a window that brings it
+// smoothly down to the ground within 0.3 m of its edges.
+double rough_field(double u, double v) {
+  auto window = [](double s, double length) {
+    const double t = std::clamp(std::min(s, length - s) / 0.3, 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  const double bumps = 0.04 + 0.02 * std::sin(2.0 * std::numbers::pi * u / 0.9) +
+                       0.02 * std::sin(2.0 * std::numbers::pi * v / 1.3 + 0.7);
+  return window(u, kRoughWidth) * window(v, kRoughLength) * bumps;
+}
+
+// The height field at a grid vertex, as the mesh stores it (rounded to float).
+double rough_vertex(int column, int row) {
+  return static_cast<float>(rough_field(column * kRoughCell, row * kRoughCell));
+}
+
+// The mesh's own surface between the vertices: every cell is split along the diagonal from its
+// (low u, low v) corner to its (high u, high v) corner.
+double rough_height(double u, double v) {
+  const int column = std::clamp(static_cast<int>(std::floor(u / kRoughCell)), 0, kRoughColumns - 1);
+  const int row = std::clamp(static_cast<int>(std::floor(v / kRoughCell)), 0, kRoughRows - 1);
+  const double a = u / kRoughCell - column;
+  const double b = v / kRoughCell - row;
+  const double h00 = rough_vertex(column, row);
+  const double h10 = rough_vertex(column + 1, row);
+  const double h01 = rough_vertex(column, row + 1);
+  const double h11 = rough_vertex(column + 1, row + 1);
+  if (a >= b) return h00 + a * (h10 - h00) + b * (h11 - h10);
+  return h00 + b * (h01 - h00) + a * (h11 - h01);
+}
+
+double rough_top() {
+  double top = 0.0;
+  for (int column = 0; column <= kRoughColumns; ++column) {
+    for (int row = 0; row <= kRoughRows; ++row) top = std::max(top, rough_vertex(column, row));
+  }
+  return top;
+}
+
+// (x, z) in the turned wall's own frame: its face runs along +z from 0 to kTurnedLength at x = 0,
+// its thickness is x in [-kWallThickness, 0].
+glm::dvec2 turned_wall_frame(double x, double z) {
+  const double angle = radians(kTurnedDegrees);
+  const double dx = x - kTurnedStart[0];
+  const double dz = z - kTurnedStart[1];
+  return {dx * std::cos(angle) - dz * std::sin(angle), dx * std::sin(angle) + dz * std::cos(angle)};
+}
+
+// "3", "16.34", "0.08": at most two decimals, no trailing zeros.
+std::string metres(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", v);
+  std::string s(text);
+  while (!s.empty() && s.back() == '0') s.pop_back();
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  return s == "-0" ? "0" : s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes, in each part's own frame
+
+struct Mesh {
+  std::vector<glm::dvec3> positions;
+  std::vector<uint32_t> indices;
+
+  uint32_t vertex(const glm::dvec3& p) {
+    positions.push_back(p);
+    return static_cast<uint32_t>(positions.size() - 1);
+  }
+
+  // A triangle wound counter-clockwise seen from `outside` (a direction its normal should face).
+  void triangle(uint32_t a, uint32_t b, uint32_t c, const glm::dvec3& outside) {
+    const glm::dvec3 normal = glm::cross(positions[b] - positions[a], positions[c] - positions[a]);
+    if (glm::dot(normal, outside) < 0.0) std::swap(b, c);
+    indices.insert(indices.end(), {a, b, c});
+  }
+
+  // A convex prism: `profile` (z, y) points in order around a convex polygon, extruded along x
+  // from x0 to x1. Every face wound outward.
+  void prism(const std::vector<glm::dvec2>& profile, double x0, double x1) {
+    glm::dvec2 centre(0.0);
+    for (const glm::dvec2& p : profile) centre += p / static_cast<double>(profile.size());
+    const glm::dvec3 middle(0.5 * (x0 + x1), centre.y, centre.x);
+    const uint32_t first = static_cast<uint32_t>(positions.size());
+    const uint32_t n = static_cast<uint32_t>(profile.size());
+    for (const glm::dvec2& p : profile) vertex({x0, p.y, p.x});
+    for (const glm::dvec2& p : profile) vertex({x1, p.y, p.x});
+    for (uint32_t k = 1; k + 1 < n; ++k) {
+      triangle(first, first + k, first + k + 1, {-1.0, 0.0, 0.0});
+      triangle(first + n, first + n + k, first + n + k + 1, {1.0, 0.0, 0.0});
+    }
+    for (uint32_t k = 0; k < n; ++k) {
+      const uint32_t next = (k + 1) % n;
+      const glm::dvec3 side = 0.5 * (positions[first + k] + positions[first + n + next]) - middle;
+      triangle(first + k, first + next, first + n + next, side);
+      triangle(first + k, first + n + next, first + n + k, side);
+    }
+  }
+
+  void box(const glm::dvec3& low, const glm::dvec3& high) {
+    prism({{low.z, low.y}, {high.z, low.y}, {high.z, high.y}, {low.z, high.y}}, low.x, high.x);
+  }
+};
+
+// A part's node: its mesh in its own frame, where the node puts it.
+struct Placed {
+  std::string name;
+  Mesh mesh;
+  glm::dvec3 translation{0.0};
+  double yaw_degrees = 0.0;
+};
+
+std::vector<Placed> course_meshes() {
+  std::vector<Placed> parts;
+  {
+    Placed ground{"ground", {}, {0.0, 0.0, 0.0}, 0.0};
+    Mesh& m = ground.mesh;
+    const uint32_t a = m.vertex({kGroundLow[0], 0.0, kGroundLow[1]});
+    const uint32_t b = m.vertex({kGroundHigh[0], 0.0, kGroundLow[1]});
+    const uint32_t c = m.vertex({kGroundHigh[0], 0.0, kGroundHigh[1]});
+    const uint32_t d = m.vertex({kGroundLow[0], 0.0, kGroundHigh[1]});
+    m.triangle(a, b, c, {0.0, 1.0, 0.0});
+    m.triangle(a, c, d, {0.0, 1.0, 0.0});
+    parts.push_back(std::move(ground));
+  }
+  for (const Ramp& ramp : kRamps) {
+    Placed placed{ramp.name, {}, {ramp.x, 0.0, kLaneStart}, 0.0};
+    const double run = ramp_run(ramp);
+    placed.mesh.prism(
+        {{0.0, 0.0}, {run, kRampRise}, {run + kRampPlateau, kRampRise}, {ramp_length(ramp), 0.0}},
+        0.0, kRampWidth);
+    parts.push_back(std::move(placed));
+  }
+  {
+    // One box per tread (the landing is one): columns standing on the ground.
+    Placed stairs{"stairs", {}, {kStairsX, 0.0, kLaneStart}, 0.0};
+    double along = 0.0;
+    for (int step = 1; step <= 2 * kSteps - 1; ++step) {
+      const double length = step == kSteps ? kLanding : kTread;
+      const double height = stairs_height(along + 0.5 * length);
+      stairs.mesh.box({0.0, 0.0, along}, {kStairsWidth, height, along + length});
+      along += length;
+    }
+    parts.push_back(std::move(stairs));
+  }
+  {
+    Placed rough{"rough", {}, {kRoughX, 0.0, kLaneStart}, 0.0};
+    Mesh& m = rough.mesh;
+    for (int row = 0; row <= kRoughRows; ++row) {
+      for (int column = 0; column <= kRoughColumns; ++column) {
+        m.vertex({column * kRoughCell, rough_vertex(column, row), row * kRoughCell});
+      }
+    }
+    auto at = [](int column, int row) {
+      return static_cast<uint32_t>(row * (kRoughColumns + 1) + column);
+    };
+    for (int row = 0; row < kRoughRows; ++row) {
+      for (int column = 0; column < kRoughColumns; ++column) {
+        // The diagonal rough_height() assumes: (column, row) to (column + 1, row + 1).
+        m.triangle(at(column, row), at(column + 1, row), at(column + 1, row + 1), {0, 1, 0});
+        m.triangle(at(column, row), at(column + 1, row + 1), at(column, row + 1), {0, 1, 0});
+      }
+    }
+    parts.push_back(std::move(rough));
+  }
+  {
+    Placed wall{"wall_head_on", {}, {kHeadOnX[0], 0.0, kHeadOnZ}, 0.0};
+    wall.mesh.box({0.0, 0.0, 0.0}, {kHeadOnX[1] - kHeadOnX[0], kWallHeight, kWallThickness});
+    parts.push_back(std::move(wall));
+  }
+  {
+    Placed wall{"wall_30", {}, {kTurnedStart[0], 0.0, kTurnedStart[1]}, kTurnedDegrees};
+    wall.mesh.box({-kWallThickness, 0.0, 0.0}, {0.0, kWallHeight, kTurnedLength});
+    parts.push_back(std::move(wall));
+  }
+  for (const Box& box : kBoxes) {
+    Placed placed{box.name, {}, {box.x, 0.0, kBoxZ}, 0.0};
+    placed.mesh.box({0.0, 0.0, 0.0}, {kBoxSide, box.top, kBoxSide});
+    parts.push_back(std::move(placed));
+  }
+  return parts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The .glb
+
+// Appends arrays to the model's one buffer, each in its own 4-byte aligned buffer view.
+int add_accessor(tinygltf::Model& model, std::vector<unsigned char>& buffer, const void* data,
+                 size_t bytes, int component_type, int type, size_t count, int target,
+                 std::vector<double> min = {}, std::vector<double> max = {}) {
+  while (buffer.size() % 4 != 0) buffer.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.size();
+  view.byteLength = bytes;
+  view.target = target;
+  const auto* p = static_cast<const unsigned char*>(data);
+  buffer.insert(buffer.end(), p, p + bytes);
+  model.bufferViews.push_back(std::move(view));
+  tinygltf::Accessor accessor;
+  accessor.bufferView = static_cast<int>(model.bufferViews.size() - 1);
+  accessor.byteOffset = 0;
+  accessor.componentType = component_type;
+  accessor.type = type;
+  accessor.count = count;
+  accessor.minValues = std::move(min);
+  accessor.maxValues = std::move(max);
+  model.accessors.push_back(std::move(accessor));
+  return static_cast<int>(model.accessors.size() - 1);
+}
+
+}  // namespace
+
+std::vector<CoursePart> course_parts() {
+  std::vector<CoursePart> parts;
+  parts.push_back({"ground",
+                   {kGroundLow[0], kGroundHigh[0]},
+                   {kGroundLow[1], kGroundHigh[1]},
+                   0.0,
+                   "flat ground (y = 0) under the whole course"});
+  for (const Ramp& ramp : kRamps) {
+    const double run = ramp_run(ramp);
+    const double z = kLaneStart;
+    parts.push_back({ramp.name,
+                     {ramp.x, ramp.x + kRampWidth},
+                     {z, z + ramp_length(ramp)},
+                     kRampRise,
+                     metres(ramp.degrees) + "° up (z " + metres(z) + " to " + metres(z + run) +
+                         "), plateau " + metres(kRampRise) + " m high (to " +
+                         metres(z + run + kRampPlateau) + "), " + metres(ramp.degrees) +
+                         "° down (to " + metres(z + ramp_length(ramp)) +
+                         "); walk +Z at x = " + metres(ramp.x + 0.5 * kRampWidth)});
+  }
+  const double up = (kSteps - 1) * kTread;
+  parts.push_back(
+      {"stairs",
+       {kStairsX, kStairsX + kStairsWidth},
+       {kLaneStart, kLaneStart + stairs_length()},
+       kRiser * kSteps,
+       std::to_string(kSteps) + " risers of " + metres(kRiser) + " m up (treads " + metres(kTread) +
+           " m, z " + metres(kLaneStart) + " to " + metres(kLaneStart + up) + "), landing " +
+           metres(kRiser * kSteps) + " m high (to " + metres(kLaneStart + up + kLanding) + "), " +
+           std::to_string(kSteps) + " down (to " + metres(kLaneStart + stairs_length()) +
+           "); walk +Z at x = " + metres(kStairsX + 0.5 * kStairsWidth)});
+  parts.push_back({"rough",
+                   {kRoughX, kRoughX + kRoughWidth},
+                   {kLaneStart, kLaneStart + kRoughLength},
+                   rough_top(),
+                   "bumps of 0 to " + metres(100.0 * rough_top()) +
+                       " cm (a smooth height field on a " + metres(100.0 * kRoughCell) +
+                       " cm grid); walk +Z at x = " + metres(kRoughX + 0.5 * kRoughWidth)});
+  parts.push_back({"wall_head_on",
+                   {kHeadOnX[0], kHeadOnX[1]},
+                   {kHeadOnZ, kHeadOnZ + kWallThickness},
+                   kWallHeight,
+                   "wall across the lane, its face at z = " + metres(kHeadOnZ) +
+                       "; walk +Z at x = " + metres(0.5 * (kHeadOnX[0] + kHeadOnX[1])) +
+                       " into it"});
+  {
+    // The turned wall's bounds: its four footprint corners, turned.
+    const double angle = radians(kTurnedDegrees);
+    const glm::dvec2 along(std::sin(angle), std::cos(angle));    // its face's direction (x, z)
+    const glm::dvec2 across(std::cos(angle), -std::sin(angle));  // its local +x
+    const glm::dvec2 start(kTurnedStart[0], kTurnedStart[1]);
+    glm::dvec2 low(1e9), high(-1e9);
+    for (double a : {0.0, kTurnedLength}) {
+      for (double t : {-kWallThickness, 0.0}) {
+        const glm::dvec2 corner = start + a * along + t * across;
+        low = glm::min(low, corner);
+        high = glm::max(high, corner);
+      }
+    }
+    const glm::dvec2 end = start + kTurnedLength * along;
+    const double meet_z = start.y + (kTurnedWalkX - start.x) / along.x * along.y;
+    parts.push_back({"wall_30",
+                     {low.x, high.x},
+                     {low.y, high.y},
+                     kWallHeight,
+                     "wall " + metres(kTurnedLength) + " m long turned " + metres(kTurnedDegrees) +
+                         "° from +Z, its face from (" + metres(start.x) + ", " + metres(start.y) +
+                         ") to (" + metres(end.x) + ", " + metres(end.y) +
+                         "); walk +Z at x = " + metres(kTurnedWalkX) +
+                         " to meet it at z = " + metres(meet_z) + " and slide along it"});
+  }
+  for (const Box& box : kBoxes) {
+    parts.push_back({box.name,
+                     {box.x, box.x + kBoxSide},
+                     {kBoxZ, kBoxZ + kBoxSide},
+                     box.top,
+                     "box " + metres(kBoxSide) + " by " + metres(kBoxSide) + " m, " +
+                         metres(box.top) +
+                         " m high; walk +Z at x = " + metres(box.x + 0.5 * kBoxSide)});
+  }
+  return parts;
+}
+
+std::string course_table() {
+  std::string table = "| part | x (m) | z (m) | top (m) | what |\n|---|---|---|---|---|\n";
+  for (const CoursePart& part : course_parts()) {
+    table += "| " + part.name + " | " + metres(part.x_range.x) + " to " + metres(part.x_range.y) +
+             " | " + metres(part.z_range.x) + " to " + metres(part.z_range.y) + " | " +
+             metres(part.top) + " | " + part.what + " |\n";
+  }
+  return table;
+}
+
+double course_height(double x, double z) {
+  auto inside = [](double v, double low, double high) { return v >= low && v <= high; };
+  for (const Ramp& ramp : kRamps) {
+    if (inside(x, ramp.x, ramp.x + kRampWidth) &&
+        inside(z, kLaneStart, kLaneStart + ramp_length(ramp))) {
+      return ramp_height(ramp, z - kLaneStart);
+    }
+  }
+  if (inside(x, kStairsX, kStairsX + kStairsWidth) &&
+      inside(z, kLaneStart, kLaneStart + stairs_length())) {
+    return stairs_height(z - kLaneStart);
+  }
+  if (inside(x, kRoughX, kRoughX + kRoughWidth) &&
+      inside(z, kLaneStart, kLaneStart + kRoughLength)) {
+    return rough_height(x - kRoughX, z - kLaneStart);
+  }
+  if (inside(x, kHeadOnX[0], kHeadOnX[1]) && inside(z, kHeadOnZ, kHeadOnZ + kWallThickness)) {
+    return kWallHeight;
+  }
+  const glm::dvec2 turned = turned_wall_frame(x, z);
+  if (inside(turned.x, -kWallThickness, 0.0) && inside(turned.y, 0.0, kTurnedLength)) {
+    return kWallHeight;
+  }
+  for (const Box& box : kBoxes) {
+    if (inside(x, box.x, box.x + kBoxSide) && inside(z, kBoxZ, kBoxZ + kBoxSide)) return box.top;
+  }
+  return 0.0;
+}
+
+std::vector<unsigned char> course_glb() {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "mm-make-course (world/src/course.cpp)";
+  std::vector<unsigned char> buffer;
+  tinygltf::Node root;
+  root.name = "course";
+  for (const Placed& part : course_meshes()) {
+    std::vector<float> positions;
+    std::vector<double> low(3, 1e300), high(3, -1e300);
+    for (const glm::dvec3& p : part.mesh.positions) {
+      for (int k = 0; k < 3; ++k) {
+        const float v = static_cast<float>(p[k]);
+        positions.push_back(v);
+        low[static_cast<size_t>(k)] = std::min(low[static_cast<size_t>(k)], double{v});
+        high[static_cast<size_t>(k)] = std::max(high[static_cast<size_t>(k)], double{v});
+      }
+    }
+    const int position_accessor =
+        add_accessor(model, buffer, positions.data(), positions.size() * sizeof(float),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, part.mesh.positions.size(),
+                     TINYGLTF_TARGET_ARRAY_BUFFER, low, high);
+    const int index_accessor = add_accessor(
+        model, buffer, part.mesh.indices.data(), part.mesh.indices.size() * sizeof(uint32_t),
+        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, part.mesh.indices.size(),
+        TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Primitive primitive;
+    primitive.attributes["POSITION"] = position_accessor;
+    primitive.indices = index_accessor;
+    primitive.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Mesh mesh;
+    mesh.name = part.name;
+    mesh.primitives.push_back(std::move(primitive));
+    model.meshes.push_back(std::move(mesh));
+
+    tinygltf::Node node;
+    node.name = part.name;
+    node.mesh = static_cast<int>(model.meshes.size() - 1);
+    if (part.translation != glm::dvec3(0.0)) {
+      node.translation = {part.translation.x, part.translation.y, part.translation.z};
+    }
+    if (part.yaw_degrees != 0.0) {
+      const double half = 0.5 * radians(part.yaw_degrees);
+      node.rotation = {0.0, std::sin(half), 0.0, std::cos(half)};  // x, y, z, w
+    }
+    model.nodes.push_back(std::move(node));
+    root.children.push_back(static_cast<int>(model.nodes.size() - 1));
+  }
+  model.nodes.push_back(std::move(root));
+  tinygltf::Scene scene;
+  scene.name = "course";
+  scene.nodes = {static_cast<int>(model.nodes.size() - 1)};
+  model.scenes.push_back(std::move(scene));
+  model.defaultScene = 0;
+  while (buffer.size() % 4 != 0) buffer.push_back(0);
+  tinygltf::Buffer gltf_buffer;
+  gltf_buffer.data = std::move(buffer);
+  model.buffers.push_back(std::move(gltf_buffer));
+
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/false, /*writeBinary=*/true);
+  const std::string bytes = stream.str();
+  return {bytes.begin(), bytes.end()};
+}
+
+}  // namespace mm
