@@ -332,9 +332,9 @@ TEST(ControllerCli, EvalRunsInALevelAndRefusesABadOne) {
   const fs::path script = fs::path(MM_SOURCE_DIR) / "scripts/input/course-walk.txt";
   const fs::path json = dir / "wall.json";
   // The lane of the wall across it: the character walks into it and stands.
-  const CommandRun run = run_mm("eval --db " + test::quoted(small_database()) + " --script " +
-                                test::quoted(script) + " --world " + test::quoted(course) +
-                                " --start 17.5,0 --json " + test::quoted(json));
+  const CommandRun run =
+      run_mm("eval --db " + test::quoted(small_database()) + " --script " + test::quoted(script) +
+             " --world " + test::quoted(course) + " --start 17.5,0 --json " + test::quoted(json));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find(", world " + course.string()), std::string::npos) << run.output;
   const nlohmann::json metrics = nlohmann::json::parse(read_text(json));
@@ -343,9 +343,8 @@ TEST(ControllerCli, EvalRunsInALevelAndRefusesABadOne) {
   EXPECT_GT(metrics["toe_clearance_cm_min"].get<double>(), 0.0);  // flat where the wall is
 
   const fs::path bad = write_script(dir, "bad.glb", "not a glTF file");
-  const CommandRun refused =
-      run_mm("eval --db " + test::quoted(small_database()) + " --script " + test::quoted(script) +
-             " --world " + test::quoted(bad));
+  const CommandRun refused = run_mm("eval --db " + test::quoted(small_database()) + " --script " +
+                                    test::quoted(script) + " --world " + test::quoted(bad));
   EXPECT_EQ(refused.exit_code, 1) << refused.output;
   EXPECT_NE(refused.output.find("mm eval: " + bad.string()), std::string::npos) << refused.output;
   std::error_code ec;
