@@ -36,8 +36,8 @@ mm::Result<std::unique_ptr<mm::BulletWorld>> open_world(const std::string& path,
   for (const glm::vec3& p : level->positions) {
     positions.emplace_back(level->origin + glm::dvec3(p));
   }
-  scene.set_level(world.get(), std::move(positions), std::move(level->indices));
   std::printf("mm-viewer: level %s, %zu triangles\n", path.c_str(), level->triangle_count());
+  scene.set_level(world.get(), std::move(positions), std::move(level->indices));
   return world;
 }
 
