@@ -37,7 +37,13 @@ done
 printf '\n=== 3/4 Crowd benchmark (mm crowd-bench, 1500 characters, 120 s at 60 Hz) ===\n'
 "$mm" crowd-bench --db out/database.mmdb --characters 1500 --seconds 120 --json out/crowd-bench.json
 
+# The same cost in the test course (Bullet) against flat ground, in one run.
+printf '\n=== 3/4 (continued) Crowd in the test course (mm crowd-bench --world, 300 characters, 30 s) ===\n'
+"$mm" crowd-bench --db out/database.mmdb --characters 300 --seconds 30 \
+  --world data/levels/course.glb --json out/crowd-bench-world.json
+
 printf '\n=== 4/4 Search benchmark (every method, 2000 queries, noise 0.1) ===\n'
 "$mm" search-bench --db out/database.mmdb --queries 2000 --noise 0.1 --json out/search-bench.json
 
-printf '\nDone: out/eval.json, out/course-<lane>.json, out/crowd-bench.json, out/search-bench.json\n'
+printf '\nDone: out/eval.json, out/course-<lane>.json, out/crowd-bench.json, out/crowd-bench-world.json,\n'
+printf 'out/search-bench.json\n'

@@ -14,6 +14,7 @@
 namespace mm {
 
 void Controller::set_world(const WorldQueries* world) {
+  if (world == world_) return;
   world_ = world;
   ground_height_ = ground_velocity_ = 0.0f;
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));

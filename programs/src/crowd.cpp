@@ -5,9 +5,11 @@
 #include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <barrier>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -15,21 +17,58 @@ namespace mm {
 
 namespace {
 
-// Where character i starts: on a grid, so a viewer of the run sees the characters apart.
-glm::vec3 start_position(size_t i) {
-  return glm::vec3(static_cast<float>(i % 32) * 3.0f, 0.0f, static_cast<float>(i / 32) * 3.0f);
+// Where character i starts: on a grid, so a viewer of the run sees the characters apart;
+// wrapped into `area` (x0, z0, x1, z1) when it has one.
+glm::vec3 start_position(size_t i, const glm::vec4& area) {
+  glm::vec3 p(static_cast<float>(i % 32) * 3.0f, 0.0f, static_cast<float>(i / 32) * 3.0f);
+  const float width = area.z - area.x, depth = area.w - area.y;
+  if (width > 0.0f && depth > 0.0f) {
+    p.x = area.x + std::fmod(p.x, width);
+    p.z = area.y + std::fmod(p.z + 1.5f * static_cast<float>(i / (32 * 32)), depth);
+  }
+  return p;
 }
+
+// A world that times its own queries, for the share of the update spent in them: the wall time
+// of every call, summed over all threads.
+class TimedWorld final : public WorldQueries {
+ public:
+  explicit TimedWorld(const WorldQueries& world) : world_(world) {}
+  void probe_ground(const glm::dvec3& origin, std::span<const GroundProbe> probes,
+                    std::span<GroundHit> hits) const override {
+    const auto start = std::chrono::steady_clock::now();
+    world_.probe_ground(origin, probes, hits);
+    add(start);
+  }
+  void sweep(const glm::dvec3& origin, std::span<const ShapeSweep> sweeps,
+             std::span<SweepHit> hits) const override {
+    const auto start = std::chrono::steady_clock::now();
+    world_.sweep(origin, sweeps, hits);
+    add(start);
+  }
+  double seconds() const { return static_cast<double>(nanoseconds_.load()) * 1e-9; }
+
+ private:
+  void add(std::chrono::steady_clock::time_point start) const {
+    const auto elapsed = std::chrono::steady_clock::now() - start;
+    nanoseconds_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(elapsed).count(),
+                           std::memory_order_relaxed);
+  }
+  const WorldQueries& world_;
+  mutable std::atomic<int64_t> nanoseconds_{0};
+};
 
 // Controllers for `n` characters, each at its start position.
 Result<std::vector<Controller>> make_characters(
-    const std::shared_ptr<const ControllerDatabase>& database, const ControllerSettings& settings,
-    size_t n) {
+    const std::shared_ptr<const ControllerDatabase>& database, const CrowdOptions& options,
+    const WorldQueries* world, size_t n) {
   std::vector<Controller> characters;
   characters.reserve(n);
   for (size_t i = 0; i < n; ++i) {
-    Result<Controller> c = Controller::create(database, settings);
+    Result<Controller> c = Controller::create(database, options.settings);
     if (!c) return Error{c.message()};
-    c->teleport(start_position(i), 0.0f);
+    c->set_world(world);
+    c->teleport(start_position(i, options.start_area), 0.0f);
     characters.push_back(std::move(c).value());
   }
   return characters;
@@ -103,10 +142,13 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   const bool replayed = frames > window;
   const size_t replay_start = replayed ? frames - window : frames;
 
-  Result<std::vector<Controller>> controllers = make_characters(database, options.settings, n);
+  std::optional<TimedWorld> world;
+  if (options.world) world.emplace(*options.world);
+  const WorldQueries* queries = world ? &*world : nullptr;
+  Result<std::vector<Controller>> controllers = make_characters(database, options, queries, n);
   if (!controllers) return Error{controllers.message()};
   Result<std::vector<Controller>> replay =
-      make_characters(database, options.settings, replayed ? n : 0);
+      make_characters(database, options, queries, replayed ? n : 0);
   if (!replay) return Error{replay.message()};
   std::vector<InputScript> scripts;
   scripts.reserve(n);
@@ -119,6 +161,9 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
                    std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
+  // Every update's time, replays included, summed per thread: what the world's share is of.
+  std::vector<double> thread_update_seconds(static_cast<size_t>(threads), 0.0);
+  const double world_before = world ? world->seconds() : 0.0;
   auto timed_update = [&](Controller& controller, float t, const InputScript& script) {
     const ControllerInput input = script.at(t);
     const Clock::time_point start = Clock::now();
@@ -136,15 +181,21 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
       // Which of a character's two updates goes first alternates, so that neither always runs
       // in the cache the other left.
       const bool replay_first = f % 2 == 0;
+      double& spent = thread_update_seconds[static_cast<size_t>(index)];
       for (size_t i = first; i < last; ++i) {
         if (replaying && replay_first) {
-          times.replay_seconds[i] += timed_update((*replay)[i], replay_t, scripts[i]);
+          const double replayed_seconds = timed_update((*replay)[i], replay_t, scripts[i]);
+          times.replay_seconds[i] += replayed_seconds;
+          spent += replayed_seconds;
         }
         const double elapsed = timed_update((*controllers)[i], t, scripts[i]);
         times.update_us[f * n + i] = static_cast<float>(elapsed * 1e6);
+        spent += elapsed;
         if (!replaying) times.search_seconds[i] += (*controllers)[i].debug().search_seconds;
         if (replaying && !replay_first) {
-          times.replay_seconds[i] += timed_update((*replay)[i], replay_t, scripts[i]);
+          const double replayed_seconds = timed_update((*replay)[i], replay_t, scripts[i]);
+          times.replay_seconds[i] += replayed_seconds;
+          spent += replayed_seconds;
         }
       }
       sync.arrive_and_wait();
@@ -162,6 +213,12 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   for (std::thread& t : pool) t.join();
 
   CrowdResult result = summarize(times, n, window, replay_start);
+  if (world) {
+    double spent = 0.0;
+    for (const double seconds : thread_update_seconds) spent += seconds;
+    result.world_share =
+        spent > 0.0 ? std::min(1.0, (world->seconds() - world_before) / spent) : 0.0;
+  }
   result.threads = threads;
   result.frames = clamped_integer<int>(frames);
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();

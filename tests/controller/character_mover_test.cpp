@@ -34,8 +34,8 @@ TEST(CharacterMover, OnFlatGroundAMoveGoesWhereItWasSentInTwoCalls) {
   EXPECT_NEAR(m.position.z, 2.25f, kTolerance);
   EXPECT_FALSE(m.blocked);
   EXPECT_FALSE(m.no_ground);
-  EXPECT_EQ(world.sweep_calls, 1);  // nothing hit: no slide
-  EXPECT_EQ(world.probe_calls, 1);
+  EXPECT_EQ(world.sweep_calls.load(), 1);  // nothing hit: no slide
+  EXPECT_EQ(world.probe_calls.load(), 1);
 }
 
 TEST(CharacterMover, HeadOnIntoAWallItStopsTheRadiusAndTheSkinShort) {
@@ -140,8 +140,8 @@ TEST(CharacterMover, ABatchIsThreeCallsWhateverItsSize) {
   for (int i = 0; i < 8; ++i) goals.emplace_back(0.3f * i, 0.0f, 0.5f * i);
   std::vector<MoveResult> out(8);
   mover.collide(world, glm::dvec3(0.0), shape(), starts, goals, out);
-  EXPECT_EQ(world.sweep_calls, 2);  // the sweeps, then the slides of those that hit
-  EXPECT_EQ(world.probe_calls, 1);
+  EXPECT_EQ(world.sweep_calls.load(), 2);  // the sweeps, then the slides of those that hit
+  EXPECT_EQ(world.probe_calls.load(), 1);
   for (int i = 0; i < 8; ++i) {
     EXPECT_LE(out[i].position.z, 2.0f - 0.3f + kTolerance) << i;
     EXPECT_EQ(out[i].blocked, 0.5f * i > 1.7f) << i;

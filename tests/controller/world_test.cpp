@@ -51,8 +51,8 @@ TEST(ControllerWorld, AFlatWorldMovesTheCharacterExactlyAsNoWorld) {
     EXPECT_EQ(a[j].translation, b[j].translation) << j;
     EXPECT_EQ(a[j].rotation, b[j].rotation) << j;
   }
-  EXPECT_GT(flat.probe_calls, 0);
-  EXPECT_LE(flat.probe_calls + flat.sweep_calls, 600 * kMaxWorldCallsPerUpdate);
+  EXPECT_GT(flat.probe_calls.load(), 0);
+  EXPECT_LE(flat.probe_calls.load() + flat.sweep_calls.load(), 600 * kMaxWorldCallsPerUpdate);
 }
 
 TEST(ControllerWorld, HeadOnIntoAWallTheCharacterStopsBeforeItAndStands) {

@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "analytic_world.hpp"
 #include "mm/controller/controller.hpp"
 #include "mm/offline/builder.hpp"
 #include "mm/programs/crowd.hpp"
@@ -78,6 +79,40 @@ TEST(CrowdThreads, TwoAndFourThreadsGiveTheOneThreadCrowd) {
     moved += glm::distance(reference[i], start) > 0.5f;
   }
   EXPECT_GE(moved, 9);
+}
+
+// In a world (here the analytic test world: a wall across the start area and a step), the
+// crowd on 2 threads ends where it does on 1, inside the start area's walls, and the world's
+// queries take a measured share of the update.
+TEST(CrowdThreads, InAWorldTwoThreadsGiveTheOneThreadCrowd) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  test::AnalyticWorld world;
+  world.boxes.push_back(
+      test::AnalyticBox{glm::vec2(5.0f, 4.5f), glm::vec2(10.0f, 0.2f), 0.0f, 2.0f});
+  world.boxes.push_back(
+      test::AnalyticBox{glm::vec2(3.0f, 1.0f), glm::vec2(1.0f, 1.0f), 0.0f, 0.15f});
+  CrowdOptions options;
+  options.characters = 8;
+  options.seconds = 3.0f;
+  options.world = &world;
+  options.start_area = glm::vec4(0.0f, 0.0f, 9.0f, 3.0f);
+  std::vector<glm::vec3> reference;
+  for (const int threads : {1, 2}) {
+    options.threads = threads;
+    Result<CrowdResult> run = run_crowd(shared, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    EXPECT_GT(run->world_share, 0.0);
+    EXPECT_LT(run->world_share, 1.0);
+    for (const glm::vec3& p : run->final_positions) {
+      EXPECT_LT(p.z, 4.3f - 0.3f + 1e-3f);  // never through the wall's face
+    }
+    if (threads == 1) {
+      reference = run->final_positions;
+    } else {
+      EXPECT_EQ(run->final_positions, reference);
+    }
+  }
 }
 
 TEST(CrowdThreads, TheReplayedFirstWindowEndsWhereTheRunsFirstWindowDid) {

@@ -7,6 +7,7 @@
 // steepness is the ground probe's to judge). It counts its calls, and can be told to answer
 // garbage.
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -36,10 +37,11 @@ class AnalyticWorld : public WorldQueries {
   glm::dvec3 offset{0.0};
   // Answers garbage: NaN fractions and points, zero normals, points off the probe.
   bool garbage = false;
-  mutable int probe_calls = 0;
-  mutable int sweep_calls = 0;
-  mutable int probes = 0;
-  mutable int sweeps = 0;
+  // Counted atomically: several controllers may query one world from several threads.
+  mutable std::atomic<int> probe_calls{0};
+  mutable std::atomic<int> sweep_calls{0};
+  mutable std::atomic<int> probes{0};
+  mutable std::atomic<int> sweeps{0};
 
   void probe_ground(const glm::dvec3& origin, std::span<const GroundProbe> queries,
                     std::span<GroundHit> hits) const override {

@@ -17,6 +17,8 @@
 #include "mm/programs/crowd.hpp"
 #include "mm/programs/shared_options.hpp"
 #include "mm/runtime/float_to_integer.hpp"
+#include "mm/world/bullet_world.hpp"
+#include "mm/world/level.hpp"
 
 namespace mm::cli {
 namespace {
@@ -24,6 +26,7 @@ namespace {
 struct Arguments {
   std::string db_path;
   std::string json_path;
+  std::string world_path;
   CrowdOptions options;
   int extra_threads = 0;
 };
@@ -65,6 +68,12 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       ->check(integer_in(1, 1024))
       ->type_name("T");
   add_set_option(app, out.options.settings);
+  app.add_option("--world", out.world_path,
+                 "also run the crowd in this level (.gltf or .glb; Bullet, docs/world.md), "
+                 "beside the same crowd on flat ground, both starting inside the level's "
+                 "bounds: the cost with the world against without, and the world's queries' "
+                 "share of it")
+      ->type_name("LEVEL");
   app.add_option("--json", out.json_path, "also write the results as JSON")->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   return check_settings(app, out.options.settings);
@@ -73,10 +82,10 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
 // The JSON of one run, and its figures printed as a table row.
 nlohmann::json report_run(const CrowdResult& run) {
   const double ratio = run.update_us_last_window / run.update_us_first_window;
-  std::printf("%8d %14.2f %14.2f %12.1f%% %14.3f %16d %12.2f %12.2f %10.2f\n", run.threads,
-              run.update_us_mean, run.update_us_p99, 100.0 * run.search_share, run.frame_ms_mean,
-              run.max_characters_60hz, run.update_us_first_window, run.update_us_last_window,
-              ratio);
+  std::printf("%8d %14.2f %14.2f %12.1f%% %12.1f%% %14.3f %16d %12.2f %12.2f %10.2f\n", run.threads,
+              run.update_us_mean, run.update_us_p99, 100.0 * run.search_share,
+              100.0 * run.world_share, run.frame_ms_mean, run.max_characters_60hz,
+              run.update_us_first_window, run.update_us_last_window, ratio);
   std::fflush(stdout);
   return {{"threads", run.threads},
           {"update_us_mean", run.update_us_mean},
@@ -85,6 +94,7 @@ nlohmann::json report_run(const CrowdResult& run) {
           {"update_us_last_window", run.update_us_last_window},
           {"update_us_window_ratio", ratio},
           {"search_share", run.search_share},
+          {"world_share", run.world_share},
           {"frame_ms_mean", run.frame_ms_mean},
           {"max_characters_60hz", run.max_characters_60hz}};
 }
@@ -106,9 +116,9 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   };
   const std::string first = window_label("first ");
   const std::string last = window_label("last ");
-  std::printf("%8s %14s %14s %13s %14s %16s %12s %12s %10s\n", "threads", "update us mean",
-              "update us p99", "search share", "frame ms mean", "max chars 60 Hz", first.c_str(),
-              last.c_str(), "last/first");
+  std::printf("%8s %14s %14s %13s %13s %14s %16s %12s %12s %10s\n", "threads", "update us mean",
+              "update us p99", "search share", "world share", "frame ms mean", "max chars 60 Hz",
+              first.c_str(), last.c_str(), "last/first");
   std::vector<glm::vec3> reference;
   bool same = true;
   for (int threads : thread_counts) {
@@ -140,6 +150,17 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   return same;
 }
 
+// The level's bounds in x and z, 2 m in from each side: where a crowd starts in it.
+glm::vec4 inner_area(const Level& level) {
+  glm::dvec2 low(1e300), high(-1e300);
+  for (const glm::vec3& p : level.positions) {
+    const glm::dvec3 w = level.origin + glm::dvec3(p);
+    low = glm::min(low, glm::dvec2(w.x, w.z));
+    high = glm::max(high, glm::dvec2(w.x, w.z));
+  }
+  return glm::vec4(low.x + 2.0, low.y + 2.0, high.x - 2.0, high.y - 2.0);
+}
+
 int run_crowd_bench(const std::vector<std::string>& args) {
   Arguments arguments;
   if (const int code = parse_arguments(args, arguments); code >= 0) return code;
@@ -160,8 +181,40 @@ int run_crowd_bench(const std::vector<std::string>& args) {
   nlohmann::json json;
   json["characters"] = arguments.options.characters;
   json["seconds"] = arguments.options.seconds;
-  const std::optional<bool> same = run_thread_counts(*shared, arguments, json);
+  std::optional<BulletWorld> world;
+  if (!arguments.world_path.empty()) {
+    Result<Level> level = load_level(arguments.world_path);
+    Result<BulletWorld> made =
+        level ? BulletWorld::create(*level) : Result<BulletWorld>(level.error());
+    if (!made) {
+      std::fprintf(stderr, "mm crowd-bench: %s\n", made.message().c_str());
+      return 1;
+    }
+    world.emplace(std::move(made).value());
+    arguments.options.start_area = inner_area(*level);
+  }
+  std::optional<bool> same = run_thread_counts(*shared, arguments, json);
   if (!same) return 1;
+  if (world) {
+    // The same crowd in the level: its cost against the flat runs above (1 thread).
+    std::printf("in %s (Bullet):\n", arguments.world_path.c_str());
+    nlohmann::json flat = json;
+    arguments.options.world = &*world;
+    nlohmann::json in_world;
+    const std::optional<bool> same_in_world = run_thread_counts(*shared, arguments, in_world);
+    if (!same_in_world) return 1;
+    same = *same && *same_in_world;
+    json["world"] = arguments.world_path;
+    json["world_runs"] = in_world["runs"];
+    json["world_update_us_mean"] = in_world["update_us_mean"];
+    json["world_share"] = in_world["runs"][0]["world_share"];
+    json["world_cost_ratio"] =
+        in_world["update_us_mean"].get<double>() / flat["update_us_mean"].get<double>();
+    std::printf(
+        "update cost in the world / on flat ground (1 thread): %.2f; the world's queries "
+        "%.1f%% of it\n",
+        json["world_cost_ratio"].get<double>(), 100.0 * json["world_share"].get<double>());
+  }
   json["same_result_every_thread_count"] = *same;
   std::printf("final positions %s across thread counts\n", *same ? "identical" : "DIFFER");
   if (!arguments.json_path.empty()) {

@@ -11,6 +11,7 @@
 
 #include "mm/controller/controller.hpp"
 #include "mm/controller/script.hpp"
+#include "mm/controller/world.hpp"
 #include "mm/runtime/result.hpp"
 
 namespace mm {
@@ -32,6 +33,11 @@ struct CrowdOptions {
   float dt = kDefaultRunDt;
   int threads = 1;  // >= 1; characters are split into contiguous slices
   ControllerSettings settings;
+  // The world every character runs in (world.hpp; not owned); null: the flat plane.
+  const WorldQueries* world = nullptr;
+  // Where the characters start: their 3 m grid wrapped into this rectangle (x0, z0, x1, z1,
+  // world metres) when it has an area, else the grid from the origin on.
+  glm::vec4 start_area{0.0f};
 };
 
 // The steady figures (mean, p99, search share, frame time, max characters) are over the frames
@@ -46,6 +52,7 @@ struct CrowdResult {
   double update_us_first_window = 0.0;  // replayed beside the last window: kCrowdWindowSeconds
   double update_us_last_window = 0.0;
   double search_share = 0.0;   // time in search / time in update
+  double world_share = 0.0;    // time in the world's queries / time in update (0 without one)
   double frame_ms_mean = 0.0;  // wall time per frame for the whole crowd
   // Characters one frame of 1/60 s could update at this run's rate per character and thread
   // count: characters * (1/60 s) / frame time.
