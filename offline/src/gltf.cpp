@@ -30,6 +30,11 @@
 namespace mm {
 namespace {
 
+using gltf_files::component_name;
+using gltf_files::component_size;
+using gltf_files::components_in_type;
+using gltf_files::type_name;
+
 // Accessor data is little-endian; reading it with memcpy is only right on a little-endian host.
 static_assert(std::endian::native == std::endian::little, "the glTF reader assumes little-endian");
 
@@ -55,84 +60,6 @@ std::string quoted_name(const std::string& name) {
 
 std::string node_label(const tinygltf::Model& model, int node) {
   return "node " + std::to_string(node) + quoted_name(model.nodes[static_cast<size_t>(node)].name);
-}
-
-int components_in_type(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    case TINYGLTF_TYPE_MAT2:
-      return 4;
-    case TINYGLTF_TYPE_MAT3:
-      return 9;
-    case TINYGLTF_TYPE_MAT4:
-      return 16;
-    default:
-      return 0;
-  }
-}
-
-std::string type_name(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return "SCALAR";
-    case TINYGLTF_TYPE_VEC2:
-      return "VEC2";
-    case TINYGLTF_TYPE_VEC3:
-      return "VEC3";
-    case TINYGLTF_TYPE_VEC4:
-      return "VEC4";
-    case TINYGLTF_TYPE_MAT2:
-      return "MAT2";
-    case TINYGLTF_TYPE_MAT3:
-      return "MAT3";
-    case TINYGLTF_TYPE_MAT4:
-      return "MAT4";
-    default:
-      return "unknown type (" + std::to_string(type) + ")";
-  }
-}
-
-// Sizes of the component types glTF 2.0 allows in accessors (INT and DOUBLE are not allowed).
-int component_size(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-std::string component_name(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-      return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-      return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-      return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return "FLOAT";
-    default:
-      return "unknown component type (" + std::to_string(component_type) + ")";
-  }
 }
 
 // Decodes one component at p into a float; integer types use the glTF "normalized" mapping.
@@ -315,65 +242,6 @@ Result<std::vector<uint32_t>> read_integer_accessor(const tinygltf::Model& model
     }
   }
   return values;
-}
-
-// Checks the GLB container (header, chunk lengths) before tinygltf sees it, so no length field
-// can make anything read past the end of the bytes. Returns the total length to parse.
-Result<size_t> check_glb_container(std::span<const unsigned char> bytes) {
-  auto u32 = [&](size_t offset) {
-    uint32_t v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
-  if (bytes.size() < 12) {
-    return Error{"binary glTF (GLB) is truncated: " + std::to_string(bytes.size()) +
-                 " bytes, shorter than the 12-byte header"};
-  }
-  if (u32(4) != 2) {
-    return Error{"binary glTF (GLB) version " + std::to_string(u32(4)) +
-                 " is not supported (expected 2)"};
-  }
-  const size_t length = u32(8);
-  if (length != bytes.size()) {
-    return Error{"binary glTF (GLB) header says the file has " + std::to_string(length) +
-                 " bytes but it has " + std::to_string(bytes.size()) +
-                 (length > bytes.size() ? " (truncated?)" : "")};
-  }
-  size_t offset = 12;
-  int chunk = 0;
-  while (offset < length) {
-    if (length - offset < 8) {
-      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) +
-                   " header at byte " + std::to_string(offset) + " is incomplete"};
-    }
-    const size_t chunk_length = u32(offset);
-    const uint32_t chunk_type = u32(offset + 4);
-    if (chunk_length > length - offset - 8) {
-      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) + " at byte " +
-                   std::to_string(offset) + " claims " + std::to_string(chunk_length) +
-                   " bytes but only " + std::to_string(length - offset - 8) + " remain"};
-    }
-    if (chunk == 0 && (chunk_type != 0x4E4F534Au || chunk_length == 0)) {
-      return Error{"binary glTF (GLB): the first chunk must be a non-empty JSON chunk"};
-    }
-    offset += 8 + chunk_length;
-    ++chunk;
-  }
-  if (chunk == 0) return Error{"binary glTF (GLB) has no JSON chunk"};
-  return length;
-}
-
-// The length of the JSON chunk of a GLB that check_glb_container accepted.
-size_t glb_json_chunk_length(std::span<const unsigned char> bytes) {
-  uint32_t length;
-  std::memcpy(&length, bytes.data() + 12, sizeof length);
-  return length;
-}
-
-// Images are never needed: accept them without decoding so textured files still load.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1147,57 +1015,13 @@ Result<Clip> sample_animation(const tinygltf::Model& model, size_t animation_ind
   return clip;
 }
 
-// The file's JSON and buffers as tinygltf reads them, after the container and the files the
-// buffers name are checked.
-Result<tinygltf::Model> load_model(std::span<const unsigned char> bytes,
-                                   const std::filesystem::path& path,
-                                   const GltfImportOptions& options) {
-  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
-    return Error{"file is larger than 4 GiB, which glTF cannot address"};
-  }
-  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  std::span<const unsigned char> json = bytes;
-  if (binary) {
-    auto length = check_glb_container(bytes);
-    if (!length) return length.error();
-    json = bytes.subspan(20, glb_json_chunk_length(bytes));
-  } else if (lower_extension(path) == ".glb") {
-    return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
-  }
-  // Every file a buffer names is checked and read before tinygltf runs; tinygltf itself opens
-  // nothing (see gltf_files.hpp), so the base folder it is given stays empty.
-  auto external = gltf_files::read_external_buffers(
-      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()), path.parent_path(),
-      options.allow_external_files);
-  if (!external) return external.error();
-
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&skip_image, nullptr);
-  loader.SetFsCallbacks(gltf_files::confined_callbacks(*external));
-  std::string err;
-  std::string warn;
-  const bool loaded = binary
-                          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                                        static_cast<unsigned int>(bytes.size()), "")
-                          : loader.LoadASCIIFromString(&model, &err, &warn,
-                                                       reinterpret_cast<const char*>(bytes.data()),
-                                                       static_cast<unsigned int>(bytes.size()), "");
-  if (!loaded) {
-    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    return Error{"not a valid glTF 2.0 file: " +
-                 (err.empty() ? std::string("unknown error") : err)};
-  }
-  return model;
-}
-
 Result<GltfAsset> parse_model(std::span<const unsigned char> bytes,
                               const std::filesystem::path& path, const GltfImportOptions& options) {
   if (!(options.sample_rate > 0.0f) || !std::isfinite(options.sample_rate)) {
     return Error{"sample rate must be a positive finite number of Hz, got " +
                  number(options.sample_rate)};
   }
-  auto loaded = load_model(bytes, path, options);
+  auto loaded = gltf_files::load_model(bytes, path, options.allow_external_files);
   if (!loaded) return loaded.error();
   const tinygltf::Model& model = *loaded;
 

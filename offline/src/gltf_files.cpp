@@ -6,12 +6,15 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <optional>
 #include <system_error>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
+#include "mm/database/files.hpp"
 #include "mm/offline/gltf.hpp"
 
 namespace mm::gltf_files {
@@ -248,6 +251,179 @@ Result<ExternalFiles> read_external_buffers(std::string_view json, const fs::pat
 
 tinygltf::FsCallbacks confined_callbacks(ExternalFiles& files) {
   return {&file_exists, &expand_file_path, &read_whole_file, &refuse_write, &files};
+}
+
+int components_in_type(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    case TINYGLTF_TYPE_MAT2:
+      return 4;
+    case TINYGLTF_TYPE_MAT3:
+      return 9;
+    case TINYGLTF_TYPE_MAT4:
+      return 16;
+    default:
+      return 0;
+  }
+}
+
+std::string type_name(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT2:
+      return "MAT2";
+    case TINYGLTF_TYPE_MAT3:
+      return "MAT3";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "unknown type (" + std::to_string(type) + ")";
+  }
+}
+
+int component_size(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+std::string component_name(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+      return "BYTE";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return "UNSIGNED_BYTE";
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+      return "SHORT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return "UNSIGNED_SHORT";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      return "UNSIGNED_INT";
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return "FLOAT";
+    default:
+      return "unknown component type (" + std::to_string(component_type) + ")";
+  }
+}
+
+Result<size_t> check_glb_container(std::span<const unsigned char> bytes) {
+  auto u32 = [&](size_t offset) {
+    uint32_t v;
+    std::memcpy(&v, bytes.data() + offset, sizeof v);
+    return v;
+  };
+  if (bytes.size() < 12) {
+    return Error{"binary glTF (GLB) is truncated: " + std::to_string(bytes.size()) +
+                 " bytes, shorter than the 12-byte header"};
+  }
+  if (u32(4) != 2) {
+    return Error{"binary glTF (GLB) version " + std::to_string(u32(4)) +
+                 " is not supported (expected 2)"};
+  }
+  const size_t length = u32(8);
+  if (length != bytes.size()) {
+    return Error{"binary glTF (GLB) header says the file has " + std::to_string(length) +
+                 " bytes but it has " + std::to_string(bytes.size()) +
+                 (length > bytes.size() ? " (truncated?)" : "")};
+  }
+  size_t offset = 12;
+  int chunk = 0;
+  while (offset < length) {
+    if (length - offset < 8) {
+      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) +
+                   " header at byte " + std::to_string(offset) + " is incomplete"};
+    }
+    const size_t chunk_length = u32(offset);
+    const uint32_t chunk_type = u32(offset + 4);
+    if (chunk_length > length - offset - 8) {
+      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) + " at byte " +
+                   std::to_string(offset) + " claims " + std::to_string(chunk_length) +
+                   " bytes but only " + std::to_string(length - offset - 8) + " remain"};
+    }
+    if (chunk == 0 && (chunk_type != 0x4E4F534Au || chunk_length == 0)) {
+      return Error{"binary glTF (GLB): the first chunk must be a non-empty JSON chunk"};
+    }
+    offset += 8 + chunk_length;
+    ++chunk;
+  }
+  if (chunk == 0) return Error{"binary glTF (GLB) has no JSON chunk"};
+  return length;
+}
+
+size_t glb_json_chunk_length(std::span<const unsigned char> bytes) {
+  uint32_t length;
+  std::memcpy(&length, bytes.data() + 12, sizeof length);
+  return length;
+}
+
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                const unsigned char*, int, void*) {
+  return true;
+}
+
+Result<tinygltf::Model> load_model(std::span<const unsigned char> bytes,
+                                   const std::filesystem::path& path, bool allow_external_files) {
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+    return Error{"file is larger than 4 GiB, which glTF cannot address"};
+  }
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  std::span<const unsigned char> json = bytes;
+  if (binary) {
+    auto length = check_glb_container(bytes);
+    if (!length) return length.error();
+    json = bytes.subspan(20, glb_json_chunk_length(bytes));
+  } else if (lower_extension(path) == ".glb") {
+    return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
+  }
+  // Every file a buffer names is checked and read before tinygltf runs; tinygltf itself opens
+  // nothing (confined_callbacks), so the base folder it is given stays empty.
+  auto external = gltf_files::read_external_buffers(
+      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()), path.parent_path(),
+      allow_external_files);
+  if (!external) return external.error();
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetFsCallbacks(gltf_files::confined_callbacks(*external));
+  std::string err;
+  std::string warn;
+  const bool loaded = binary
+                          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
+                                                        static_cast<unsigned int>(bytes.size()), "")
+                          : loader.LoadASCIIFromString(&model, &err, &warn,
+                                                       reinterpret_cast<const char*>(bytes.data()),
+                                                       static_cast<unsigned int>(bytes.size()), "");
+  if (!loaded) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    return Error{"not a valid glTF 2.0 file: " +
+                 (err.empty() ? std::string("unknown error") : err)};
+  }
+  return model;
 }
 
 }  // namespace mm::gltf_files

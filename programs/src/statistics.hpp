@@ -11,6 +11,13 @@
 
 namespace mm::detail {
 
+// The 0-based index of the p-th percentile (0..100) among `count` sorted values (count > 0), by
+// nearest rank.
+inline size_t nearest_rank(double p, size_t count) {
+  const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count));
+  return std::min(count - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
+}
+
 // The percentiles of a run in fixed memory, whatever its length: a histogram of the values by
 // their binary exponent and the first kMantissaBits bits of their mantissa, so a bin spans a
 // 2^-kMantissaBits fraction of its lower edge. A percentile is taken by nearest rank, as over
@@ -39,9 +46,7 @@ class PercentileHistogram {
   // The p-th percentile (0..100) by nearest rank (see the class); 0 for no values.
   double percentile(double p) const {
     if (count_ == 0) return 0.0;
-    const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count_));
-    const size_t rank =
-        std::min(count_ - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
+    const size_t rank = nearest_rank(p, count_);
     size_t below = 0;
     for (size_t bin = 0; bin < kBinCount; ++bin) {
       below += bins_[bin];
@@ -119,9 +124,7 @@ class LinearHistogram {
 
   double percentile(double p) const {
     if (count_ == 0) return 0.0;
-    const double exact_rank = std::ceil(p / 100.0 * static_cast<double>(count_));
-    const size_t rank =
-        std::min(count_ - 1, clamped_integer<size_t>(exact_rank) - (p > 0.0 ? 1 : 0));
+    const size_t rank = nearest_rank(p, count_);
     size_t below = 0;
     for (size_t bin = 0; bin < bins_.size(); ++bin) {
       below += bins_[bin];

@@ -5,14 +5,17 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "mm/controller/controller.hpp"
 #include "mm/database/database.hpp"
 #include "mm/offline/builder.hpp"
+#include "mm/runtime/transform.hpp"
 
 namespace mm::python {
 
@@ -50,6 +53,11 @@ struct DatabaseHandle {
 // "on"/"off", other values their str()), then validated. Raises ValueError with the library's
 // message on an unknown name, a bad value or settings out of range.
 ControllerSettings settings_from_kwargs(ControllerSettings settings, const py::kwargs& kwargs);
+
+// Every transform's translation as a (count, 3) float32 array, and its rotation as (count, 4)
+// quaternions (x, y, z, w): copies, for poses that change or are computed on request.
+py::array_t<float> translation_array(std::span<const Transform> transforms);
+py::array_t<float> rotation_array(std::span<const Transform> transforms);
 
 void bind_database(py::module_& m);
 void bind_controller(py::module_& m);

@@ -57,31 +57,12 @@ class PyController {
     controller_->teleport_world(glm::dvec3(x, 0.0, z), yaw);
   }
 
-  // Every joint's global position, world metres (float: exact near the world origin).
+  // Every joint's global position, world metres (float: exact near the world origin), and
+  // rotation.
   py::array_t<float> positions() const {
-    const auto globals = controller_->global_transforms();
-    py::array_t<float> out({static_cast<py::ssize_t>(globals.size()), py::ssize_t{3}});
-    auto o = out.mutable_unchecked<2>();
-    for (size_t j = 0; j < globals.size(); ++j) {
-      for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(j), k) = globals[j].translation[k];
-    }
-    return out;
+    return translation_array(controller_->global_transforms());
   }
-
-  py::array_t<float> rotations() const {
-    const auto globals = controller_->global_transforms();
-    py::array_t<float> out({static_cast<py::ssize_t>(globals.size()), py::ssize_t{4}});
-    auto o = out.mutable_unchecked<2>();
-    for (size_t j = 0; j < globals.size(); ++j) {
-      const glm::quat& q = globals[j].rotation;
-      const auto row = static_cast<py::ssize_t>(j);
-      o(row, 0) = q.x;
-      o(row, 1) = q.y;
-      o(row, 2) = q.z;
-      o(row, 3) = q.w;
-    }
-    return out;
-  }
+  py::array_t<float> rotations() const { return rotation_array(controller_->global_transforms()); }
 
   // Row-major 4x4 matrices (numpy's order: m[joint] @ [x, y, z, 1] transforms a bind-pose
   // point); GLM stores them column by column.

@@ -58,28 +58,11 @@ std::vector<Transform> global_pose(const Database& db, int frame) {
 }
 
 py::array_t<float> positions_at(const Handle& handle, int frame) {
-  const std::vector<Transform> global = global_pose(db_of(handle), frame);
-  py::array_t<float> out({static_cast<py::ssize_t>(global.size()), py::ssize_t{3}});
-  auto o = out.mutable_unchecked<2>();
-  for (size_t j = 0; j < global.size(); ++j) {
-    for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(j), k) = global[j].translation[k];
-  }
-  return out;
+  return translation_array(global_pose(db_of(handle), frame));
 }
 
 py::array_t<float> rotations_at(const Handle& handle, int frame) {
-  const std::vector<Transform> global = global_pose(db_of(handle), frame);
-  py::array_t<float> out({static_cast<py::ssize_t>(global.size()), py::ssize_t{4}});
-  auto o = out.mutable_unchecked<2>();
-  for (size_t j = 0; j < global.size(); ++j) {
-    const glm::quat& q = global[j].rotation;
-    const auto row = static_cast<py::ssize_t>(j);
-    o(row, 0) = q.x;
-    o(row, 1) = q.y;
-    o(row, 2) = q.z;
-    o(row, 3) = q.w;
-  }
-  return out;
+  return rotation_array(global_pose(db_of(handle), frame));
 }
 
 std::vector<std::string> tag_names_of(const Database& db, uint64_t tags) {

@@ -34,6 +34,29 @@ void raise_for_file(const std::string& message, const std::filesystem::path& pat
   throw LibraryError(message);
 }
 
+py::array_t<float> translation_array(std::span<const Transform> transforms) {
+  py::array_t<float> out({static_cast<py::ssize_t>(transforms.size()), py::ssize_t{3}});
+  auto o = out.mutable_unchecked<2>();
+  for (size_t j = 0; j < transforms.size(); ++j) {
+    for (int k = 0; k < 3; ++k) o(static_cast<py::ssize_t>(j), k) = transforms[j].translation[k];
+  }
+  return out;
+}
+
+py::array_t<float> rotation_array(std::span<const Transform> transforms) {
+  py::array_t<float> out({static_cast<py::ssize_t>(transforms.size()), py::ssize_t{4}});
+  auto o = out.mutable_unchecked<2>();
+  for (size_t j = 0; j < transforms.size(); ++j) {
+    const glm::quat& q = transforms[j].rotation;
+    const auto row = static_cast<py::ssize_t>(j);
+    o(row, 0) = q.x;
+    o(row, 1) = q.y;
+    o(row, 2) = q.z;
+    o(row, 3) = q.w;
+  }
+  return out;
+}
+
 ControllerSettings settings_from_kwargs(ControllerSettings settings, const py::kwargs& kwargs) {
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);

@@ -28,6 +28,11 @@
 namespace mm {
 namespace {
 
+using gltf_files::component_name;
+using gltf_files::component_size;
+using gltf_files::components_in_type;
+using gltf_files::type_name;
+
 // Accessor data is little-endian; reading it with memcpy is only right on a little-endian host.
 static_assert(std::endian::native == std::endian::little, "the level reader assumes little-endian");
 
@@ -92,85 +97,6 @@ std::string degenerate_reason(const glm::vec3& a, const glm::vec3& b, const glm:
 // ---------------------------------------------------------------------------------------------
 // Accessors
 
-int components_in_type(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    case TINYGLTF_TYPE_MAT2:
-      return 4;
-    case TINYGLTF_TYPE_MAT3:
-      return 9;
-    case TINYGLTF_TYPE_MAT4:
-      return 16;
-    default:
-      return 0;
-  }
-}
-
-std::string type_name(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return "SCALAR";
-    case TINYGLTF_TYPE_VEC2:
-      return "VEC2";
-    case TINYGLTF_TYPE_VEC3:
-      return "VEC3";
-    case TINYGLTF_TYPE_VEC4:
-      return "VEC4";
-    case TINYGLTF_TYPE_MAT2:
-      return "MAT2";
-    case TINYGLTF_TYPE_MAT3:
-      return "MAT3";
-    case TINYGLTF_TYPE_MAT4:
-      return "MAT4";
-    default:
-      return "unknown type " + std::to_string(type);
-  }
-}
-
-size_t component_size(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-std::string component_name(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-      return "BYTE";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return "UNSIGNED_BYTE";
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-      return "SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return "UNSIGNED_SHORT";
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-      return "UNSIGNED_INT";
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return "FLOAT";
-    case TINYGLTF_COMPONENT_TYPE_DOUBLE:
-      return "DOUBLE";
-    default:
-      return "unknown component type " + std::to_string(component_type);
-  }
-}
-
 // Where an accessor's elements lie, once its type, component type and bounds are checked: every
 // byte read lies inside its buffer, so a declared count is backed by the file's own bytes.
 struct Located {
@@ -208,8 +134,8 @@ Result<Located> locate(const tinygltf::Model& model, int index, int expected_typ
   if (accessor.bufferView < 0) {
     return Error{where + " has no buffer view (all zeros: every triangle would be degenerate)"};
   }
-  const size_t element_size =
-      static_cast<size_t>(components_in_type(accessor.type)) * component_size(ct);
+  const size_t element_size = static_cast<size_t>(components_in_type(accessor.type)) *
+                              static_cast<size_t>(component_size(ct));
   if (static_cast<size_t>(accessor.bufferView) >= model.bufferViews.size()) {
     return Error{where + " refers to buffer view " + std::to_string(accessor.bufferView) +
                  ", out of range (the file has " + std::to_string(model.bufferViews.size()) +
@@ -267,105 +193,6 @@ uint32_t read_index(const Located& a, size_t i) {
       return v;
     }
   }
-}
-
-// ---------------------------------------------------------------------------------------------
-// The container and the model
-
-// Checks the GLB container (header, chunk lengths) before tinygltf sees it, so no length field
-// can make anything read past the end of the bytes; the same rules as the glTF importer's.
-// Returns the length of the JSON chunk.
-Result<size_t> check_glb_container(std::span<const unsigned char> bytes) {
-  auto u32 = [&](size_t offset) {
-    uint32_t v;
-    std::memcpy(&v, bytes.data() + offset, sizeof v);
-    return v;
-  };
-  if (bytes.size() < 12) {
-    return Error{"binary glTF (GLB) is truncated: " + std::to_string(bytes.size()) +
-                 " bytes, shorter than the 12-byte header"};
-  }
-  if (u32(4) != 2) {
-    return Error{"binary glTF (GLB) version " + std::to_string(u32(4)) +
-                 " is not supported (expected 2)"};
-  }
-  const size_t length = u32(8);
-  if (length != bytes.size()) {
-    return Error{"binary glTF (GLB) header says the file has " + std::to_string(length) +
-                 " bytes but it has " + std::to_string(bytes.size())};
-  }
-  size_t offset = 12;
-  size_t json_length = 0;
-  for (int chunk = 0; offset < length; ++chunk) {
-    if (length - offset < 8) {
-      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) +
-                   " header at byte " + std::to_string(offset) + " is incomplete"};
-    }
-    const size_t chunk_length = u32(offset);
-    const uint32_t chunk_type = u32(offset + 4);
-    if (chunk_length > length - offset - 8) {
-      return Error{"binary glTF (GLB) is truncated: chunk " + std::to_string(chunk) + " at byte " +
-                   std::to_string(offset) + " claims " + std::to_string(chunk_length) +
-                   " bytes but only " + std::to_string(length - offset - 8) + " remain"};
-    }
-    if (chunk == 0) {
-      if (chunk_type != 0x4E4F534Au || chunk_length == 0) {
-        return Error{"binary glTF (GLB): the first chunk must be a non-empty JSON chunk"};
-      }
-      json_length = chunk_length;
-    }
-    offset += 8 + chunk_length;
-  }
-  if (json_length == 0) return Error{"binary glTF (GLB) has no JSON chunk"};
-  return json_length;
-}
-
-// Images are never needed: accept them without decoding so textured levels still load.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;
-}
-
-Result<tinygltf::Model> load_model(std::span<const unsigned char> bytes,
-                                   const std::filesystem::path& path,
-                                   const LevelLoadOptions& options) {
-  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
-    return Error{"file is larger than 4 GiB, which glTF cannot address"};
-  }
-  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  std::span<const unsigned char> json = bytes;
-  if (binary) {
-    auto json_length = check_glb_container(bytes);
-    if (!json_length) return json_length.error();
-    json = bytes.subspan(20, *json_length);
-  } else if (lower_extension(path) == ".glb") {
-    return Error{"not a binary glTF file (it does not start with the \"glTF\" magic)"};
-  }
-  // Every file a buffer names is checked and read before tinygltf runs; tinygltf itself opens
-  // nothing (gltf_files.hpp), so the base folder it is given stays empty.
-  auto external = gltf_files::read_external_buffers(
-      std::string_view(reinterpret_cast<const char*>(json.data()), json.size()), path.parent_path(),
-      options.allow_external_files);
-  if (!external) return external.error();
-
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&skip_image, nullptr);
-  loader.SetFsCallbacks(gltf_files::confined_callbacks(*external));
-  std::string err;
-  std::string warn;
-  const bool loaded = binary
-                          ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(),
-                                                        static_cast<unsigned int>(bytes.size()), "")
-                          : loader.LoadASCIIFromString(&model, &err, &warn,
-                                                       reinterpret_cast<const char*>(bytes.data()),
-                                                       static_cast<unsigned int>(bytes.size()), "");
-  if (!loaded) {
-    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-    return Error{"not a valid glTF 2.0 file: " +
-                 (err.empty() ? std::string("unknown error") : err)};
-  }
-  return model;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -759,7 +586,7 @@ Result<Level> parse_level(std::span<const unsigned char> bytes,
                           const LevelLoadOptions& options) {
   const std::string where = path_for_messages.string() + ": ";
   try {
-    auto model = load_model(bytes, path_for_messages, options);
+    auto model = gltf_files::load_model(bytes, path_for_messages, options.allow_external_files);
     if (!model) return Error{where + model.message()};
     auto level = read_level(*model);
     if (!level) return Error{where + level.message()};
