@@ -87,6 +87,10 @@ void Controller::lift_to_ground(float dt) {
   if (world_) {
     last_root_ = glm::vec3(locals_[0].translation.x, last_root_.y, locals_[0].translation.z);
     ground = last_root_.y;
+    // Halfway to the ground under the trajectory's first sample (the last update's): stairs
+    // become the slope they climb rather than a riser to jump at every tread, and the spring's
+    // lag up a ramp is made up ahead of time.
+    if (debug_.trajectory_count > 0) ground = 0.5f * (ground + debug_.predicted_positions[0].y);
   }
   critical_spring_update(ground_height_, ground_velocity_, ground, settings_.ground_height_halflife,
                          dt);
