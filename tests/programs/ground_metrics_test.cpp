@@ -12,7 +12,6 @@ namespace {
 
 // Joints: 0 root, 1 hips, 2 left upper leg, 3 left lower leg, 4 left foot, 5 left toe, 6 right
 // toe (the right leg has no knee: it never counts as straight).
-constexpr size_t kJoints = 7;
 constexpr float kDt = 0.1f;
 
 JointRoleIndices roles() {
