@@ -156,4 +156,12 @@ bool CharacterMover::ground(const WorldQueries& world, const glm::dvec3& origin,
   return accept(probe, hit) && hit.hit && hit.walkable;
 }
 
+void CharacterMover::probe(const WorldQueries& world, const glm::dvec3& origin,
+                           std::span<const GroundProbe> probes, std::span<GroundHit> hits) {
+  std::fill(hits.begin(), hits.end(), GroundHit{});
+  if (probes.empty()) return;
+  world.probe_ground(origin, probes, hits);
+  for (size_t i = 0; i < probes.size(); ++i) accept(probes[i], hits[i]);
+}
+
 }  // namespace mm

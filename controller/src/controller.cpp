@@ -370,6 +370,7 @@ void Controller::update(float dt, const ControllerInput& input) {
 // (or a teleport or adjustment) from the local pose.
 void Controller::refresh_outputs(float dt) {
   finish_pose();
+  if (world_) place_feet(dt);
   foot_lock(dt);
   publish_world_transforms();
   if (settings_.compute_skinning) {
@@ -1055,28 +1056,33 @@ void Controller::foot_lock(float dt) {
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
-    const glm::vec3 target = foot_target(side, animated, settling, dt);
+    const glm::vec3 on_ground = animated + glm::vec3(0.0f, ground_offset_[side], 0.0f);
+    const glm::vec3 target = foot_target(side, animated, on_ground, settling, dt);
     hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
     debug_.ik_target[side] = target;
     // A stepping foot is in the air, whatever the playing frame says.
     debug_.contact[side] = debug_.contact[side] && !feet_[side].stepping;
-    if (glm::length(target - animated) >= 1e-5f || std::abs(feet_[side].heading_offset) > 1e-5f) {
+    if (glm::length(target - animated) >= 1e-5f || std::abs(feet_[side].heading_offset) > 1e-5f ||
+        (world_ && foot_placement_.tilted(side))) {
       reach(side, animated, target);
     }
   }
 }
 
-// Where one foot's toe goes this update: the lock point, or the animated toe plus an offset
-// that decays after a release and keeps the target continuous there. A lock starts where the
-// toe is, at once (easing it to rest would be a slide on the ground), when a contact begins or
-// once a foot released during one has eased back onto the animation.
-glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool settling, float dt) {
+// Where one foot's toe goes this update: the lock point, or the animated toe on its ground
+// (`on_ground`: `animated` raised by its ground's offset, foot_placement.hpp; the same without a
+// world) plus an offset that decays after a release and keeps the target continuous there. A
+// lock starts where the toe is, at once (easing it to rest would be a slide on the ground), when
+// a contact begins or once a foot released during one has eased back onto the animation; it
+// holds that point in 3-D.
+glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
+                                  bool settling, float dt) {
   FootLock& f = feet_[side];
   const bool contact = debug_.contact[side];
   if (!f.has_target) {
-    f.target = animated;
+    f.target = on_ground;
     f.has_target = true;
   }
   if (contact && !f.locked && !f.stepping &&
@@ -1109,20 +1115,25 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, bool sett
       // A foot that has to move while its frame says "contact" steps there rather than slides.
       f.locked = false;
       f.stepping = contact && (settle || dragged);
-      f.offset = f.target - animated;
+      f.offset = f.target - on_ground;
       f.offset_velocity = glm::vec3(0.0f);
     }
   }
   f.previous_contact = contact;
   critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
                          settings_.foot_lock_release_halflife, dt);
-  glm::vec3 target = (f.locked ? f.position : animated) + f.offset;
+  glm::vec3 target = (f.locked ? f.position : on_ground) + f.offset;
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
   // toe dead at the floor, a jerk the legs show.
   float floor = shared_->lowest_foot_end(side);
-  // In a world, the body stands on the ground under the root (ground_height_).
-  if (world_ || game_capsule_) floor += ground_height_;
+  // In a world, each toe stands on the ground under it; on the game's capsule, the body on its
+  // height (ground_height_).
+  if (world_) {
+    floor += foot_placement_.ground(side).toe;
+  } else if (game_capsule_) {
+    floor += ground_height_;
+  }
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
   f.target = target;
@@ -1194,9 +1205,13 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   const std::span<const int> parents = db_->skeleton().parents();
   const std::vector<int>& leg = leg_joints_[side];
   const int hip = leg[0], knee = leg[1], foot = leg[2];
-  // Reach: the ankle goes where the foot's rotation (animated, turned to the held heading)
-  // puts it above the target toe.
-  const glm::quat swivel = yaw_rotation(feet_[side].heading_offset);
+  // Reach: the ankle goes where the foot's rotation (animated, turned to the held heading, in
+  // a world pitched to its ground: foot_placement.hpp) puts it above the target toe.
+  glm::quat swivel = yaw_rotation(feet_[side].heading_offset);
+  if (world_) {
+    const glm::vec3 along = swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
+    swivel = foot_placement_.tilt(side, along, settings_.max_foot_tilt) * swivel;
+  }
   const glm::quat foot_rotation =
       glm::normalize(swivel * globals_[static_cast<size_t>(foot)].rotation);
   const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;

@@ -13,10 +13,20 @@
 
 namespace mm {
 
+namespace {
+
+// A toe this close to its lowest height in the data (m) is about to land or has just lifted:
+// its leg's reach counts for the pelvis drop (foot_placement.hpp).
+constexpr float kNearGroundHeight = 0.1f;
+
+}  // namespace
+
 void Controller::set_world(const WorldQueries* world) {
   if (world == world_) return;
   world_ = world;
   ground_height_ = ground_velocity_ = 0.0f;
+  foot_placement_.reset(0.0f);
+  ground_offset_[0] = ground_offset_[1] = 0.0f;
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
 }
 
@@ -169,6 +179,48 @@ void Controller::settle_on_ground() {
   ground_velocity_ = 0.0f;
   last_root_ = sim_position_;
   debug_.ground_height = ground_height_;
+  foot_placement_.reset(ground_height_);
+}
+
+// Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the
+// foot lock: the probes, the pelvis drop applied to everything above the root (the root stays
+// on the body's ground), and each toe's offset from where the animation puts it, which the
+// foot lock adds. Needs the legs' IK: without it the feet stay the animation's.
+void Controller::place_feet(float dt) {
+  ground_offset_[0] = ground_offset_[1] = 0.0f;
+  if (!settings_.ik_enabled || !settings_.foot_lock_enabled) return;
+  std::array<PlacementLeg, 2> legs;
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<int>& leg = leg_joints_[side];
+    PlacementLeg& p = legs[static_cast<size_t>(side)];
+    p.hip = globals_[static_cast<size_t>(leg[0])].translation;
+    p.ankle = globals_[static_cast<size_t>(leg[2])].translation;
+    p.toe = globals_[static_cast<size_t>(leg_end(side))].translation;
+    p.length = leg_length(side);
+    p.planted = feet_[side].locked || debug_.contact[side];
+    p.near_ground =
+        p.planted || p.toe.y - ground_height_ - shared_->lowest_foot_end(side) < kNearGroundHeight;
+  }
+  FootPlacementSettings placement;
+  placement.max_pelvis_drop = settings_.max_pelvis_drop;
+  placement.pelvis_drop_halflife = settings_.pelvis_drop_halflife;
+  placement.max_foot_tilt = settings_.max_foot_tilt;
+  placement.step_height = settings_.step_height;
+  placement.max_step_down = settings_.max_step_down;
+  foot_placement_.update(*world_, origin_, mover_, placement, legs, ground_height_, sim_velocity_,
+                         dt);
+  debug_.world_rejected = mover_.rejected();
+  const float drop = foot_placement_.pelvis_drop();
+  for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation.y -= drop;
+  for (int side = 0; side < 2; ++side) {
+    ground_offset_[side] = foot_placement_.ground(side).toe - ground_height_ + drop;
+    debug_.foot_ground[side] = foot_placement_.ground(side);
+  }
+  std::copy(foot_placement_.probe_points().begin(), foot_placement_.probe_points().end(),
+            debug_.foot_probes);
+  std::copy(foot_placement_.probe_grounds().begin(), foot_placement_.probe_grounds().end(),
+            debug_.foot_probe_grounds);
+  debug_.pelvis_drop = drop;
 }
 
 }  // namespace mm

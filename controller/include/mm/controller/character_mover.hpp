@@ -72,6 +72,11 @@ class CharacterMover {
   bool ground(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
               const glm::vec3& position, float above, GroundHit& hit);
 
+  // Ground probes as given, in one call to the world; an answer that fails the checks
+  // (world.hpp) becomes no hit and is counted in rejected(). `hits` is as long as `probes`.
+  void probe(const WorldQueries& world, const glm::dvec3& origin,
+             std::span<const GroundProbe> probes, std::span<GroundHit> hits);
+
   // Answers ignored because they failed the checks (world.hpp), since creation.
   int64_t rejected() const { return rejected_; }
 

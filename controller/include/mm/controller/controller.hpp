@@ -40,6 +40,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/controller/character_mover.hpp"
+#include "mm/controller/foot_placement.hpp"
 #include "mm/controller/input.hpp"
 #include "mm/controller/local_origin.hpp"
 #include "mm/controller/world.hpp"
@@ -263,6 +264,12 @@ struct ControllerSettings {
   float max_step_down = 0.5f;     // m: a drop deeper than this is a ledge the character stops at
   float max_slope = 0.8f;         // radians: ground steeper than this is not walkable
   float ground_height_halflife = 0.1f;  // s: the body rises and falls to the ground on a spring
+  // Feet on the ground (foot_placement.hpp; with IK and foot locking on): the pelvis comes down
+  // at most this far (m), on a spring of this halflife (s), so that the lower foot reaches its
+  // ground; a foot pitches at most max_foot_tilt (radians) to put heel and toe on a slope.
+  float max_pelvis_drop = 0.35f;
+  float pelvis_drop_halflife = 0.24f;
+  float max_foot_tilt = 0.6f;
 
   // ---- Robustness. A dt larger than this is clamped to it (s).
   float max_dt = 0.1f;
@@ -335,6 +342,13 @@ struct ControllerDebug {
   bool simulation_blocked = false;     // the simulation object's move met an obstacle
   glm::vec3 simulation_contact{0.0f};  // that obstacle's horizontal normal
   int64_t world_rejected = 0;          // the world's answers ignored (world.hpp), since create()
+  // Feet on the ground (foot_placement.hpp): the probed points (per side: heel, toe, heel
+  // ahead, toe ahead) and the ground found under each (the body's ground where none was), the
+  // heights each foot's heel and toe stand on, and how far the pelvis came down.
+  glm::vec3 foot_probes[FootPlacement::kProbes] = {};
+  glm::vec3 foot_probe_grounds[FootPlacement::kProbes] = {};
+  FootGround foot_ground[2] = {};
+  float pelvis_drop = 0.0f;
 
   // Feet: 0 left, 1 right.
   bool contact[2] = {false, false};  // the playing frame's contact, false while stepping
@@ -448,6 +462,7 @@ class Controller {
   void move_displayed_root(const glm::vec3& position, const glm::quat& rotation);
   void lift_to_ground(float dt);
   void settle_on_ground();
+  void place_feet(float dt);
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
@@ -484,7 +499,8 @@ class Controller {
   void synchronize(float dt);
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
-  glm::vec3 foot_target(int side, const glm::vec3& animated, bool settling, float dt);
+  glm::vec3 foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
+                        bool settling, float dt);
   void hold_heading(int side, float dt);
   glm::vec3 playing_position(int joint) const;
   int leg_end(int side) const;
@@ -615,6 +631,10 @@ class Controller {
   // height the game gave it, and the body stands at it. With a world or the game's capsule, the
   // displayed root (locals_[0]) is lifted by ground_height_ between updates.
   bool game_capsule_ = false;
+  // Feet on the world's ground, and per foot how far its toe's ground is above where the
+  // animation puts it (the body's ground, less the pelvis drop); zero without a world.
+  FootPlacement foot_placement_;
+  float ground_offset_[2] = {0.0f, 0.0f};
 
   ControllerDebug debug_;
 };

@@ -7,10 +7,11 @@
 // update (at most kMaxWorldCallsPerUpdate), each carrying every query of one kind that one of
 // its moves needs: a sweep, a slide and a ground probe (character_mover.hpp) for the simulation
 // object, the same for the animated root, and the same for every predicted trajectory sample at
-// once. The spans are the controller's own pre-sized buffers: an implementation must not
-// keep them past the call. A call must not allocate if the game's frame must not, and must be
-// safe to make from the thread that runs this controller's update (several controllers may
-// query one world from several threads at once: queries are const).
+// once; and one call probing the ground under the feet (foot_placement.hpp). The spans are the
+// controller's own pre-sized buffers: an implementation must not keep them past the call. A
+// call must not allocate if the game's frame must not, and must be safe to make from the thread
+// that runs this controller's update (several controllers may query one world from several
+// threads at once: queries are const).
 //
 // In what frame: every position is relative to `origin` (world = origin + position, added in
 // double), the controller's local origin (local_origin.hpp): near the world origin it is zero
@@ -28,8 +29,8 @@
 namespace mm {
 
 // At most this many query calls per update: three moves (simulation, root, trajectory) of at
-// most three calls each.
-inline constexpr int kMaxWorldCallsPerUpdate = 9;
+// most three calls each, and the feet's ground probes (foot_placement.hpp).
+inline constexpr int kMaxWorldCallsPerUpdate = 10;
 
 // From `from`, straight down (-Y), at most `max_distance` metres.
 struct GroundProbe {

@@ -1,0 +1,122 @@
+#pragma once
+// Feet on the world's ground (docs/world.md, "Feet on the ground"). The data was recorded on a
+// flat floor: the animated pose stands on the body's ground (the height the controller lifts
+// the body to, under the root). On a level the ground under each foot differs from that: a
+// step up, a tread down, a slope under the toe. Once per update, after forward kinematics and
+// before foot locking, FootPlacement
+// 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
+//    (the body's velocity ahead), in one batched call of kProbes probes;
+// 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
+//    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
+//    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
+//    tilted at most max_foot_tilt, the other end hanging over), each on a spring that rises
+//    faster than it falls;
+// 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
+//    their ground reaches it without straightening its leg further than the animation did (or
+//    than kMaxLegExtension of its length, if that is further).
+// The foot lock then takes each toe's target from the animation raised or lowered by its
+// ground's offset from the body's ground, holds the planted point in 3-D, keeps a toe above
+// its own ground, and pitches the foot so that heel and toe each keep their height above their
+// ground (tilt()).
+//
+// A probe that misses, finds ground farther than a step above or below the body's ground, or
+// returns garbage (rejected by CharacterMover's checks, counted in world_rejected) falls back to
+// the body's ground, the capsule's floor: the animation as recorded.
+
+#include <array>
+#include <span>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include "mm/controller/character_mover.hpp"
+#include "mm/controller/world.hpp"
+
+namespace mm {
+
+// What the placement reads of one leg, after forward kinematics (relative to the controller's
+// origin, before the pelvis drop).
+struct PlacementLeg {
+  glm::vec3 hip{0.0f};
+  glm::vec3 ankle{0.0f};
+  glm::vec3 toe{0.0f};
+  float length = 0.0f;       // upper plus lower leg (m)
+  bool planted = false;      // locked or in contact: its probes look only where it is
+  bool near_ground = false;  // planted or about to be: its reach counts for the pelvis
+};
+
+struct FootPlacementSettings {
+  float max_pelvis_drop = 0.35f;       // m
+  float pelvis_drop_halflife = 0.24f;  // s
+  float max_foot_tilt = 0.6f;          // radians, pitch of the heel-to-toe line
+  float step_height = 0.35f;           // m: ground higher than this above the body's is a wall
+  float max_step_down = 0.5f;          // m: ground lower than this below the body's is a ledge
+};
+
+// One foot's ground (heights in the controller's frame, m).
+struct FootGround {
+  float heel = 0.0f;
+  float toe = 0.0f;
+};
+
+class FootPlacement {
+ public:
+  // Heel and toe of each foot, now and ahead.
+  static constexpr int kProbes = 8;
+  // How far ahead the probes look: the body's velocity times this (s).
+  static constexpr float kLookahead = 0.2f;
+  // A leg may straighten to this share of its length to reach a lower foot's ground before
+  // the pelvis has to drop.
+  static constexpr float kMaxLegExtension = 0.97f;
+
+  // Every foot's ground at `ground`, the pelvis not dropped: a placement or a new world.
+  void reset(float ground);
+
+  // Probes under both feet (one call to the world through `mover`, whose checks apply) and
+  // moves the grounds and the pelvis drop on their springs by dt (0: only probes).
+  void update(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
+              const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
+              float body_ground, const glm::vec3& body_velocity, float dt);
+
+  const FootGround& ground(int side) const { return feet_[side != 0 ? 1 : 0].ground; }
+  float pelvis_drop() const { return pelvis_drop_; }
+
+  // The rotation that pitches a foot whose heel-to-toe line is `along` (the animated one, after
+  // any heading swivel) so that heel and toe each keep their animated height above their own
+  // ground: the toe rises by toe - heel relative to the heel. At most max_foot_tilt.
+  glm::quat tilt(int side, const glm::vec3& along, float max_tilt) const;
+  // Whether tilt() turns the foot at all: its heel and toe stand at different heights.
+  bool tilted(int side) const {
+    const FootGround& g = ground(side);
+    return g.toe != g.heel;
+  }
+
+  // The probes' last answers, for the debug drawing: the points probed and the ground found
+  // (the body's ground where nothing acceptable was).
+  const std::array<glm::vec3, kProbes>& probe_points() const { return probe_points_; }
+  const std::array<glm::vec3, kProbes>& probe_grounds() const { return probe_grounds_; }
+
+ private:
+  struct Foot {
+    FootGround ground;
+    FootGround velocity;
+  };
+  void probe(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
+             const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
+             float body_ground, const glm::vec3& body_velocity);
+  FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
+  float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
+                  float body_ground) const;
+
+  std::array<Foot, 2> feet_{};
+  float pelvis_drop_ = 0.0f;
+  float pelvis_drop_velocity_ = 0.0f;
+  float drop_goal_ = 0.0f;  // the drop's goal, smoothed
+  float drop_goal_velocity_ = 0.0f;
+  std::array<GroundProbe, kProbes> probes_{};
+  std::array<GroundHit, kProbes> hits_{};
+  std::array<glm::vec3, kProbes> probe_points_{};
+  std::array<glm::vec3, kProbes> probe_grounds_{};
+};
+
+}  // namespace mm

@@ -1,0 +1,169 @@
+// Feet on the world's ground: probes, per-foot ground heights, the pelvis drop, the foot's tilt
+// (foot_placement.hpp).
+
+#include "mm/controller/foot_placement.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mm/runtime/spring.hpp"
+
+namespace mm {
+
+namespace {
+
+// A foot's ground follows its goal at once where the goal moves little in an update (along a
+// slope, over bumps: a spring would lag behind a slope and land the foot above or in it), and
+// on a spring across a step (a tread's edge: the foot would pop). The spring rises faster
+// than it sinks: a toe late onto a tread is inside its riser, one late off it only hovers.
+constexpr float kStepChange = 0.06f;    // m in one update: a step, not a slope
+constexpr float kRiseHalflife = 0.02f;  // s
+constexpr float kFallHalflife = 0.06f;  // s
+// How far above the highest walkable step a probe starts (m): the point it starts from is
+// never inside that step.
+constexpr float kProbeMargin = 0.02f;
+// Ground ahead this much higher than the plane of the ground under the foot (m) is a step.
+constexpr float kStepRise = 0.02f;
+
+// Probe slots: per side, heel now, toe now, heel ahead, toe ahead.
+constexpr int kHeel = 0, kToe = 1, kHeelAhead = 2, kToeAhead = 3;
+constexpr int slot(int side, int which) {
+  return side * 4 + which;
+}
+
+void follow_ground(float& height, float& velocity, float goal, float dt) {
+  if (std::abs(goal - height) <= kStepChange && std::abs(velocity) * dt <= kStepChange) {
+    height = goal;
+    velocity = 0.0f;
+    return;
+  }
+  critical_spring_update(height, velocity, goal, goal > height ? kRiseHalflife : kFallHalflife, dt);
+}
+
+}  // namespace
+
+void FootPlacement::reset(float ground) {
+  for (Foot& foot : feet_) {
+    foot.ground = FootGround{ground, ground};
+    foot.velocity = FootGround{};
+  }
+  pelvis_drop_ = pelvis_drop_velocity_ = drop_goal_ = drop_goal_velocity_ = 0.0f;
+  probe_grounds_.fill(glm::vec3(0.0f, ground, 0.0f));
+}
+
+void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
+                           CharacterMover& mover, const FootPlacementSettings& settings,
+                           std::span<const PlacementLeg, 2> legs, float body_ground,
+                           const glm::vec3& body_velocity, float dt) {
+  probe(world, origin, mover, settings, legs, body_ground, body_velocity);
+  for (int side = 0; side < 2; ++side) {
+    const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
+    const FootGround g = goal(side, settings, foot_length);
+    Foot& foot = feet_[side];
+    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
+  }
+  // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
+  // one spring would answer each jump with a jump of the hips' vertical acceleration.
+  const float halflife = 0.5f * settings.pelvis_drop_halflife;
+  critical_spring_update(drop_goal_, drop_goal_velocity_, drop_goal(settings, legs, body_ground),
+                         halflife, dt);
+  critical_spring_update(pelvis_drop_, pelvis_drop_velocity_, drop_goal_, halflife, dt);
+  pelvis_drop_ = std::clamp(pelvis_drop_, 0.0f, settings.max_pelvis_drop);
+}
+
+// Heel and toe, where they are and (for a foot in the air) where the body's velocity takes them
+// shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only where
+// it is: ahead, up a slope, it would rise off the surface it stands on.
+void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
+                          CharacterMover& mover, const FootPlacementSettings& settings,
+                          std::span<const PlacementLeg, 2> legs, float body_ground,
+                          const glm::vec3& body_velocity) {
+  const glm::vec3 ahead(body_velocity.x * kLookahead, 0.0f, body_velocity.z * kLookahead);
+  const float top = body_ground + settings.step_height + kProbeMargin;
+  const float reach = settings.step_height + settings.max_step_down + 2.0f * kProbeMargin;
+  for (int side = 0; side < 2; ++side) {
+    const PlacementLeg& leg = legs[side];
+    const glm::vec3 look = leg.planted ? glm::vec3(0.0f) : ahead;
+    probe_points_[slot(side, kHeel)] = leg.ankle;
+    probe_points_[slot(side, kToe)] = leg.toe;
+    probe_points_[slot(side, kHeelAhead)] = leg.ankle + look;
+    probe_points_[slot(side, kToeAhead)] = leg.toe + look;
+  }
+  for (int i = 0; i < kProbes; ++i) {
+    probes_[i] = GroundProbe{glm::vec3(probe_points_[i].x, top, probe_points_[i].z), reach, 0.0f};
+  }
+  mover.probe(world, origin, probes_, hits_);
+  for (int i = 0; i < kProbes; ++i) {
+    const float y = hits_[i].hit ? hits_[i].point.y : body_ground;
+    probe_grounds_[i] = glm::vec3(probe_points_[i].x, y, probe_points_[i].z);
+  }
+  // Ahead counts only where the ground steps up: up a slope it is only the slope, which the
+  // foot will meet as it gets there (counted now, a landing foot would lock in the air).
+  for (int side = 0; side < 2; ++side) {
+    for (const int now : {kHeel, kToe}) {
+      const int later = now + 2;  // kHeelAhead, kToeAhead
+      glm::vec3& ahead_ground = probe_grounds_[slot(side, later)];
+      const glm::vec3& here = probe_grounds_[slot(side, now)];
+      const GroundHit& hit = hits_[slot(side, now)];
+      const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+      const glm::vec3 d = ahead_ground - here;
+      const float along_plane = here.y - (n.x * d.x + n.z * d.z) / std::max(n.y, 0.1f);
+      if (ahead_ground.y < along_plane + kStepRise) ahead_ground.y = here.y;
+    }
+  }
+}
+
+// The heights a foot's heel and toe go to: the higher of now and ahead, then each raised to
+// within the steepest tilt of the other (a foot over a step's edge rests on the higher side).
+FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
+                               float foot_length) const {
+  const auto height = [&](int which) { return probe_grounds_[slot(side, which)].y; };
+  const float heel = std::max(height(kHeel), height(kHeelAhead));
+  const float toe = std::max(height(kToe), height(kToeAhead));
+  const float rise = foot_length * std::tan(settings.max_foot_tilt);
+  return FootGround{std::max(heel, toe - rise), std::max(toe, heel - rise)};
+}
+
+// How far the pelvis must come down so that every leg near its ground reaches the ground under
+// its heel: the ankle, lowered by its ground's depth below the body's, no farther from the hip
+// than the animation had it or than kMaxLegExtension of the leg, whichever is farther.
+float FootPlacement::drop_goal(const FootPlacementSettings& settings,
+                               std::span<const PlacementLeg, 2> legs, float body_ground) const {
+  float drop = 0.0f;
+  for (int side = 0; side < 2; ++side) {
+    const PlacementLeg& leg = legs[side];
+    // A foot on ground no lower than the body's reaches it as the animation does.
+    if (!leg.near_ground || feet_[side].ground.heel >= body_ground) continue;
+    const float ankle_y = leg.ankle.y + (feet_[side].ground.heel - body_ground);
+    const float below_hip = leg.hip.y - ankle_y;
+    const float across = glm::length(glm::vec2(leg.hip.x - leg.ankle.x, leg.hip.z - leg.ankle.z));
+    const float allowed = std::max(glm::length(leg.hip - leg.ankle), kMaxLegExtension * leg.length);
+    const float reachable =
+        allowed > across ? std::sqrt(allowed * allowed - across * across) : 0.0f;
+    drop = std::max(drop, below_hip - reachable);
+  }
+  return std::clamp(drop, 0.0f, settings.max_pelvis_drop);
+}
+
+glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) const {
+  const glm::quat none(1.0f, 0.0f, 0.0f, 0.0f);
+  const float length = glm::length(along);
+  const glm::vec3 level(along.x, 0.0f, along.z);
+  if (length < 1e-4f || glm::length(level) < 1e-4f) return none;
+  if (!tilted(side)) return none;
+  const FootGround& g = feet_[side != 0 ? 1 : 0].ground;
+  // In the foot's vertical plane: the heel-to-toe line (h0, y0) turned about the heel to
+  // (h1, y1), same length, so that the toe is as high above the line from the heel's ground to
+  // the toe's (slope s) as it was above the flat floor: y1 = s h1 + y0.
+  const float h0 = glm::length(level), y0 = along.y;
+  const float s = (g.toe - g.heel) / h0;
+  const float a = 1.0f + s * s;
+  const float h1 =
+      (-s * y0 + std::sqrt(std::max(0.0f, s * s * y0 * y0 - a * (y0 * y0 - length * length)))) / a;
+  const float y1 = s * h1 + y0;
+  const float angle = std::clamp(std::atan2(y1, h1) - std::atan2(y0, h0), -max_tilt, max_tilt);
+  return glm::angleAxis(angle, glm::normalize(glm::cross(level, glm::vec3(0.0f, 1.0f, 0.0f))));
+}
+
+}  // namespace mm

@@ -1,0 +1,215 @@
+// Feet on the world's ground (issue 29; foot_placement.hpp): each rule of FootPlacement on the
+// analytic test world (slopes up and down, a stair's edge, a toe swinging toward a riser, a
+// probe that misses, a probe that answers garbage, the pelvis drop and its limit), then a
+// controller walking on 10, 20 and 30 degree slopes with its planted feet on the surface.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+#include "analytic_world.hpp"
+#include "controller_support.hpp"
+#include "mm/controller/controller.hpp"
+#include "mm/controller/foot_placement.hpp"
+
+namespace mm {
+namespace {
+
+using test::AnalyticBox;
+using test::AnalyticWorld;
+
+constexpr float kDt = 1.0f / 60.0f;
+constexpr float kPi = 3.14159265f;
+
+// A standing leg as the flat data has it: heel (ankle) 8 cm up, toe 15 cm ahead (+Z) and 3 cm
+// up, the hip 85 cm above the ankle; heights above `ground`.
+PlacementLeg standing_leg(float x, float z, float ground) {
+  PlacementLeg leg;
+  leg.ankle = glm::vec3(x, ground + 0.08f, z);
+  leg.toe = glm::vec3(x, ground + 0.03f, z + 0.15f);
+  leg.hip = glm::vec3(x, ground + 0.93f, z - 0.05f);
+  leg.length = 0.9f;
+  leg.planted = leg.near_ground = true;
+  return leg;
+}
+
+// Runs the placement until its springs have settled (3 s), the body standing on `ground`.
+void settle(FootPlacement& p, const AnalyticWorld& world, CharacterMover& mover,
+            const std::array<PlacementLeg, 2>& legs, float ground,
+            const FootPlacementSettings& settings = {}) {
+  p.reset(ground);
+  for (int f = 0; f < 180; ++f) {
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, ground, glm::vec3(0.0f), kDt);
+  }
+}
+
+// The toe's height above the surface after the foot is tilted about its heel: the animated
+// foot line turned by tilt(), started from the heel on its ground.
+float tilted_toe_clearance(const FootPlacement& p, const AnalyticWorld& world,
+                           const PlacementLeg& leg, float body_ground) {
+  const glm::vec3 along = leg.toe - leg.ankle;
+  const glm::vec3 heel = leg.ankle + glm::vec3(0.0f, p.ground(0).heel - body_ground, 0.0f);
+  const glm::vec3 toe = heel + p.tilt(0, along, FootPlacementSettings{}.max_foot_tilt) * along;
+  return toe.y - static_cast<float>(world.surface(toe.x, toe.z));
+}
+
+TEST(FootPlacement, OnSlopesUpAndDownHeelAndToeKeepTheirHeightAboveTheSurface) {
+  for (const float degrees : {10.0f, 20.0f, 30.0f}) {
+    for (const float direction : {1.0f, -1.0f}) {  // uphill, then downhill (the O3DE case)
+      const double slope = direction * std::tan(degrees * kPi / 180.0f);
+      AnalyticWorld world;
+      world.height = [slope](double, double z) { return z * slope; };
+      CharacterMover mover;
+      FootPlacement p;
+      const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
+                                             standing_leg(0.1f, 0.0f, 0.0f)};
+      settle(p, world, mover, legs, 0.0f);
+      const PlacementLeg& leg = legs[0];
+      EXPECT_NEAR(p.ground(0).heel, world.surface(leg.ankle.x, leg.ankle.z), 1e-3)
+          << degrees << " " << direction;
+      EXPECT_NEAR(p.ground(0).toe, world.surface(leg.toe.x, leg.toe.z), 1e-3)
+          << degrees << " " << direction;
+      // The toe sits as high above the slope as it did above the flat floor: downhill it is
+      // pitched down onto the surface rather than floating off it.
+      EXPECT_NEAR(tilted_toe_clearance(p, world, leg, 0.0f), 0.03f, 2e-3f)
+          << degrees << " " << direction;
+    }
+  }
+}
+
+TEST(FootPlacement, AFootOverAStairsEdgeRestsOnTheStepNeverInsideIt) {
+  AnalyticWorld world;
+  // A 17 cm step whose edge is at z = 0.1: the heel is below it, the toe over it.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.1f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
+                                         standing_leg(0.1f, 0.0f, 0.0f)};
+  settle(p, world, mover, legs, 0.0f);
+  const FootPlacementSettings settings;
+  const float rise = glm::length(legs[0].toe - legs[0].ankle) * std::tan(settings.max_foot_tilt);
+  EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f);
+  // The heel hangs over the lower tread, the foot tilted no more than its limit.
+  EXPECT_NEAR(p.ground(0).heel, 0.17f - rise, 2e-3f);
+  EXPECT_GT(p.ground(0).heel, 0.0f);
+}
+
+TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
+  AnalyticWorld world;
+  // The riser at z = 0.3, ahead of a toe at z = 0.15 moving forward with the body.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.3f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
+  legs[0].planted = legs[0].near_ground = false;
+  p.reset(0.0f);
+  const FootPlacementSettings settings;
+  const glm::vec3 velocity(0.0f, 0.0f, 1.4f);
+  for (int f = 0; f < 6; ++f) {
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, velocity, kDt);
+  }
+  // 0.1 s later the toe, still over the lower tread, stands on the step's height already; the
+  // planted foot, looking only where it is, does not.
+  EXPECT_GT(p.ground(0).toe, 0.15f);
+  EXPECT_EQ(p.ground(1).toe, 0.0f);
+}
+
+TEST(FootPlacement, AProbeThatMissesFallsBackToTheBodysGround) {
+  AnalyticWorld world;
+  world.height = [](double, double) { return -5.0; };  // far below any probe's reach
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.3f),
+                                         standing_leg(0.1f, 0.0f, 0.3f)};
+  settle(p, world, mover, legs, 0.3f);
+  EXPECT_EQ(p.ground(0).heel, 0.3f);
+  EXPECT_EQ(p.ground(1).toe, 0.3f);
+  EXPECT_EQ(p.pelvis_drop(), 0.0f);
+  EXPECT_EQ(p.probe_grounds()[0].y, 0.3f);
+}
+
+TEST(FootPlacement, GarbageAnswersAreIgnoredAndCounted) {
+  AnalyticWorld world;
+  world.garbage = true;
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.2f),
+                                         standing_leg(0.1f, 0.0f, 0.2f)};
+  settle(p, world, mover, legs, 0.2f);
+  EXPECT_EQ(mover.rejected(), 180 * FootPlacement::kProbes);
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_EQ(p.ground(side).heel, 0.2f);
+    EXPECT_EQ(p.ground(side).toe, 0.2f);
+  }
+  EXPECT_EQ(p.pelvis_drop(), 0.0f);
+}
+
+TEST(FootPlacement, ThePelvisComesDownSoThatTheLowerFootReachesWithinItsLimit) {
+  AnalyticWorld world;
+  // The right foot's ground 12 cm lower than the body's: a step down under it.
+  world.height = [](double x, double) { return x > 0.0 ? -0.12 : 0.0; };
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
+  legs[1].length = 0.86f;  // as straight as the animation has it: any lower needs the pelvis
+  settle(p, world, mover, legs, 0.0f);
+  const PlacementLeg& low = legs[1];
+  const float ankle_y = low.ankle.y - 0.12f;
+  const glm::vec3 hip = low.hip - glm::vec3(0.0f, p.pelvis_drop(), 0.0f);
+  const float reach = glm::length(hip - glm::vec3(low.ankle.x, ankle_y, low.ankle.z));
+  EXPECT_GT(p.pelvis_drop(), 0.05f);
+  EXPECT_NEAR(reach, std::max(glm::length(low.hip - low.ankle), 0.97f * low.length), 2e-3f);
+
+  // Far deeper than the limit: the drop stops at it.
+  world.height = [](double x, double) { return x > 0.0 ? -0.45 : 0.0; };
+  FootPlacementSettings settings;
+  settings.max_pelvis_drop = 0.2f;
+  settle(p, world, mover, legs, 0.0f, settings);
+  EXPECT_FLOAT_EQ(p.pelvis_drop(), 0.2f);
+}
+
+// Walking up and down a slope, a planted foot stands on it as on flat ground: its toe and its
+// heel (ankle) as high above the surface under them as the flat run has them, and never below.
+TEST(FootPlacementController, OnSlopesThePlantedFeetStandOnTheSurface) {
+  const auto clearances = [](const AnalyticWorld& world, float yaw_degrees) {
+    Controller c = test::make_controller();
+    c.set_world(&world);
+    const Database& db = c.controller_database().database();
+    const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
+    const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
+    double toe_sum = 0.0, heel_sum = 0.0, lowest = 1e9;
+    int count = 0;
+    for (int f = 0; f < 5 * 60; ++f) {
+      c.update(kDt, test::push_toward(yaw_degrees, false));
+      if (f < 60) continue;
+      for (int side = 0; side < 2; ++side) {
+        const glm::vec3 toe = c.global_transforms()[static_cast<size_t>(toes[side])].translation;
+        const glm::vec3 heel = c.global_transforms()[static_cast<size_t>(feet[side])].translation;
+        const double toe_clearance = toe.y - world.surface(toe.x, toe.z);
+        lowest = std::min(lowest, toe_clearance);
+        if (!c.debug().locked[side]) continue;
+        toe_sum += toe_clearance;
+        heel_sum += heel.y - world.surface(heel.x, heel.z);
+        ++count;
+      }
+    }
+    return std::array<double, 3>{toe_sum / count, heel_sum / count, lowest};
+  };
+  AnalyticWorld flat;
+  const std::array<double, 3> on_flat = clearances(flat, 0.0f);
+  for (const float degrees : {10.0f, 20.0f, 30.0f}) {
+    for (const float yaw : {0.0f, 180.0f}) {  // up the slope (+Z), then down it
+      AnalyticWorld world;
+      const double slope = std::tan(degrees * kPi / 180.0f);
+      world.height = [slope](double, double z) { return z * slope; };
+      const std::array<double, 3> on_slope = clearances(world, yaw);
+      EXPECT_NEAR(on_slope[0], on_flat[0], 0.015) << degrees << " yaw " << yaw;
+      EXPECT_NEAR(on_slope[1], on_flat[1], 0.02) << degrees << " yaw " << yaw;
+      EXPECT_GT(on_slope[2], 0.01) << degrees << " yaw " << yaw;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mm
