@@ -14,6 +14,8 @@ const glm::vec3 kMatch{0.85f, 0.15f, 0.85f};
 const glm::vec3 kContact{0.1f, 0.8f, 0.2f};
 const glm::vec3 kAir{0.45f, 0.45f, 0.45f};
 const glm::vec3 kLock{0.9f, 0.1f, 0.1f};
+const glm::vec3 kProbe{0.2f, 0.8f, 0.9f};
+const glm::vec3 kPelvis{0.95f, 0.3f, 0.6f};
 constexpr float kLift = 0.01f;  // lines on the ground are lifted so the grid does not hide them
 
 glm::vec3 ground(glm::vec3 p) {
@@ -123,10 +125,32 @@ void draw_contacts(const Controller& controller, DebugLines& lines) {
   for (int side = 0; side < 2; ++side) {
     if (toes[side] < 0) continue;
     const glm::vec3 toe = globals[toes[side]].translation;
-    lines.circle(ground(toe), 0.07f, d.contact[side] ? kContact : kAir, 16);
+    // In a world, the circle lies on the ground the foot stands on (foot_placement.hpp).
+    glm::vec3 on_ground = ground(toe);
+    if (controller.world()) {
+      on_ground.y = static_cast<float>(d.origin.y + d.foot_ground[side].toe) + kLift;
+    }
+    lines.circle(on_ground, 0.07f, d.contact[side] ? kContact : kAir, 16);
     if (d.locked[side]) lines.cross(d.world(d.lock_position[side]), 0.06f, kLock);
     lines.cross(d.world(d.ik_target[side]), 0.03f, kAir);
   }
+}
+
+// Feet on a level's ground: each probe from the foot down to the ground it found (a cross
+// there), and the pelvis drop as a bar from where the hips would be down to where they are.
+void draw_foot_placement(const Controller& controller, DebugLines& lines) {
+  if (!controller.world()) return;
+  const ControllerDebug& d = controller.debug();
+  for (int i = 0; i < FootPlacement::kProbes; ++i) {
+    const glm::vec3 found = d.world(d.foot_probe_grounds[i]);
+    lines.line(d.world(d.foot_probes[i]), found, kProbe);
+    lines.cross(found, 0.02f, kProbe);
+  }
+  const int hips = controller.controller_database().database().roles().hips;
+  if (hips < 0 || d.pelvis_drop <= 0.0f) return;
+  const glm::vec3 at = controller.global_transforms()[static_cast<size_t>(hips)].translation;
+  lines.line(at + glm::vec3(0.0f, d.pelvis_drop, 0.0f), at, kPelvis);
+  lines.cross(at, 0.05f, kPelvis);
 }
 
 }  // namespace
@@ -136,7 +160,10 @@ void draw_controller_debug(const Controller& controller, const DebugToggles& tog
   if (toggles.trajectory) draw_trajectory(controller.debug(), lines);
   if (toggles.roots) draw_roots(controller, lines);
   if (toggles.features) draw_features(controller, lines);
-  if (toggles.contacts) draw_contacts(controller, lines);
+  if (toggles.contacts) {
+    draw_contacts(controller, lines);
+    draw_foot_placement(controller, lines);
+  }
 }
 
 void draw_skeleton(const Controller& controller, DebugLines& lines) {
