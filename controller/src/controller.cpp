@@ -44,15 +44,24 @@ constexpr float kSettleHeading = 0.25f;
 // A step lands once its heading too has come this close (radians) to the animation's, so a
 // foot never plants with the twist it stepped to undo.
 constexpr float kRelockHeading = 0.05f;
-// A step lifts the toe by this share of the distance it still has to go, at most kStepHeight
-// (m): it rises as it leaves and lands as it arrives.
+// A step lifts the toe by this share of the distance it still has to go, at least
+// kStepMinLift and at most kStepHeight (m), and over its last kStepLanding (m) comes down in
+// proportion: it rises, moves, and lands as it arrives. It moves once it has risen
+// kStepMoveLift (m): a foot that shuffles along low is a foot sliding on the ground.
 constexpr float kStepLift = 0.5f;
+constexpr float kStepMinLift = 0.05f;
 constexpr float kStepHeight = 0.08f;
+constexpr float kStepLanding = 0.03f;
+constexpr float kStepMoveLift = 0.035f;
 // Halflife (s) of the lift's spring: short beside a step, long beside a frame.
 constexpr float kLiftHalflife = 0.06f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
 // foot) steps rather than being dragged: past full length, since soft reach still bends it.
 constexpr float kStepReach = 1.03f;
+// An animated toe lower than this above its ground (m) and horizontally slower than this (m/s)
+// is planted, whatever its label says: the skating metric's rule (ground_metrics.hpp).
+constexpr float kPlantedHeight = 0.06f;
+constexpr float kPlantedSpeed = 0.35f;
 const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
 
 // A rotation a game may hand in: finite and not far from unit length (it is normalized).
@@ -1057,7 +1066,8 @@ void Controller::foot_lock(float dt) {
       continue;
     }
     const glm::vec3 on_ground = animated + glm::vec3(0.0f, ground_offset_[side], 0.0f);
-    const glm::vec3 target = foot_target(side, animated, on_ground, settling, dt);
+    const bool contact = debug_.contact[side] || low_and_slow(side, on_ground, dt);
+    const glm::vec3 target = foot_target(side, animated, on_ground, contact, settling, dt);
     hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
@@ -1078,9 +1088,9 @@ void Controller::foot_lock(float dt) {
 // a contact begins or once a foot released during one has eased back onto the animation; it
 // holds that point in 3-D.
 glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
-                                  bool settling, float dt) {
+                                  bool contact, bool settling, float dt) {
   FootLock& f = feet_[side];
-  const bool contact = debug_.contact[side];
+  bool released = false;
   if (!f.has_target) {
     f.target = on_ground;
     f.has_target = true;
@@ -1113,6 +1123,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     const bool dragged = glm::length(drag) > settings_.foot_unlock_radius || out_of_reach;
     if (!contact || dragged || settle) {
       // A foot that has to move while its frame says "contact" steps there rather than slides.
+      released = true;
       f.locked = false;
       f.stepping = contact && (settle || dragged);
       f.offset = f.target - on_ground;
@@ -1120,20 +1131,17 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     }
   }
   f.previous_contact = contact;
-  critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
-                         settings_.foot_lock_release_halflife, dt);
+  // The release's first update holds the toe where it was: its offset starts decaying from
+  // rest on the next.
+  if (!released) {
+    critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
+                           settings_.foot_lock_release_halflife, dt);
+  }
   glm::vec3 target = (f.locked ? f.position : on_ground) + f.offset;
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
   // toe dead at the floor, a jerk the legs show.
-  float floor = shared_->lowest_foot_end(side);
-  // In a world, each toe stands on the ground under it; on the game's capsule, the body on its
-  // height (ground_height_).
-  if (world_) {
-    floor += foot_placement_.ground(side).toe;
-  } else if (game_capsule_) {
-    floor += ground_height_;
-  }
+  const float floor = shared_->lowest_foot_end(side) + toe_ground(side);
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
   f.target = target;
@@ -1150,6 +1158,29 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     f.stepping = false;
   }
   return target;
+}
+
+// The height of the ground a toe stands on: in a world, the ground under it; on the game's
+// capsule, the capsule's height (ground_height_); else the plane y = 0.
+float Controller::toe_ground(int side) const {
+  if (world_) return foot_placement_.ground(side).toe;
+  return game_capsule_ ? ground_height_ : 0.0f;
+}
+
+// Whether the animated toe (on its ground) is planted by geometry, as the skating metric sees
+// a toe (ground_metrics.hpp): low and horizontally slow. A blend's pose drags such a toe along
+// the ground while neither pose's contact label is on (a dead blend's first half has a foot
+// down only where both poses do); held like a labelled contact, it stays where it is. Updates
+// of no time keep the last answer.
+bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
+  FootLock& f = feet_[side];
+  if (dt > 0.0f && f.has_animated) {
+    const float speed = std::hypot(on_ground.x - f.animated.x, on_ground.z - f.animated.z) / dt;
+    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
+  }
+  f.animated = on_ground;
+  f.has_animated = true;
+  return f.low_and_slow;
 }
 
 // Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
@@ -1177,8 +1208,9 @@ void Controller::hold_heading(int side, float dt) {
   }
   const float animated = foot_heading(side);
   // A foot down in the pose a dead blend started from keeps its heading while the fade is
-  // under half way, even when its toe is let go: the fade would swivel it on the ground.
-  const bool hold = f.locked || (in_early_blend() && blend_source_contact_[side]);
+  // under half way, even when its toe is let go: the fade would swivel it on the ground. Not
+  // a stepping foot: it is in the air, and held it would never come round to land.
+  const bool hold = f.locked || (in_early_blend() && blend_source_contact_[side] && !f.stepping);
   if (hold) {
     if (!f.heading_held) f.heading = wrap_angle(animated + f.heading_offset);
     f.heading_held = true;

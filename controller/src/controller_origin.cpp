@@ -50,6 +50,7 @@ void Controller::shift_origin(const glm::vec3& shift) {
   for (FootLock& foot : feet_) {
     foot.position -= shift;
     foot.target -= shift;
+    foot.animated -= shift;
   }
   debug_.simulation_position -= shift;
   for (int i = 0; i < ControllerDebug::kMaxTrajectoryPoints; ++i) {

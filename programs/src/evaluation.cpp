@@ -451,7 +451,7 @@ std::string csv_header(const Database& db) {
   for (const std::string& name : db.skeleton().names()) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
-  h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck");
+  h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
   return h;
 }
 
@@ -471,8 +471,9 @@ std::string csv_row(const EvaluationFrame& r) {
     std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f", p.x, p.y, p.z);
     row += buffer;
   }
-  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%d", r.toe_ground[0], r.toe_ground[1],
-                r.hips_ground, r.wall_depth, r.stuck ? 1 : 0);
+  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%d,%d,%d", r.toe_ground[0],
+                r.toe_ground[1], r.hips_ground, r.wall_depth, r.stuck ? 1 : 0, r.locked[0] ? 1 : 0,
+                r.locked[1] ? 1 : 0);
   row += buffer;
   return row;
 }
@@ -497,6 +498,8 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.frame = d.frame;
   r.contact[0] = d.contact[0];
   r.contact[1] = d.contact[1];
+  r.locked[0] = d.locked[0];
+  r.locked[1] = d.locked[1];
   r.update_seconds = update_seconds;
   r.searched = d.searched;
   r.search_seconds = d.search_seconds;

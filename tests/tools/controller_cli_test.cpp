@@ -170,7 +170,7 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
     header.append(",").append(joint).append("_x,").append(joint).append("_y,").append(joint).append(
         "_z");
   }
-  header.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck");
+  header.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
   std::istringstream lines(dumps[0]);
   std::string first;
   std::getline(lines, first);

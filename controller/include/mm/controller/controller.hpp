@@ -500,7 +500,9 @@ class Controller {
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
-                        bool settling, float dt);
+                        bool contact, bool settling, float dt);
+  float toe_ground(int side) const;
+  bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
   void hold_heading(int side, float dt);
   glm::vec3 playing_position(int joint) const;
   int leg_end(int side) const;
@@ -602,6 +604,10 @@ class Controller {
     float heading_offset = 0.0f;
     float heading_offset_velocity = 0.0f;
     bool heading_held = false;  // on the last update
+    // The animated toe on its ground last update, and whether it was low and slow then.
+    glm::vec3 animated{0.0f};
+    bool has_animated = false;
+    bool low_and_slow = false;
   };
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).

@@ -193,6 +193,7 @@ struct EvaluationFrame {
   float desired_yaw = 0.0f;
   bool transition = false;
   bool contact[2] = {false, false};  // left, right
+  bool locked[2] = {false, false};   // the foot lock holds the toe (left, right)
   int clip = -1;                     // playing: index into the database's clips
   int frame = -1;                    // playing: the database frame
   double update_seconds = 0.0;
