@@ -86,9 +86,16 @@ struct StandTurnSums {
   double response_s = 0.0;
   double final_error_deg = 0.0;
   double peak_rate_deg_s = 0.0;
+  int interrupted = 0;               // ended by a new request before kStandTurnJudgeSeconds
+  double final_error_deg_max = 0.0;  // over the others
   void close(const StandTurn& turn, float dt) {
     if (!turn.open) return;
     ++events;
+    if (turn.length * static_cast<double>(dt) < kStandTurnJudgeSeconds) {
+      ++interrupted;
+    } else {
+      final_error_deg_max = std::max(final_error_deg_max, turn.last_error_deg);
+    }
     unsettled += turn.settle_frame < 0 ? 1 : 0;
     response_s +=
         (turn.settle_frame < 0 ? turn.length : turn.settle_frame) * static_cast<double>(dt);
@@ -430,6 +437,8 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   turns.close(s.stand_turn, s.dt);
   m.stand_turns = turns.events;
   m.stand_turn_unsettled = turns.unsettled;
+  m.stand_turn_interrupted = turns.interrupted;
+  m.stand_turn_final_error_deg_max = turns.final_error_deg_max;
   m.stand_turn_response_s = turns.events > 0 ? turns.response_s / turns.events : 0.0;
   m.stand_turn_final_error_deg_mean = turns.events > 0 ? turns.final_error_deg / turns.events : 0.0;
   m.stand_turn_peak_rate_deg_s_max = turns.peak_rate_deg_s;

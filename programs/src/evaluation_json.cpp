@@ -33,6 +33,8 @@ nlohmann::json evaluation_metrics_json(const EvaluationMetrics& m) {
           {"foot_pivot_frames", m.foot_pivot_frames},
           {"stand_turns", m.stand_turns},
           {"stand_turn_unsettled", m.stand_turn_unsettled},
+          {"stand_turn_interrupted", m.stand_turn_interrupted},
+          {"stand_turn_final_error_deg_max", m.stand_turn_final_error_deg_max},
           {"stand_turn_response_s", m.stand_turn_response_s},
           {"stand_turn_final_error_deg_mean", m.stand_turn_final_error_deg_mean},
           {"stand_turn_peak_rate_deg_s_max", m.stand_turn_peak_rate_deg_s_max},

@@ -281,8 +281,28 @@ TEST(Evaluation, AnUnsettledStandTurnCountsItsWholeLengthAndItsFinalError) {
   EXPECT_NEAR(m.stand_turn_response_s, (10.0 + 50.0) / 2.0 * kDt, 1e-6);
   // Errors on the last frames: 5 degrees, then 175.
   EXPECT_NEAR(m.stand_turn_final_error_deg_mean, (5.0 + 175.0) / 2.0, 1e-3);
+  // Both lasted at least 40 frames (0.67 s): shorter than kStandTurnJudgeSeconds, so both were
+  // cut short and neither is judged by where it ended.
+  EXPECT_EQ(m.stand_turn_interrupted, 2);
+  EXPECT_EQ(m.stand_turn_final_error_deg_max, 0.0);
   // The hips' one jump, 45 degrees in a frame, is the fastest rate inside an event.
   EXPECT_NEAR(m.stand_turn_peak_rate_deg_s_max, 45.0 / kDt, 0.1);
+}
+
+TEST(Evaluation, AStandTurnGivenTimeIsJudgedByWhereItEndedAndAShortOneIsInterrupted) {
+  FrameFeed run;
+  Pose pose;
+  for (int f = 0; f < 60; ++f) run.add(pose);
+  // A turn to 90 cut short after 0.5 s by a turn to -90; the hips follow to -82 and stay
+  // there for 2 s: the first is interrupted, the second ends 8 degrees off.
+  const int half_second = static_cast<int>(0.5f / kDt);
+  for (int k = 0; k < half_second; ++k) run.add(pose, glm::vec3(0.0f), 90.0f);
+  pose.hips_yaw = -82.0f;
+  for (int k = 0; k < 4 * half_second; ++k) run.add(pose, glm::vec3(0.0f), -90.0f);
+  const EvaluationMetrics m = run.metrics();
+  EXPECT_EQ(m.stand_turns, 2);
+  EXPECT_EQ(m.stand_turn_interrupted, 1);
+  EXPECT_NEAR(m.stand_turn_final_error_deg_max, 8.0, 1e-3);
 }
 
 TEST(Evaluation, NoStandTurnWithoutAStandOrForASmallTurn) {

@@ -136,6 +136,9 @@ void print_body_metrics(const EvaluationMetrics& m) {
   std::printf("stand_turn_unsettled        %10d\n", m.stand_turn_unsettled);
   std::printf("stand_turn_response_s       %10.3f\n", m.stand_turn_response_s);
   std::printf("stand_turn_final_error_deg_mean %6.3f\n", m.stand_turn_final_error_deg_mean);
+  std::printf("stand_turn_interrupted      %10d\n", m.stand_turn_interrupted);
+  std::printf("stand_turn_final_error_deg_max %7.3f   (turns given %.1f s)\n",
+              m.stand_turn_final_error_deg_max, static_cast<double>(kStandTurnJudgeSeconds));
   std::printf("stand_turn_peak_rate_deg_s_max %7.3f\n", m.stand_turn_peak_rate_deg_s_max);
   std::printf("strafe_chest_error_deg_mean %10.3f   (%d strafing frames)\n",
               m.strafe_chest_error_deg_mean, m.strafe_chest_frames);

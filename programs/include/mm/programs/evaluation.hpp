@@ -68,7 +68,10 @@
 //   first frame within kSettleAngle, an unsettled event counting its whole length (frames
 //   times dt); stand_turn_final_error_deg_mean: mean of the hips' yaw error to the desired
 //   facing on each event's last frame; stand_turn_peak_rate_deg_s_max: the largest hips' yaw
-//   rate on any frame inside an event. With no events, all five are 0;
+//   rate on any frame inside an event. stand_turn_interrupted counts the events that lasted
+//   less than kStandTurnJudgeSeconds (a new turn or the stick cut them short: no turn could be
+//   done by then), and stand_turn_final_error_deg_max is the largest final error of the
+//   others, the turns given time to finish. With no events, all seven are 0;
 // - strafe_chest_error_deg_mean: the chest's yaw error to the desired facing on frames where
 //   the desired velocity is at least kStrafeMinSpeed, points at least kStrafeMinAngle away from
 //   the desired facing, and neither has changed for kStrafeSettleSeconds; strafe_chest_frames
@@ -126,6 +129,8 @@ inline constexpr float kPivotToeSpeed = 0.35f;
 inline constexpr float kStandTurnSpeed = 0.01f;
 inline constexpr float kStandTurnLookback = 0.1f;
 inline constexpr float kStandTurnAngleDegrees = 45.0f;
+// A turn on the spot given at least this long (s) is judged by where it ended.
+inline constexpr float kStandTurnJudgeSeconds = 1.5f;
 // Strafing: desired speed at least this (m/s), at least this far (degrees) from the facing,
 // both held this long (s).
 inline constexpr float kStrafeMinSpeed = 0.3f;
@@ -164,6 +169,8 @@ struct EvaluationMetrics {
   int foot_pivot_frames = 0;
   int stand_turns = 0;
   int stand_turn_unsettled = 0;
+  int stand_turn_interrupted = 0;
+  double stand_turn_final_error_deg_max = 0.0;
   double stand_turn_response_s = 0.0;
   double stand_turn_final_error_deg_mean = 0.0;
   double stand_turn_peak_rate_deg_s_max = 0.0;
