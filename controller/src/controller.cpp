@@ -415,6 +415,7 @@ void Controller::desired_motion(const ControllerInput& input) {
   const float backward = run ? speeds_.run_backward : speeds_.walk_backward;
   const glm::vec3 scaled(local.x * sideways, 0.0f, local.z * (local.z > 0.0f ? forward : backward));
   desired_velocity_ = desired_rotation_ * scaled;
+  if (world_ && !input.strafe && !facing_given) face_along_obstacle();
 
   tag_bits_ = resolve_tag(input.tag);
   const bool released = glm::length(move) == 0.0f;

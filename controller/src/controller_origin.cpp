@@ -42,6 +42,7 @@ void Controller::shift_origin(const glm::vec3& shift) {
   debug_.origin = origin_;
   sim_position_ -= shift;
   last_root_ -= shift;
+  obstacle_point_ -= shift;
   transition_src_position_ -= shift;
   for (std::vector<Transform>* pose : {&sampled_, &other_, &locals_}) {
     (*pose)[0].translation -= shift;  // only the root is in the world; the rest hang from it

@@ -18,6 +18,12 @@ namespace {
 // A toe this close to its lowest height in the data (m) is about to land or has just lifted:
 // its leg's reach counts for the pelvis drop (foot_placement.hpp).
 constexpr float kNearGroundHeight = 0.1f;
+// Pushing into a wall, the share of the desired speed that must be left along it for the
+// character to turn and walk along it rather than stand facing the wall.
+constexpr float kSlideFacingShare = 0.3f;
+// The simulation object is still beside the wall it last met while no farther from it than
+// this (m).
+constexpr float kBesideObstacle = 0.05f;
 
 }  // namespace
 
@@ -27,6 +33,7 @@ void Controller::set_world(const WorldQueries* world) {
   ground_height_ = ground_velocity_ = 0.0f;
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
+  obstacle_normal_ = glm::vec3(0.0f);
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
 }
 
@@ -49,6 +56,10 @@ void Controller::collide_simulation(const glm::vec3& before) {
   sim_position_ = m.position;
   debug_.simulation_blocked = m.blocked || m.no_ground;
   debug_.simulation_contact = m.normal;
+  if (m.blocked && glm::length(m.normal) > 0.5f) {
+    obstacle_normal_ = m.normal;
+    obstacle_point_ = sim_position_;
+  }
   if (m.no_ground) {
     sim_velocity_ = sim_acceleration_ = glm::vec3(0.0f);
   } else if (m.blocked) {
@@ -106,6 +117,24 @@ void Controller::lift_to_ground(float dt) {
                          dt);
   locals_[0].translation.y += ground_height_;
   debug_.ground_height = ground_height_;
+}
+
+// Pushed into a wall at an angle, the character walks along it, so it faces along it: facing
+// the stick's direction, into the wall, the arms and the leading shoulder would swing through
+// it. The velocity asked for keeps the stick's direction (the wall slides it); only the facing
+// turns, once the simulation object has met the wall and while it stays beside it (a slide
+// along a wall does not touch it on every update). Head-on there is nothing to slide along,
+// and the facing stays the stick's.
+void Controller::face_along_obstacle() {
+  const glm::vec3 n = obstacle_normal_;
+  if (glm::length(n) < 0.5f || glm::dot(sim_position_ - obstacle_point_, n) > kBesideObstacle) {
+    return;
+  }
+  const float into = glm::dot(desired_velocity_, n);
+  if (into >= 0.0f) return;
+  const glm::vec3 along = desired_velocity_ - n * into;
+  if (glm::length(along) < kSlideFacingShare * glm::length(desired_velocity_)) return;
+  desired_rotation_ = glm::angleAxis(std::atan2(along.x, along.z), glm::vec3(0.0f, 1.0f, 0.0f));
 }
 
 void Controller::set_simulation_position_world(const glm::dvec3& position) {
@@ -180,6 +209,7 @@ void Controller::settle_on_ground() {
   last_root_ = sim_position_;
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
+  obstacle_normal_ = glm::vec3(0.0f);
 }
 
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the

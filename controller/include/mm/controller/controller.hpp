@@ -463,6 +463,7 @@ class Controller {
   void lift_to_ground(float dt);
   void settle_on_ground();
   void place_feet(float dt);
+  void face_along_obstacle();
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
@@ -640,6 +641,9 @@ class Controller {
   // Feet on the world's ground, and per foot how far its toe's ground is above where the
   // animation puts it (the body's ground, less the pelvis drop); zero without a world.
   FootPlacement foot_placement_;
+  // The wall the simulation object last met (its horizontal normal; zero: none) and where.
+  glm::vec3 obstacle_normal_{0.0f};
+  glm::vec3 obstacle_point_{0.0f};
   float ground_offset_[2] = {0.0f, 0.0f};
 
   ControllerDebug debug_;
