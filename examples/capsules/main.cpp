@@ -60,7 +60,7 @@ struct Level {
     // Bullet's sweeps allow 4 cm of penetration by default: the capsule would rest that deep in
     // the ground. None here.
     world.getDispatchInfo().m_allowedCcdPenetration = 0.0f;
-    add_box({-20, -1, -20}, {20, 0, 20});  // the ground, top at y = 0
+    add_box({-20, -1, -20}, {20, 0, 20});   // the ground, top at y = 0
     for (int step = 0; step < 6; ++step) {  // each riser 0.15 m, each tread 0.35 m
       const float z = 3.0f + 0.35f * static_cast<float>(step);
       add_box({-20, 0, z}, {20, 0.15f * static_cast<float>(step + 1), 20});
@@ -123,8 +123,8 @@ std::unique_ptr<Character> spawn(Level& level, mm::Controller controller, float 
   c->ghost = std::make_unique<btPairCachingGhostObject>();
   c->ghost->setCollisionShape(c->shape.get());
   c->ghost->setCollisionFlags(btCollisionObject::CF_CHARACTER_OBJECT);
-  c->physics = std::make_unique<btKinematicCharacterController>(
-      c->ghost.get(), c->shape.get(), kStepHeight, btVector3(0, 1, 0));
+  c->physics = std::make_unique<btKinematicCharacterController>(c->ghost.get(), c->shape.get(),
+                                                                kStepHeight, btVector3(0, 1, 0));
   c->physics->setGravity(btVector3(0, -9.81f, 0));
   // After the controller is made: its constructor turns the ghost from Bullet's default up axis
   // (Z) to Y, which would lay the capsule on its side.
@@ -204,8 +204,8 @@ int main(int argc, char** argv) {
   for (size_t i = 0; i < crowd.size(); ++i) {
     const glm::dvec3 feet = crowd[i]->feet();
     const float ground = level.ground_under(static_cast<float>(feet.x), static_cast<float>(feet.z));
-    std::printf("character %zu: x=%.3f y=%.3f z=%.3f ground=%.3f highest=%.3f\n", i, feet.x,
-                feet.y, feet.z, static_cast<double>(ground), static_cast<double>(crowd[i]->highest));
+    std::printf("character %zu: x=%.3f y=%.3f z=%.3f ground=%.3f highest=%.3f\n", i, feet.x, feet.y,
+                feet.z, static_cast<double>(ground), static_cast<double>(crowd[i]->highest));
   }
   std::printf("summary: %d characters, %d frames at 60 Hz\n", characters, frames);
   return 0;
