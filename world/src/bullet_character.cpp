@@ -79,6 +79,8 @@ Result<BulletCharacters> BulletCharacters::create(const Level& level) {
   auto state = std::make_unique<State>();
   state->origin = level.origin;
   state->broadphase.getOverlappingPairCache()->setInternalGhostPairCallback(&state->ghost_pairs);
+  // The character controller's sweeps allow this much penetration: by default the capsule would
+  // rest that deep in the ground and stop that deep in walls.
   state->world.getDispatchInfo().m_allowedCcdPenetration = 0.0f;
   state->mesh.build(level);
   state->mesh_object = std::make_unique<btCollisionObject>();

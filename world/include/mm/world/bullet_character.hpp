@@ -8,14 +8,15 @@
 // library: nothing here names it.
 //
 // What Bullet's controller does with a move (and so what a game using it gets): the capsule
-// slides along walls, climbs steps up to step_height (and a slope up to max_slope), and falls
-// under gravity where there is no ground; it is never pushed into the geometry. It keeps a
-// small gap over the ground (its collision margin and a skin): feet() is the bottom of the
-// capsule, so a character stood on it floats by that gap (tests/world/bullet_character_test.cpp
-// measures it).
+// slides along walls, climbs steps up to step_height (and slopes up to max_slope), and falls
+// under gravity where there is no ground. It stops at a wall to within a few millimetres, either
+// side of the contact. With the dispatcher's allowed CCD penetration set to 0 here (Bullet's
+// default, 4 cm, lets the capsule rest that deep in the ground and walls), feet() stands on the
+// surface, and over a step's edge on its rounded bottom (tests/world/bullet_character_test.cpp
+// checks both).
 //
-// Frame: world positions in double; the geometry and the capsules are held in float relative to
-// the level's origin, so a level far from the world origin is as exact as one near it.
+// Frame: world positions in double, converted once to the float frame of the level's origin,
+// where the geometry and the capsules are held.
 // Not thread safe: one thread moves every capsule of one BulletCharacters.
 
 #include <cstddef>
