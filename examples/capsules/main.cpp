@@ -27,9 +27,11 @@
 #include <BulletDynamics/Character/btKinematicCharacterController.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
+#include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -39,6 +41,14 @@
 #include "mm/database/database_file.hpp"
 
 namespace {
+
+// Reads a whole command-line argument as a number; false on anything else ("12abc", "").
+template <class T>
+bool parse_number(std::string_view text, T& value) {
+  const char* end = text.data() + text.size();
+  const auto [last, error] = std::from_chars(text.data(), end, value);
+  return error == std::errc() && last == end;
+}
 
 constexpr float kRadius = 0.3f;  // the capsule: mm's ControllerSettings defaults
 constexpr float kHeight = 1.7f;
@@ -165,10 +175,15 @@ int main(int argc, char** argv) {
     std::fputs("usage: mm-capsules-example DATABASE.mmdb [characters=8] [seconds=8]\n", stderr);
     return 2;
   }
-  const int characters = argc > 2 ? std::atoi(argv[2]) : 8;
-  const float seconds = argc > 3 ? static_cast<float>(std::atof(argv[3])) : 8.0f;
-  if (characters < 1 || characters > 1000 || !(seconds > 0.0f && seconds <= 600.0f)) {
-    std::fputs("mm-capsules-example: characters in [1, 1000], seconds in (0, 600]\n", stderr);
+  int characters = 8;
+  float seconds = 8.0f;
+  if ((argc > 2 && !parse_number(argv[2], characters)) ||
+      (argc > 3 && !parse_number(argv[3], seconds)) || characters < 1 || characters > 1000 ||
+      !(seconds > 0.0f && seconds <= 600.0f)) {
+    std::fputs(
+        "mm-capsules-example: characters is a whole number in [1, 1000], seconds a number "
+        "in (0, 600]\n",
+        stderr);
     return 2;
   }
   mm::Result<mm::Database> database = mm::load_database(argv[1]);
