@@ -4,6 +4,7 @@
 #include <exception>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +20,8 @@
 #include "mm/offline/joint_map.hpp"
 #include "mm/programs/evaluation.hpp"
 #include "mm/programs/evaluation_json.hpp"
+#include "mm/world/bullet_world.hpp"
+#include "mm/world/level.hpp"
 
 namespace mm::python {
 namespace {
@@ -137,6 +140,17 @@ InputScript load_script(const std::filesystem::path& path) {
   return std::move(script).value();
 }
 
+// The level at `path` as a Bullet world (mm eval --world); a bad file raises (FileNotFoundError
+// when it does not exist, else mm.LibraryError with the loader's message).
+std::optional<BulletWorld> open_world(const std::optional<std::filesystem::path>& path) {
+  if (!path) return std::nullopt;
+  Result<Level> level = load_level(*path);
+  if (!level) raise_for_file(level.message(), *path);
+  Result<BulletWorld> made = BulletWorld::create(*level);
+  if (!made) throw LibraryError(made.message());
+  return std::move(made).value();
+}
+
 // Runs the script; every failure raises.
 EvaluationResult run(DatabaseHandle& database, const InputScript& script,
                      const EvaluationOptions& options) {
@@ -216,9 +230,13 @@ struct RunColumns {
 
 py::dict run_script(const std::shared_ptr<DatabaseHandle>& database,
                     const std::filesystem::path& script_path, float dt, bool ik, float seconds,
-                    std::pair<double, double> start, const py::kwargs& settings) {
+                    std::pair<double, double> start,
+                    const std::optional<std::filesystem::path>& world_path,
+                    const py::kwargs& settings) {
   EvaluationOptions options = run_options(dt, ik, seconds, start, settings);
   const InputScript script = load_script(script_path);
+  const std::optional<BulletWorld> world = open_world(world_path);
+  if (world) options.world = &*world;
   RunColumns columns;
   columns.joints = static_cast<size_t>(database->database->joint_count());
   options.on_frame = [&columns](const EvaluationFrame& frame) { columns.add(frame); };
@@ -228,13 +246,17 @@ py::dict run_script(const std::shared_ptr<DatabaseHandle>& database,
 
 py::object evaluate(const std::shared_ptr<DatabaseHandle>& database,
                     const std::filesystem::path& script_path, float dt, bool ik, float seconds,
-                    std::pair<double, double> start, const py::kwargs& settings) {
-  const EvaluationOptions options = run_options(dt, ik, seconds, start, settings);
+                    std::pair<double, double> start,
+                    const std::optional<std::filesystem::path>& world_path,
+                    const py::kwargs& settings) {
+  EvaluationOptions options = run_options(dt, ik, seconds, start, settings);
   const InputScript script = load_script(script_path);
+  const std::optional<BulletWorld> world = open_world(world_path);
+  if (world) options.world = &*world;
   const EvaluationResult result = run(*database, script, options);
-  const std::string json =
-      evaluation_run_json(result.metrics, script_path.string(), options).dump();
-  return py::module_::import("json").attr("loads")(json);
+  nlohmann::json json = evaluation_run_json(result.metrics, script_path.string(), options);
+  if (world_path) json["world"] = world_path->string();  // as mm eval --json names it
+  return py::module_::import("json").attr("loads")(json.dump());
 }
 
 }  // namespace
@@ -251,8 +273,9 @@ void bind_runs(py::module_& m) {
         "build_report.");
   m.def("run_script", &run_script, py::arg("database"), py::arg("script"),
         py::arg("dt") = kDefaultRunDt, py::arg("ik") = true, py::arg("seconds") = 0.0f,
-        py::arg("start") = std::pair<double, double>{0.0, 0.0},
-        "Runs one controller on a script (mm eval's run; settings as keyword arguments) and "
+        py::arg("start") = std::pair<double, double>{0.0, 0.0}, py::arg("world") = py::none(),
+        "Runs one controller on a script (mm eval's run; world: a level file, .gltf or .glb, "
+        "as mm eval --world; settings as keyword arguments) and "
         "returns every frame as numpy arrays: t (frames,), positions (frames, joints, 3) world "
         "metres, root and simulation (frames, 3) with root_yaw_deg and simulation_yaw_deg, "
         "desired_velocity (frames, 3) and desired_yaw_deg, transition (frames,) and contacts "
@@ -260,9 +283,9 @@ void bind_runs(py::module_& m) {
         "wall_depth (frames,) metres and stuck (frames,) bool: the columns of mm eval --dump.");
   m.def("evaluate", &evaluate, py::arg("database"), py::arg("script"),
         py::arg("dt") = kDefaultRunDt, py::arg("ik") = true, py::arg("seconds") = 0.0f,
-        py::arg("start") = std::pair<double, double>{0.0, 0.0},
-        "Runs one controller on a script and returns its metrics: the keys and values of mm "
-        "eval --json.");
+        py::arg("start") = std::pair<double, double>{0.0, 0.0}, py::arg("world") = py::none(),
+        "Runs one controller on a script (world: a level file, as mm eval --world) and returns "
+        "its metrics: the keys and values of mm eval --json.");
 }
 
 }  // namespace mm::python

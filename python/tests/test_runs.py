@@ -145,3 +145,38 @@ def test_build_database_tags_map_and_warnings(shared_dir, tmp_path):
         mm.build_database(clips, tmp_path / "u.mmdb", idle=0, map=joint_map)
     with pytest.raises(FileNotFoundError, match="nothing.bvh"):
         mm.build_database([folder / "nothing.bvh"], tmp_path / "v.mmdb")
+
+
+def test_a_run_in_a_level_equals_the_command_line_and_stops_at_its_wall(
+        database, database_path, mm_tool, scripts_dir, source_dir, tmp_path):
+    script = scripts_dir / "course-walk.txt"
+    level = source_dir / "data" / "levels" / "course.glb"
+    # The head-on wall's lane: its face across the lane at z = 8 (docs/world-levels.md).
+    dump, cli = _mm_eval(mm_tool, database_path, script, tmp_path, "--world", str(level),
+                         "--start", "17.5,0")
+    metrics = mm.evaluate(database, script, world=level, start=(17.5, 0.0))
+    assert set(metrics) == set(cli)
+    for key, value in cli.items():
+        if key not in TIMINGS:
+            assert metrics[key] == value, key
+    assert metrics["world"] == str(level)
+    run = mm.run_script(database, script, world=level, start=(17.5, 0.0))
+    close = dict(atol=6e-6, rtol=0)
+    np.testing.assert_allclose(run["simulation"][:, 2], dump["sim_z"], **close)
+    np.testing.assert_allclose(run["wall_depth"], dump["wall_depth"], **close)
+    # The wall stopped the simulation a capsule's radius (0.3 m) before it; without the level
+    # the same script walks on through z = 8.
+    assert run["simulation"][:, 2].max() < 8.0 - 0.29
+    flat = mm.run_script(database, script, start=(17.5, 0.0))
+    assert flat["simulation"][:, 2].max() > 9.0
+
+
+def test_a_bad_level_raises_with_its_message(database, scripts_dir, tmp_path):
+    script = scripts_dir / "course-walk.txt"
+    with pytest.raises(FileNotFoundError, match="missing.glb"):
+        mm.evaluate(database, script, world=tmp_path / "missing.glb")
+    not_gltf = tmp_path / "level.gltf"
+    not_gltf.write_text("this is not glTF")
+    with pytest.raises(mm.Error) as raised:
+        mm.run_script(database, script, world=not_gltf)
+    assert str(raised.value).startswith(str(not_gltf))

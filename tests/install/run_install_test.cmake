@@ -8,11 +8,15 @@
 #   5. run:       the example with that database, 100 characters, 2 s
 #   6. check:     exactly one "character N:" line for each N in 0..99, every number finite, and
 #                 more than half of the characters moved more than 0.1 m from their start.
+#   7. capsules:  examples/capsules (configured and built in step 3, against the game component
+#                 alone) run with the same database, 8 characters, 8 s: each capsule Bullet moved
+#                 ends on the level's surface (within 2 cm of the ground under it), climbed the
+#                 0.9 m stairs and stopped at the wall (z <= 7.7 + 5 mm).
 # Any failure ends in message(FATAL_ERROR) naming the step.
 cmake_minimum_required(VERSION 3.25)  # this script's policies (IN_LIST), as the project's
 
-foreach(var MM_BUILD_DIR MM_EXAMPLE_SOURCE_DIR MM_WORK_DIR MM_DATA_DIR MM_GENERATOR
-            MM_CXX_COMPILER)
+foreach(var MM_BUILD_DIR MM_EXAMPLE_SOURCE_DIR MM_CAPSULES_SOURCE_DIR MM_WORK_DIR MM_DATA_DIR
+            MM_GENERATOR MM_CXX_COMPILER)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
     message(FATAL_ERROR "install_example: -D${var}=... is required")
   endif()
@@ -20,6 +24,7 @@ endforeach()
 
 set(prefix "${MM_WORK_DIR}/prefix")
 set(example_build "${MM_WORK_DIR}/example-build")
+set(capsules_build "${MM_WORK_DIR}/capsules-build")
 set(database "${MM_WORK_DIR}/crowd.mmdb")
 set(characters 100)
 set(seconds 2)
@@ -38,7 +43,7 @@ function(run_step step)
 endfunction()
 
 # ---- 1. install into a fresh prefix, so nothing left from an earlier run can make it pass.
-file(REMOVE_RECURSE "${prefix}" "${example_build}" "${database}")
+file(REMOVE_RECURSE "${prefix}" "${example_build}" "${capsules_build}" "${database}")
 # What a game links alone: the example must configure and build against the game component with
 # nothing of the offline side (or the programs) present.
 run_step(install "${CMAKE_COMMAND}" --install "${MM_BUILD_DIR}" --prefix "${prefix}"
@@ -58,7 +63,7 @@ foreach(file IN LISTS game_files)
 endforeach()
 
 set(configure_args
-    -S "${MM_EXAMPLE_SOURCE_DIR}" -B "${example_build}" -G "${MM_GENERATOR}"
+    -G "${MM_GENERATOR}"
     "-DCMAKE_CXX_COMPILER=${MM_CXX_COMPILER}"
     -DCMAKE_BUILD_TYPE=Release
     "-DCMAKE_PREFIX_PATH=${prefix}"
@@ -69,7 +74,8 @@ set(configure_args
 if(MM_MAKE_PROGRAM)
   list(APPEND configure_args "-DCMAKE_MAKE_PROGRAM=${MM_MAKE_PROGRAM}")
 endif()
-run_step(configure "${CMAKE_COMMAND}" ${configure_args})
+run_step(configure "${CMAKE_COMMAND}" -S "${MM_EXAMPLE_SOURCE_DIR}" -B "${example_build}"
+         ${configure_args})
 file(STRINGS "${example_build}/CMakeCache.txt" mm_dir_line REGEX "^mm_DIR:")
 string(REGEX REPLACE "^mm_DIR:[A-Z]+=" "" mm_dir "${mm_dir_line}")
 file(REAL_PATH "${prefix}" real_prefix)
@@ -88,6 +94,11 @@ set(example "${example_build}/mm-crowd-example")
 if(NOT EXISTS "${example}")
   message(FATAL_ERROR "install_example: step 'build' made no ${example}")
 endif()
+# The second example, against the game component alone too: Bullet is its own dependency.
+run_step(configure-capsules "${CMAKE_COMMAND}" -S "${MM_CAPSULES_SOURCE_DIR}" -B "${capsules_build}"
+         ${configure_args})
+run_step(build-capsules "${CMAKE_COMMAND}" --build "${capsules_build}")
+set(capsules "${capsules_build}/mm-capsules-example")
 
 # The rest (the offline component and the programs): `mm build` makes the example's database,
 # and the offline component is found when asked for.
@@ -162,4 +173,33 @@ endif()
 if(NOT output MATCHES "\nsummary: [^\n]*\n?$")
   message(FATAL_ERROR "install_example: step 'check': no summary line at the end")
 endif()
-message(STATUS "install_example: passed (${moved} of ${characters} characters moved)")
+
+# ---- 7. the capsules example: each capsule on the surface, up the stairs, stopped at the wall.
+set(capsule_count 8)
+run_step(run-capsules "${capsules}" "${database}" ${capsule_count} 8)
+set(output "${step_output}")
+message(STATUS "install_example: the capsules example printed:\n${output}")
+string(REGEX MATCHALL "character [0-9]+:[^\n]*" lines "${output}")
+list(LENGTH lines line_count)
+if(NOT line_count EQUAL capsule_count)
+  message(FATAL_ERROR "install_example: step 'capsules': ${line_count} \"character N:\" lines, "
+                      "expected ${capsule_count}")
+endif()
+string(CONCAT line_regex "^character [0-9]+: x=${num} y=${num} z=${num} ground=${num} "
+                         "highest=${num}$")
+foreach(line IN LISTS lines)
+  if(NOT line MATCHES "${line_regex}")
+    message(FATAL_ERROR "install_example: step 'capsules': unexpected or non-finite line: ${line}")
+  endif()
+  foreach(n 2 3 4 5)  # millimetres as integers
+    string(REPLACE "." "" mm_${n} "${CMAKE_MATCH_${n}}")
+  endforeach()
+  math(EXPR above "${mm_2} - (${mm_4})")
+  if(above LESS -10 OR above GREATER 20 OR mm_5 LESS 850 OR mm_3 GREATER 7705)
+    message(FATAL_ERROR "install_example: step 'capsules': not on the landing at the wall "
+                        "(within 2 cm of the ground, up the 0.9 m stairs, z <= 7.705): ${line}")
+  endif()
+endforeach()
+
+message(STATUS "install_example: passed (${moved} of ${characters} characters moved; "
+               "${capsule_count} capsules up the stairs and at the wall)")

@@ -391,3 +391,86 @@ TEST(RunPlotPng, UnwritablePathIsAnErrorNamingIt) {
 
 }  // namespace
 }  // namespace mm::viewer
+
+namespace mm::viewer {
+namespace {
+
+// A 4 m floor (two triangles) and on it a 1 m box 0.2 m high, x and z in [0, 1], each face with
+// its own vertices, as exporters write them.
+struct OutlineLevel {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  void quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+    const uint32_t first = static_cast<uint32_t>(positions.size());
+    positions.insert(positions.end(), {a, b, c, d});
+    indices.insert(indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
+  }
+  OutlineLevel() {
+    quad({-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2});
+    const float h = 0.2f;
+    quad({0, h, 0}, {0, h, 1}, {1, h, 1}, {1, h, 0});  // top
+    quad({0, 0, 0}, {0, h, 0}, {1, h, 0}, {1, 0, 0});  // the four sides
+    quad({1, 0, 0}, {1, h, 0}, {1, h, 1}, {1, 0, 1});
+    quad({1, 0, 1}, {1, h, 1}, {0, h, 1}, {0, 0, 1});
+    quad({0, 0, 1}, {0, h, 1}, {0, h, 0}, {0, 0, 0});
+  }
+};
+
+bool on_line(const OutlineSegment& s, int axis, float value) {
+  return std::abs(s.a[axis] - value) < 1e-6f && std::abs(s.b[axis] - value) < 1e-6f;
+}
+
+TEST(RunPlot, TheLevelOutlineIsTheBordersAndFoldsSeenFromAbove) {
+  const OutlineLevel level;
+  const std::vector<OutlineSegment> outline = level_outline(level.positions, level.indices);
+  int floor_border = 0, box_top = 0, box_foot = 0;
+  for (const OutlineSegment& s : outline) {
+    // Nothing seen end-on (the box's vertical edges), nothing across a flat face (the
+    // diagonals of the floor and the box's top and sides).
+    ASSERT_TRUE(s.a.x != s.b.x || s.a.z != s.b.z);
+    ASSERT_TRUE(s.a.x == s.b.x || s.a.z == s.b.z) << "a diagonal";
+    const bool box_line =
+        on_line(s, 0, 0.0f) || on_line(s, 0, 1.0f) || on_line(s, 2, 0.0f) || on_line(s, 2, 1.0f);
+    if (on_line(s, 0, -2.0f) || on_line(s, 0, 2.0f) || on_line(s, 2, -2.0f) ||
+        on_line(s, 2, 2.0f)) {
+      ++floor_border;
+    } else if (box_line && s.a.y == 0.2f) {
+      ++box_top;  // the top's edges, where it folds down into the sides
+    } else if (box_line && s.a.y == 0.0f) {
+      ++box_foot;  // the sides' open bottom edges
+    } else {
+      ADD_FAILURE() << "unexpected segment (" << s.a.x << ", " << s.a.z << ") - (" << s.b.x << ", "
+                    << s.b.z << ")";
+    }
+  }
+  EXPECT_EQ(floor_border, 4);
+  EXPECT_EQ(box_top, 4);
+  EXPECT_EQ(box_foot, 4);
+  // A crease wider than the box's fold leaves only the borders (the floor's and the box's foot).
+  EXPECT_EQ(level_outline(level.positions, level.indices, 95.0f).size(), 8u);
+  // Bad triangles are skipped, not read.
+  const std::vector<uint32_t> out_of_range = {0, 1, 99};
+  EXPECT_TRUE(level_outline(level.positions, out_of_range).empty());
+}
+
+TEST(RunPlot, TheLevelOutlineIsDrawnUnderTheRunAndNamedInTheLegend) {
+  const std::vector<RunSample> run = synthetic_run({{2.0f, 1.0f, 0.0f}}, {-1, 0, 0.5f});
+  const OutlineLevel level;
+  const std::vector<OutlineSegment> outline = level_outline(level.positions, level.indices);
+  const RunPlotOptions o;
+  const Image with = render_run_plot(run, o, outline);
+  const Image without = render_run_plot(run, o);
+  const RunPlotView view = run_plot_view(run, o, outline);
+  // The box's side at z = 0 (x from 0 to 1), beside the run along z = 0.5, is drawn where the
+  // view puts it.
+  for (float x : {0.25f, 0.5f, 0.75f}) {
+    EXPECT_TRUE(near_colour(with, view.to_pixel({x, 0.0f, 0.0f}), o.outline, 1)) << x;
+  }
+  EXPECT_TRUE(pixels_of(without, o.outline, 0, without.height).empty());
+  // In the legend: an item more (its anti-aliased glyph never takes the exact colour).
+  const size_t band = static_cast<size_t>(view.legend_top) * with.width * 3;
+  EXPECT_FALSE(std::equal(with.rgb.begin() + band, with.rgb.end(), without.rgb.begin() + band));
+}
+
+}  // namespace
+}  // namespace mm::viewer

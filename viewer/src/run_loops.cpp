@@ -135,7 +135,12 @@ void print_character_box(const Stage& stage, const Scene& scene) {
 
 Status write_plot(const ViewerOptions& options, const Scene& scene) {
   if (options.plot_path.empty()) return Status::success();
-  if (Status s = write_png(render_run_plot(scene.run()), options.plot_path); !s) return s;
+  // In a level, its outline under the run: the steps, ramps and walls the run met.
+  const std::vector<OutlineSegment> outline =
+      level_outline(scene.level_positions(), scene.level_indices());
+  if (Status s = write_png(render_run_plot(scene.run(), {}, outline), options.plot_path); !s) {
+    return s;
+  }
   std::printf("wrote the run plot %s\n", options.plot_path.c_str());
   return Status::success();
 }

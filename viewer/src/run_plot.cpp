@@ -1,11 +1,14 @@
 #include "run_plot.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <string>
 
 // Debian's libstb compiles the stb implementations into libstb.so, which PkgConfig::STB links:
@@ -32,6 +35,8 @@ RunPlotOptions sanitized(RunPlotOptions o) {
   if (!finite(o.character_width)) o.character_width = 5.0f;
   o.simulation_width = std::clamp(o.simulation_width, 0.5f, 50.0f);
   o.character_width = std::clamp(o.character_width, 0.5f, 50.0f);
+  if (!finite(o.outline_width)) o.outline_width = 1.5f;
+  o.outline_width = std::clamp(o.outline_width, 0.5f, 50.0f);
   return o;
 }
 
@@ -185,6 +190,7 @@ void mark_end(Image& image, glm::vec2 at, const RunPlotOptions& o) {
 // scale bar and a summary line; the legend's items flow over the rows below it.
 
 enum class Mark {
+  Outline,
   Axes,
   Simulation,
   Character,
@@ -202,7 +208,7 @@ struct LegendItem {
   std::string label;
 };
 
-std::vector<LegendItem> legend_items(const RunPlotOptions& o) {
+std::vector<LegendItem> legend_items(const RunPlotOptions& o, bool outline) {
   char facing[64];
   std::snprintf(facing, sizeof facing, "facing (every %g s)",
                 static_cast<double>(o.facing_tick_interval));
@@ -217,6 +223,7 @@ std::vector<LegendItem> legend_items(const RunPlotOptions& o) {
                                    {Mark::End, "end"},
                                    {Mark::Axes, "+X, +Z (seen from above)"}};
   if (o.facing_tick_interval == 0.0f) items.erase(items.begin() + 3);  // no facing marks drawn
+  if (outline) items.insert(items.begin(), {Mark::Outline, "level outline"});
   return items;
 }
 
@@ -293,9 +300,10 @@ RunPlotView make_view(std::span<const RunSample> samples, const RunPlotOptions& 
 
 }  // namespace
 
-RunPlotView run_plot_view(std::span<const RunSample> samples, const RunPlotOptions& options) {
+RunPlotView run_plot_view(std::span<const RunSample> samples, const RunPlotOptions& options,
+                          std::span<const OutlineSegment> outline) {
   const RunPlotOptions o = sanitized(options);
-  return make_view(samples, o, layout(o, legend_items(o)));
+  return make_view(samples, o, layout(o, legend_items(o, !outline.empty())));
 }
 
 namespace {
@@ -419,6 +427,39 @@ void draw_events(Image& image, const RunPlotView& view, std::span<const RunSampl
   }
 }
 
+// The level's outline, cut to the image (a segment across a level far larger than the run would
+// otherwise cost a pass over its whole bounding box for nothing).
+void draw_outline(Image& image, const RunPlotView& view, std::span<const OutlineSegment> outline,
+                  const RunPlotOptions& o) {
+  const glm::dvec2 lo(-o.outline_width - 2.0),
+      hi(image.width + o.outline_width + 2.0, image.height + o.outline_width + 2.0);
+  for (const OutlineSegment& segment : outline) {
+    if (!finite(segment.a) || !finite(segment.b)) continue;
+    glm::dvec2 a = view.to_pixel(segment.a), b = view.to_pixel(segment.b);
+    // Liang-Barsky: the part of a-b inside [lo, hi].
+    double t0 = 0.0, t1 = 1.0;
+    const glm::dvec2 d = b - a;
+    bool inside = true;
+    for (int axis = 0; axis < 2 && inside; ++axis) {
+      const double p[2] = {-d[axis], d[axis]};
+      const double q[2] = {a[axis] - lo[axis], hi[axis] - a[axis]};
+      for (int k = 0; k < 2; ++k) {
+        if (p[k] == 0.0) {
+          if (q[k] < 0.0) inside = false;
+        } else if (const double t = q[k] / p[k]; p[k] < 0.0) {
+          t0 = std::max(t0, t);
+        } else {
+          t1 = std::min(t1, t);
+        }
+      }
+    }
+    if (!inside || t0 > t1) continue;
+    b = a + t1 * d;
+    a = a + t0 * d;
+    draw_segment(image, glm::vec2(a), glm::vec2(b), o.outline_width, o.outline);
+  }
+}
+
 void draw_start_end(Image& image, const RunPlotView& view, std::span<const RunSample> samples,
                     const RunPlotOptions& o) {
   const auto has_position = [](const RunSample& s) { return finite(s.character); };
@@ -459,6 +500,9 @@ void draw_legend_glyph(Image& image, Mark mark, glm::vec2 left, float width,
   const glm::vec2 centre = left + glm::vec2(0.5f * width, 0.0f);
   const glm::vec2 right = left + glm::vec2(width, 0.0f);
   switch (mark) {
+    case Mark::Outline:
+      draw_segment(image, left, right, o.outline_width, o.outline);
+      break;
     case Mark::Simulation:
       draw_segment(image, left, right, o.simulation_width, o.simulation);
       break;
@@ -532,9 +576,10 @@ void draw_legend(Image& image, const RunPlotView& view, std::span<const RunSampl
 
 }  // namespace
 
-Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& options) {
+Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& options,
+                      std::span<const OutlineSegment> outline) {
   const RunPlotOptions o = sanitized(options);
-  const std::vector<LegendItem> items = legend_items(o);
+  const std::vector<LegendItem> items = legend_items(o, !outline.empty());
   const Layout l = layout(o, items);
   const RunPlotView view = make_view(samples, o, l);
   Image image{o.width, o.height, {}};
@@ -542,6 +587,11 @@ Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& 
   fill_rect(image, 0, 0, o.width, o.height, o.background);
   const int grid_bottom = l.legend_top - 2 * o.text_scale;
   draw_grid(image, view, o, grid_bottom);
+  if (!outline.empty()) {
+    draw_outline(image, view, outline, o);
+    // What of it reached below the plot is cleared for the legend.
+    fill_rect(image, 0, grid_bottom, o.width, o.height, o.background);
+  }
   fill_rect(image, 0, grid_bottom, o.width, grid_bottom + 1, o.text);  // separates the legend
   glm::dvec2 lo, hi;
   if (run_bounds(samples, lo, hi)) {
@@ -556,6 +606,68 @@ Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& 
   }
   draw_legend(image, view, samples, o, l, items);
   return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The level's outline.
+
+namespace {
+
+// A position rounded to whole millimetres: where two triangles' edges meet.
+using Key = std::array<int64_t, 3>;
+
+Key key_of(const glm::vec3& p) {
+  return {static_cast<int64_t>(std::llround(static_cast<double>(p.x) * 1000.0)),
+          static_cast<int64_t>(std::llround(static_cast<double>(p.y) * 1000.0)),
+          static_cast<int64_t>(std::llround(static_cast<double>(p.z) * 1000.0))};
+}
+
+struct Edge {
+  glm::vec3 a{0.0f}, b{0.0f};
+  glm::vec3 first_normal{0.0f};
+  int triangles = 0;
+  bool folds = false;  // a triangle after the first meets the first at more than the crease
+};
+
+}  // namespace
+
+std::vector<OutlineSegment> level_outline(std::span<const glm::vec3> positions,
+                                          std::span<const uint32_t> indices, float crease_degrees) {
+  const float min_cos = std::cos(glm::radians(std::clamp(crease_degrees, 0.0f, 180.0f)));
+  std::map<std::pair<Key, Key>, Edge> edges;
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    if (indices[t] >= positions.size() || indices[t + 1] >= positions.size() ||
+        indices[t + 2] >= positions.size()) {
+      continue;
+    }
+    const glm::vec3 v[3] = {positions[indices[t]], positions[indices[t + 1]],
+                            positions[indices[t + 2]]};
+    if (!finite(v[0]) || !finite(v[1]) || !finite(v[2])) continue;
+    const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
+    if (!(glm::length(cross) > 0.0f)) continue;
+    const glm::vec3 normal = glm::normalize(cross);
+    for (int e = 0; e < 3; ++e) {
+      glm::vec3 a = v[e], b = v[(e + 1) % 3];
+      Key ka = key_of(a), kb = key_of(b);
+      if (kb < ka) std::swap(ka, kb), std::swap(a, b);
+      if (ka == kb) continue;
+      Edge& edge = edges[{ka, kb}];
+      if (edge.triangles == 0) {
+        edge.a = a, edge.b = b, edge.first_normal = normal;
+      } else if (std::abs(glm::dot(edge.first_normal, normal)) < min_cos) {
+        // Either winding: a level's faces need not agree on it.
+        edge.folds = true;
+      }
+      ++edge.triangles;
+    }
+  }
+  std::vector<OutlineSegment> outline;
+  for (const auto& [key, edge] : edges) {
+    if (edge.triangles != 1 && !edge.folds) continue;
+    if (key.first[0] == key.second[0] && key.first[2] == key.second[2]) continue;  // end-on
+    outline.push_back({edge.a, edge.b});
+  }
+  return outline;
 }
 
 // ---------------------------------------------------------------------------------------------

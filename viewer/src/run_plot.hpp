@@ -15,6 +15,8 @@
 //   sample's path point); paths join the finite points on either side.
 // - An empty run, or one with no finite position, is not an error: it renders a valid image
 //   (background, grid, scale bar, legend) with the words "no finite samples" instead of paths.
+// - A level's outline (level_outline), when given, is drawn under the run in grey and named in
+//   the legend; the view still frames the run, and the outline is cut at the plot's edges.
 
 #include <filesystem>
 #include <span>
@@ -62,7 +64,26 @@ struct RunPlotOptions {
   Rgb toe[2]{{0, 165, 190}, {225, 60, 170}};  // left, right toe contact marks
   Rgb start{20, 150, 60};                     // the first position
   Rgb end{20, 20, 20};                        // the last position
+  Rgb outline{135, 135, 135};                 // the level's outline
+  float outline_width = 1.5f;
 };
+
+// A segment of a level's outline, world space (Y ignored).
+struct OutlineSegment {
+  glm::vec3 a{0.0f};
+  glm::vec3 b{0.0f};
+};
+
+// A level's outline seen from above: every triangle edge that borders no other triangle, or
+// where the surface folds by more than `crease_degrees` (a step's nosing and foot, a ramp's foot
+// and top, a wall's and a box's footprint), so that the flat ground and gentle bumps stay blank.
+// Triangles meet where their edges' end points agree to 1 mm (levels often repeat a vertex per
+// face). Edges seen end-on from above are left out; so are triangles with an index out of range
+// or a position that is not finite, and degenerate ones. World positions, three indices a
+// triangle.
+std::vector<OutlineSegment> level_outline(std::span<const glm::vec3> positions,
+                                          std::span<const uint32_t> indices,
+                                          float crease_degrees = 8.0f);
 
 inline constexpr int kMinRunPlotSize = 200;
 inline constexpr int kMaxRunPlotSize = 8192;
@@ -84,10 +105,13 @@ struct RunPlotView {
 };
 
 // The view render_run_plot uses for these samples and options.
-RunPlotView run_plot_view(std::span<const RunSample> samples, const RunPlotOptions& options = {});
+RunPlotView run_plot_view(std::span<const RunSample> samples, const RunPlotOptions& options = {},
+                          std::span<const OutlineSegment> outline = {});
 
-// Renders the run into an image of options.width x options.height (after clamping).
-Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& options = {});
+// Renders the run into an image of options.width x options.height (after clamping), over the
+// level's outline when one is given.
+Image render_run_plot(std::span<const RunSample> samples, const RunPlotOptions& options = {},
+                      std::span<const OutlineSegment> outline = {});
 
 // Writes the image as an 8-bit RGB PNG. Fails with a message naming the path when the image is
 // malformed or the file cannot be written.

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "debug_drawing.hpp"
@@ -70,6 +71,9 @@ class Scene {
   // triangle). The character is placed on its ground where it stands.
   void set_level(const WorldQueries* world, std::vector<glm::vec3> positions,
                  std::vector<uint32_t> indices);
+  // The level's triangles (empty without one): world positions, three indices a triangle.
+  std::span<const glm::vec3> level_positions() const { return level_positions_; }
+  std::span<const uint32_t> level_indices() const { return level_indices_; }
 
  private:
   explicit Scene(SkinnedMesh body) : body_(std::move(body)) {}

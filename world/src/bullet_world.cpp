@@ -12,16 +12,11 @@
 #include <utility>
 #include <vector>
 
+#include "level_mesh.hpp"
 #include "mm/runtime/assert.hpp"
 
 namespace mm {
 namespace {
-
-// Triangles per part of Bullet's mesh: its quantized tree keeps a triangle's index in 21 bits
-// of a node (and the part in the 10 above them), so one part holds at most 2^21 triangles;
-// kMaxLevelTriangles takes five parts of this size.
-constexpr size_t kTrianglesPerPart = size_t{1} << 20;
-static_assert(kMaxLevelTriangles / kTrianglesPerPart < 1024, "Bullet's mesh has 10 bits of parts");
 
 // Object bounds are grown by this (m) before a query's bounds are tested against them: the
 // bounds are floats, and a query that only touches an object must not be culled.
@@ -72,12 +67,8 @@ bool overlaps(const Culled& culled, const btVector3& low, const btVector3& high)
 // the broadphase), then the broadphase, and the objects, shapes and arrays it pointed into last.
 struct BulletWorld::State {
   glm::dvec3 origin{0.0};
-  // The level's triangles, owned here: Bullet's mesh interface points into them. State lives on
-  // the heap and never moves, so the pointers stay valid when the BulletWorld moves.
-  std::vector<glm::vec3> positions;
-  std::vector<uint32_t> indices;
-  std::unique_ptr<btTriangleIndexVertexArray> mesh_interface;
-  std::unique_ptr<btBvhTriangleMeshShape> mesh_shape;
+  // The level's triangles and Bullet's mesh over them (State lives on the heap and never moves).
+  LevelMesh mesh;
   std::unique_ptr<btCollisionObject> mesh_object;
   std::vector<std::unique_ptr<btBoxShape>> box_shapes;
   std::vector<std::unique_ptr<btCollisionObject>> box_objects;
@@ -124,29 +115,10 @@ Result<BulletWorld> BulletWorld::create(const Level& level) {
   }
   auto state = std::make_unique<State>();
   state->origin = level.origin;
-  state->positions = level.positions;
-  state->indices = level.indices;
-  const size_t triangles = level.triangle_count();
-  if (triangles > 0) {
-    state->mesh_interface = std::make_unique<btTriangleIndexVertexArray>();
-    for (size_t first = 0; first < triangles; first += kTrianglesPerPart) {
-      btIndexedMesh part;
-      part.m_numTriangles = static_cast<int>(std::min(kTrianglesPerPart, triangles - first));
-      part.m_triangleIndexBase =
-          reinterpret_cast<const unsigned char*>(state->indices.data() + first * 3);
-      part.m_triangleIndexStride = 3 * sizeof(uint32_t);
-      part.m_indexType = PHY_INTEGER;
-      // Every part sees every vertex: the indices are the level's own.
-      part.m_numVertices = static_cast<int>(state->positions.size());
-      part.m_vertexBase = reinterpret_cast<const unsigned char*>(state->positions.data());
-      part.m_vertexStride = sizeof(glm::vec3);
-      part.m_vertexType = PHY_FLOAT;
-      state->mesh_interface->addIndexedMesh(part, PHY_INTEGER);
-    }
-    state->mesh_shape = std::make_unique<btBvhTriangleMeshShape>(
-        state->mesh_interface.get(), /*useQuantizedAabbCompression=*/true, /*buildBvh=*/true);
+  state->mesh.build(level);
+  if (state->mesh.shape) {
     state->mesh_object = std::make_unique<btCollisionObject>();
-    state->mesh_object->setCollisionShape(state->mesh_shape.get());
+    state->mesh_object->setCollisionShape(state->mesh.shape.get());
     state->add(state->mesh_object.get());
   }
   return BulletWorld(std::move(state));
@@ -303,7 +275,7 @@ glm::dvec3 BulletWorld::origin() const {
 }
 
 size_t BulletWorld::triangle_count() const {
-  return state_->indices.size() / 3;
+  return state_->mesh.indices.size() / 3;
 }
 
 size_t BulletWorld::box_count() const {
