@@ -80,6 +80,7 @@ Result<CrowdScheduler> CrowdScheduler::create(size_t characters, size_t joints,
   s.pending_dt_.assign(characters, 0.0f);
   s.update_period_.assign(characters, 1);
   s.blend_weight_.assign(characters, 0.0f);
+  s.shows_last_.assign(characters, 0);
   s.keys_.assign(characters, 0.0f);
   s.order_.resize(characters);
   for (size_t i = 0; i < characters; ++i) s.order_[i] = static_cast<uint32_t>(i);
@@ -226,8 +227,11 @@ void CrowdScheduler::step(size_t i, Controller& controller, float dt,
   const bool at_once = now == Step::Move || crowd_tier_period(t) == 1;
   const bool continues = last_step == now && update_period_[i] == 1;
   const bool blends = at_once && !continues && last_step != Step::None;
-  std::copy(pose_begin(shown_), pose_begin(shown_) + static_cast<std::ptrdiff_t>(joints_),
-            pose_begin(from_));
+  // What is shown now: where a chase starts, or what a blend eases from.
+  if (blends || !at_once) {
+    const std::span<const Transform> shown = pose(i);
+    std::copy(shown.begin(), shown.end(), pose_begin(from_));
+  }
   if (now == Step::Move) {
     controller.update_move_only(pending_dt_[i], input);
   } else {
@@ -263,6 +267,10 @@ void CrowdScheduler::show(size_t i) {
   const std::span<Transform> out(shown_.data() + base, joints_);
   const float s = std::min(
       1.0f, static_cast<float>(held_frames_[i] + 1) / static_cast<float>(update_period_[i]));
+  const float w = blend_weight_[i];
+  // The update's pose as it is: shown from last_ itself, without a copy.
+  shows_last_[i] = s == 1.0f && w == 0.0f;
+  if (shows_last_[i]) return;
   if (s == 1.0f) {
     std::copy(last_.begin() + static_cast<std::ptrdiff_t>(base),
               last_.begin() + static_cast<std::ptrdiff_t>(base + joints_), out.begin());
@@ -276,7 +284,6 @@ void CrowdScheduler::show(size_t i) {
       out[j].scale = b.scale;
     }
   }
-  const float w = blend_weight_[i];
   if (w == 0.0f) return;
   const glm::quat identity(1.0f, 0.0f, 0.0f, 0.0f);
   for (size_t j = 0; j < joints_; ++j) {

@@ -172,8 +172,12 @@ struct ScheduledCrowd {
 Result<ScheduledCrowd> make_scheduled_crowd(
     const std::shared_ptr<const ControllerDatabase>& database, const CrowdOptions& options,
     size_t n, const CrowdSchedulerSettings& settings) {
+  // What a scheduled character shows is the scheduler's pose, not its controller's: skinning
+  // matrices are the renderer's, from that pose.
+  CrowdOptions scheduled = options;
+  scheduled.settings.compute_skinning = false;
   Result<std::vector<Controller>> controllers =
-      make_characters(database, options, options.world, n);
+      make_characters(database, scheduled, options.world, n);
   if (!controllers) return Error{controllers.message()};
   Result<CrowdScheduler> scheduler =
       CrowdScheduler::create(n, database->database().skeleton().joint_count(), settings);
@@ -216,9 +220,11 @@ struct PlanRecord {
   std::vector<double> planned_us;
 };
 
-// The frames of a budgeted run on `threads` threads: planned on thread 0, stepped by all.
+// The frames of a budgeted run on `threads` threads: planned on thread 0 (every character at
+// `all` when given), stepped by all.
 void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, int threads,
-                          CrowdTimes& times, PlanRecord& plans) {
+                          CrowdTimes& times, PlanRecord& plans,
+                          std::optional<CrowdTier> all = std::nullopt) {
   const size_t n = crowd.controllers.size();
   const size_t frames = times.frame_seconds.size();
   std::atomic<size_t> next{0};
@@ -229,7 +235,11 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
     for (size_t f = 0; f < frames; ++f) {
       const float t = static_cast<float>(f + 1) * options.dt;
       if (index == 0) {
-        plan_frame(crowd, options, t);
+        if (all) {
+          crowd.scheduler.plan_all(*all);
+        } else {
+          plan_frame(crowd, options, t);
+        }
         plans.counts[f] = crowd.scheduler.tier_counts();
         plans.planned_us[f] = crowd.scheduler.planned_cost_us();
         next.store(0, std::memory_order_relaxed);
@@ -417,27 +427,26 @@ Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
     int characters) {
   CrowdOptions calibration = options;
   calibration.characters = std::max(1, characters);
-  calibration.seconds = 3.0f;
+  calibration.seconds = 2.0f;
   if (Status valid = check_options(calibration); !valid) return Error{valid.message()};
+  const CrowdSchedulerSettings settings = options.lod ? *options.lod : CrowdSchedulerSettings{};
+  const int threads = std::min(settings.threads, calibration.characters);
   const size_t n = static_cast<size_t>(calibration.characters);
   const size_t frames = clamped_integer<size_t>(std::ceil(calibration.seconds / options.dt));
-  const size_t measured_from = frames / 3;
   std::array<float, kCrowdTierCount> costs{};
   for (int tier = 0; tier < kCrowdTierCount; ++tier) {
-    Result<ScheduledCrowd> crowd = make_scheduled_crowd(
-        database, calibration, n, options.lod ? *options.lod : CrowdSchedulerSettings{});
+    Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, calibration, n, settings);
     if (!crowd) return Error{crowd.message()};
-    double seconds = 0.0, search = 0.0;
-    for (size_t f = 0; f < frames; ++f) {
-      const float t = static_cast<float>(f + 1) * options.dt;
-      crowd->scheduler.plan_all(static_cast<CrowdTier>(tier));
-      for (size_t i = 0; i < n; ++i) {
-        const double elapsed = step_character(*crowd, i, t, options.dt, search);
-        if (f >= measured_from) seconds += elapsed;
-      }
-    }
-    costs[static_cast<size_t>(tier)] =
-        static_cast<float>(seconds * 1e6 / static_cast<double>(n * (frames - measured_from)));
+    CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
+                     std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+    PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
+                     std::vector<double>(frames, 0.0)};
+    run_scheduled_frames(*crowd, calibration, threads, times, plans, static_cast<CrowdTier>(tier));
+    // The second half's frames: thread time per character.
+    double seconds = 0.0;
+    for (size_t f = frames / 2; f < frames; ++f) seconds += times.frame_seconds[f];
+    costs[static_cast<size_t>(tier)] = static_cast<float>(
+        seconds * 1e6 * threads / static_cast<double>(n * (frames - frames / 2)));
   }
   // Timing noise must not make a slower tier look dearer than a faster one.
   for (size_t t = 1; t < costs.size(); ++t) costs[t] = std::min(costs[t], costs[t - 1]);

@@ -39,8 +39,7 @@ struct Arguments {
 // are per character, and a full-rate crowd of the budget's size is many times slower than real
 // time.
 constexpr float kFullRateSecondsBesideBudget = 10.0f;
-// The calibration's and the per-tier quality runs' crowds.
-constexpr int kCalibrationCharacters = 256;
+// The per-tier quality runs' crowd.
 constexpr int kQualityCharacters = 16;
 constexpr float kQualitySeconds = 20.0f;
 
@@ -223,11 +222,11 @@ std::optional<std::array<float, kCrowdTierCount>> tier_costs(
     std::copy(arguments.tier_costs_us.begin(), arguments.tier_costs_us.end(), costs.begin());
     return costs;
   }
-  std::printf("calibrating the cost model (%d characters, 3 s at each tier)...\n",
-              kCalibrationCharacters);
+  std::printf("calibrating the cost model (the crowd, 2 s at each tier on %d threads)...\n",
+              arguments.options.lod->threads);
   std::fflush(stdout);
   Result<std::array<float, kCrowdTierCount>> measured =
-      calibrate_crowd_tiers(shared, arguments.options, kCalibrationCharacters);
+      calibrate_crowd_tiers(shared, arguments.options, arguments.options.characters);
   if (!measured) {
     std::fprintf(stderr, "mm crowd-bench: %s\n", measured.message().c_str());
     return std::nullopt;
@@ -268,12 +267,13 @@ std::optional<nlohmann::json> report_tier_quality(
 // returns whether every run ended with the same poses, or nothing when a run failed.
 std::optional<bool> run_budget(const std::shared_ptr<const ControllerDatabase>& shared,
                                const Arguments& arguments, nlohmann::json& json) {
-  const std::optional<std::array<float, kCrowdTierCount>> costs = tier_costs(shared, arguments);
-  if (!costs) return std::nullopt;
   Arguments budgeted = arguments;
   CrowdSchedulerSettings lod;
   lod.budget_ms = static_cast<float>(arguments.budget_ms);
   lod.threads = std::max(2, arguments.extra_threads);
+  budgeted.options.lod = lod;
+  const std::optional<std::array<float, kCrowdTierCount>> costs = tier_costs(shared, budgeted);
+  if (!costs) return std::nullopt;
   lod.cost_us = *costs;
   budgeted.options.lod = lod;
   if (Status valid = lod.validate(); !valid) {

@@ -101,7 +101,9 @@ class CrowdScheduler {
 
   // What to display for character i: global transforms (as Controller::global_transforms())
   // after this frame's step.
-  std::span<const Transform> pose(size_t i) const { return {shown_.data() + i * joints_, joints_}; }
+  std::span<const Transform> pose(size_t i) const {
+    return {(shows_last_[i] != 0 ? last_ : shown_).data() + i * joints_, joints_};
+  }
   CrowdTier tier(size_t i) const { return static_cast<CrowdTier>(tier_[i]); }
   // Characters per tier in this frame's plan, and the plan's work by the cost model (us).
   const std::array<int, kCrowdTierCount>& tier_counts() const { return counts_; }
@@ -130,6 +132,7 @@ class CrowdScheduler {
   std::vector<float> pending_dt_;       // game time since the last update (s)
   std::vector<uint8_t> update_period_;  // frames the last update's pose is chased over
   std::vector<float> blend_weight_;     // of the offsets: 1 at a blend's start, decaying to 0
+  std::vector<uint8_t> shows_last_;     // pose() is the last update's pose as it is
   std::vector<float> keys_;             // significance with hysteresis, this frame
   std::vector<uint32_t> order_;         // characters by key, most significant first
   // Per character and joint (character-major): what was shown when the last update came, that

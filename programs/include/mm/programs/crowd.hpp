@@ -47,6 +47,8 @@ struct CrowdOptions {
   // spread evenly over the index), and there is no replay: the windows are the run's own first
   // and last. The significance of a character is minus its distance to a camera point that
   // circles through the crowd's start area (crowd_camera), so tiers change during the run.
+  // What such a crowd shows is the scheduler's poses, so its controllers compute no skinning
+  // matrices (settings.compute_skinning is off for them): skinning is the renderer's work.
   std::optional<CrowdSchedulerSettings> lod;
 };
 
@@ -89,9 +91,11 @@ struct CrowdResult {
 Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
                               const CrowdOptions& options);
 
-// The scheduler's cost model measured on this machine: each tier's mean work per character per
-// frame (us, one thread) over the last two of three seconds of `characters` of the options'
-// crowd, every one at that tier.
+// The scheduler's cost model measured on this machine: each tier's frame time over the last of
+// two seconds of `characters` of the options' crowd, every one at that tier, stepped on the
+// threads the budget is planned for (options.lod), as thread time per character (us). Measured
+// at the crowd's size and thread count, it holds the cache misses of a large crowd and the
+// threads' imperfect scaling.
 Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
     std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options,
     int characters);
