@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <random>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "controller_support.hpp"
