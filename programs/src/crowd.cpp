@@ -2,6 +2,7 @@
 // game loop, every update timed.
 
 #include "mm/programs/crowd.hpp"
+#include "mm/programs/ground_metrics.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <optional>
 #include <random>
+#include <span>
 #include <thread>
 
 namespace mm {
@@ -58,6 +60,24 @@ class TimedWorld final : public WorldQueries {
   mutable std::atomic<int64_t> nanoseconds_{0};
 };
 
+// The frames a run's steady state leaves out at its start (the first searches, every character
+// at once): one second of game time, when the steady frames are at least twice that.
+size_t warm_up_frames(size_t steady, float dt) {
+  const size_t second = clamped_integer<size_t>(std::ceil(1.0f / dt));
+  return steady >= 2 * second ? second : 0;
+}
+
+// The nearest-rank p99 of `values` (reordered).
+template <typename T>
+T p99(std::span<T> values) {
+  const size_t count = values.size();
+  const size_t rank = std::min(
+      count - 1, clamped_integer<size_t>(std::ceil(0.99 * static_cast<double>(count))) - 1);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank),
+                   values.end());
+  return values[rank];
+}
+
 // Controllers for `n` characters, each at its start position.
 Result<std::vector<Controller>> make_characters(
     const std::shared_ptr<const ControllerDatabase>& database, const CrowdOptions& options,
@@ -92,7 +112,7 @@ double mean_update_us(const CrowdTimes& times, size_t characters, size_t first, 
 // The figures of a run whose frames [replay_start, end) also updated the replay (none when
 // replay_start is the end): the steady figures come from the frames before the replay, and
 // the first window from the replay, when there is one.
-CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_start) {
+CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_start, float dt) {
   const size_t frames = times.frame_seconds.size();
   const size_t steady = replay_start;
   CrowdResult result;
@@ -107,33 +127,187 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
   result.update_us_last_window = mean_update_us(times, n, frames - window, frames);
   result.update_us_first_window = steady == frames ? mean_update_us(times, n, 0, window)
                                                    : replay * 1e6 / static_cast<double>(n * window);
+  // The frames' figures leave the start out (warm_up_frames).
+  const size_t warm = warm_up_frames(steady, dt);
   double frame_seconds = 0.0;
-  for (size_t f = 0; f < steady; ++f) frame_seconds += times.frame_seconds[f];
-  const double frame_mean = frame_seconds / static_cast<double>(steady);
+  for (size_t f = warm; f < steady; ++f) frame_seconds += times.frame_seconds[f];
+  const double frame_mean = frame_seconds / static_cast<double>(steady - warm);
   result.frame_ms_mean = frame_mean * 1e3;
+  result.frame_ms_p99 =
+      p99(std::span<double>(times.frame_seconds.data() + warm, steady - warm)) * 1e3;
   result.max_characters_60hz =
       clamped_integer<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / frame_mean));
   // The p99 of the steady frames, which come first in the frame-major times.
-  const auto begin = times.update_us.begin();
-  const auto end = begin + static_cast<std::ptrdiff_t>(steady * n);
-  const size_t count = steady * n;
-  const size_t rank = std::min(
-      count - 1, clamped_integer<size_t>(std::ceil(0.99 * static_cast<double>(count))) - 1);
-  std::nth_element(begin, begin + static_cast<std::ptrdiff_t>(rank), end);
-  result.update_us_p99 = times.update_us[rank];
+  result.update_us_p99 = p99(std::span<float>(times.update_us.data(), steady * n));
   return result;
 }
 
-}  // namespace
-
-Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
-                              const CrowdOptions& options) {
+Status check_options(const CrowdOptions& options) {
   if (options.characters < 1) return Error{"crowd: at least one character"};
   if (options.threads < 1 || options.threads > 256) return Error{"crowd: threads in [1, 256]"};
   if (!(options.seconds > 0.0f) || !std::isfinite(options.seconds)) {
     return Error{"crowd: seconds must be positive"};
   }
   if (!(options.dt > 0.0f) || !(options.dt <= 1.0f)) return Error{"crowd: dt in (0, 1] s"};
+  if (options.lod) {
+    if (Status valid = options.lod->validate(); !valid) return Error{"crowd: " + valid.message()};
+  }
+  return Status::success();
+}
+
+// ---- Budgeted runs (crowd_scheduler.hpp) ----------------------------------------------------
+
+// The characters a worker takes off the shared counter at a time: few enough that the threads
+// end a frame together, many enough that the counter is not contended.
+constexpr size_t kChunk = 32;
+
+// A crowd under its scheduler: the controllers, their scripts and what the run measures.
+struct ScheduledCrowd {
+  std::vector<Controller> controllers;
+  std::vector<InputScript> scripts;
+  CrowdScheduler scheduler;
+  std::vector<float> significance;
+};
+
+Result<ScheduledCrowd> make_scheduled_crowd(
+    const std::shared_ptr<const ControllerDatabase>& database, const CrowdOptions& options,
+    size_t n, const CrowdSchedulerSettings& settings) {
+  // What a scheduled character shows is the scheduler's pose, not its controller's: skinning
+  // matrices are the renderer's, from that pose.
+  CrowdOptions scheduled = options;
+  scheduled.settings.compute_skinning = false;
+  Result<std::vector<Controller>> controllers =
+      make_characters(database, scheduled, options.world, n);
+  if (!controllers) return Error{controllers.message()};
+  Result<CrowdScheduler> scheduler =
+      CrowdScheduler::create(n, database->database().skeleton().joint_count(), settings);
+  if (!scheduler) return Error{"crowd: " + scheduler.message()};
+  std::vector<InputScript> scripts;
+  scripts.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    scripts.push_back(varied_input_script(static_cast<uint32_t>(i), options.seconds));
+  }
+  return ScheduledCrowd{std::move(controllers).value(), std::move(scripts),
+                        std::move(scheduler).value(), std::vector<float>(n, 0.0f)};
+}
+
+// Steps character i at game time t; returns the step's wall time (s) and adds what its update
+// spent searching to `search`.
+double step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double& search) {
+  const bool updates = crowd.scheduler.updates(i);
+  const ControllerInput input = updates ? crowd.scripts[i].at(t) : ControllerInput{};
+  const auto start = std::chrono::steady_clock::now();
+  crowd.scheduler.step(i, crowd.controllers[i], dt, input);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (updates) search += crowd.controllers[i].debug().search_seconds;
+  return elapsed;
+}
+
+// This frame's plan: every character's significance from the camera at game time t.
+void plan_frame(ScheduledCrowd& crowd, const CrowdOptions& options, float t) {
+  const glm::vec3 camera = crowd_camera(options, t);
+  for (size_t i = 0; i < crowd.controllers.size(); ++i) {
+    const glm::vec3 p = crowd.controllers[i].root_transform().translation;
+    crowd.significance[i] = -glm::distance(glm::vec2(p.x, p.z), glm::vec2(camera.x, camera.z));
+  }
+  crowd.scheduler.plan(crowd.significance);
+}
+
+// What a budgeted run keeps of each frame besides CrowdTimes: the tiers and the planned work.
+struct PlanRecord {
+  std::vector<std::array<int, kCrowdTierCount>> counts;
+  std::vector<double> planned_us;
+};
+
+// The frames of a budgeted run on `threads` threads: planned on thread 0 (every character at
+// `all` when given), stepped by all.
+void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, int threads,
+                          CrowdTimes& times, PlanRecord& plans,
+                          std::optional<CrowdTier> all = std::nullopt) {
+  const size_t n = crowd.controllers.size();
+  const size_t frames = times.frame_seconds.size();
+  std::atomic<size_t> next{0};
+  std::barrier sync(threads);
+  using Clock = std::chrono::steady_clock;
+  auto worker = [&](int index) {
+    Clock::time_point frame_start = Clock::now();
+    for (size_t f = 0; f < frames; ++f) {
+      const float t = static_cast<float>(f + 1) * options.dt;
+      if (index == 0) {
+        if (all) {
+          crowd.scheduler.plan_all(*all);
+        } else {
+          plan_frame(crowd, options, t);
+        }
+        plans.counts[f] = crowd.scheduler.tier_counts();
+        plans.planned_us[f] = crowd.scheduler.planned_cost_us();
+        next.store(0, std::memory_order_relaxed);
+      }
+      sync.arrive_and_wait();
+      for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
+        for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
+          times.update_us[f * n + i] = static_cast<float>(
+              step_character(crowd, i, t, options.dt, times.search_seconds[i]) * 1e6);
+        }
+      }
+      sync.arrive_and_wait();
+      if (index == 0) {
+        const Clock::time_point now = Clock::now();
+        times.frame_seconds[f] = std::chrono::duration<double>(now - frame_start).count();
+        frame_start = now;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < threads; ++k) pool.emplace_back(worker, k);
+  worker(0);
+  for (std::thread& t : pool) t.join();
+}
+
+Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>& database,
+                                 const CrowdOptions& options) {
+  const size_t n = static_cast<size_t>(options.characters);
+  const size_t frames = clamped_integer<size_t>(std::ceil(options.seconds / options.dt));
+  const size_t window = std::clamp<size_t>(
+      clamped_integer<size_t>(std::round(kCrowdWindowSeconds / options.dt)), 1, frames);
+  Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, options, n, *options.lod);
+  if (!crowd) return Error{crowd.message()};
+  const int threads = std::min<int>(options.threads, options.characters);
+  CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
+                   std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+  PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
+                   std::vector<double>(frames, 0.0)};
+  const auto start = std::chrono::steady_clock::now();
+  run_scheduled_frames(*crowd, options, threads, times, plans);
+  // No replay: every frame is steady, the first window is the run's own.
+  CrowdResult result = summarize(times, n, window, frames, options.dt);
+  result.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.threads = threads;
+  result.frames = clamped_integer<int>(frames);
+  const size_t warm = warm_up_frames(frames, options.dt);
+  result.tier_counts = plans.counts.back();
+  result.full_min = options.characters;
+  double planned = 0.0;
+  for (size_t f = warm; f < frames; ++f) {
+    result.full_min = std::min(result.full_min, plans.counts[f][0]);
+    planned += plans.planned_us[f];
+  }
+  result.planned_cost_us_mean = planned / static_cast<double>(frames - warm);
+  for (size_t i = 0; i < n; ++i) {
+    result.final_positions.push_back(crowd->controllers[i].root_transform().translation);
+    const std::span<const Transform> pose = crowd->scheduler.pose(i);
+    result.final_poses.insert(result.final_poses.end(), pose.begin(), pose.end());
+  }
+  return result;
+}
+}  // namespace
+
+Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
+                              const CrowdOptions& options) {
+  if (Status valid = check_options(options); !valid) return Error{valid.message()};
+  if (options.lod) return run_budgeted(database, options);
   const size_t n = static_cast<size_t>(options.characters);
   const size_t frames = clamped_integer<size_t>(std::ceil(options.seconds / options.dt));
   const size_t window = std::clamp<size_t>(
@@ -212,7 +386,7 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   worker(0);
   for (std::thread& t : pool) t.join();
 
-  CrowdResult result = summarize(times, n, window, replay_start);
+  CrowdResult result = summarize(times, n, window, replay_start, options.dt);
   if (world) {
     double spent = 0.0;
     for (const double seconds : thread_update_seconds) spent += seconds;
@@ -226,7 +400,116 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
     result.final_positions.push_back(c.root_transform().translation);
   for (const Controller& c : *replay)
     result.replay_final_positions.push_back(c.root_transform().translation);
+  for (const Controller& c : *controllers) {
+    result.final_poses.insert(result.final_poses.end(), c.global_transforms().begin(),
+                              c.global_transforms().end());
+  }
+  result.tier_counts[0] = result.full_min = clamped_integer<int>(n);
   return result;
+}
+
+glm::vec3 crowd_camera(const CrowdOptions& options, float t) {
+  glm::vec4 area = options.start_area;
+  if (!(area.z > area.x && area.w > area.y)) {
+    const int n = std::max(options.characters, 1);
+    area = glm::vec4(0.0f, 0.0f, static_cast<float>(std::min(n, 32) - 1) * 3.0f,
+                     static_cast<float>((n - 1) / 32) * 3.0f);
+  }
+  const glm::vec2 centre(0.5f * (area.x + area.z), 0.5f * (area.y + area.w));
+  const glm::vec2 half(0.5f * (area.z - area.x), 0.5f * (area.w - area.y));
+  const float angle = 2.0f * glm::pi<float>() * t / 60.0f;
+  return glm::vec3(centre.x + 0.5f * half.x * std::sin(angle), 0.0f,
+                   centre.y + 0.5f * half.y * std::cos(angle));
+}
+
+Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
+    std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options,
+    int characters) {
+  CrowdOptions calibration = options;
+  calibration.characters = std::max(1, characters);
+  calibration.seconds = 2.0f;
+  if (Status valid = check_options(calibration); !valid) return Error{valid.message()};
+  const CrowdSchedulerSettings settings = options.lod ? *options.lod : CrowdSchedulerSettings{};
+  const int threads = std::min(settings.threads, calibration.characters);
+  const size_t n = static_cast<size_t>(calibration.characters);
+  const size_t frames = clamped_integer<size_t>(std::ceil(calibration.seconds / options.dt));
+  std::array<float, kCrowdTierCount> costs{};
+  for (int tier = 0; tier < kCrowdTierCount; ++tier) {
+    Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, calibration, n, settings);
+    if (!crowd) return Error{crowd.message()};
+    CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
+                     std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+    PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
+                     std::vector<double>(frames, 0.0)};
+    run_scheduled_frames(*crowd, calibration, threads, times, plans, static_cast<CrowdTier>(tier));
+    // The second half's frames: thread time per character.
+    double seconds = 0.0;
+    for (size_t f = frames / 2; f < frames; ++f) seconds += times.frame_seconds[f];
+    costs[static_cast<size_t>(tier)] = static_cast<float>(
+        seconds * 1e6 * threads / static_cast<double>(n * (frames - frames / 2)));
+  }
+  // Timing noise must not make a slower tier look dearer than a faster one.
+  for (size_t t = 1; t < costs.size(); ++t) costs[t] = std::min(costs[t], costs[t - 1]);
+  return costs;
+}
+
+namespace {
+
+// One character's ground metrics, fed its displayed pose every frame.
+struct QualityProbe {
+  QualityProbe(const JointRoleIndices& roles, float dt, size_t joints)
+      : ground(roles, dt), positions(joints) {}
+  GroundAccumulator ground;
+  std::vector<glm::vec3> positions;
+};
+
+}  // namespace
+
+Result<std::array<CrowdTierQuality, kCrowdTierCount>> crowd_tier_quality(
+    std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options, int characters,
+    float seconds) {
+  CrowdOptions run = options;
+  run.characters = std::max(1, characters);
+  run.seconds = seconds;
+  if (Status valid = check_options(run); !valid) return Error{valid.message()};
+  const size_t n = static_cast<size_t>(run.characters);
+  const size_t frames = clamped_integer<size_t>(std::ceil(seconds / options.dt));
+  const Database& db = database->database();
+  std::array<CrowdTierQuality, kCrowdTierCount> quality{};
+  for (int tier = 0; tier < kCrowdTierCount; ++tier) {
+    Result<ScheduledCrowd> crowd = make_scheduled_crowd(
+        database, run, n, options.lod ? *options.lod : CrowdSchedulerSettings{});
+    if (!crowd) return Error{crowd.message()};
+    std::vector<std::unique_ptr<QualityProbe>> probes;
+    for (size_t i = 0; i < n; ++i) {
+      probes.push_back(
+          std::make_unique<QualityProbe>(db.roles(), options.dt, crowd->scheduler.joints()));
+    }
+    double search = 0.0;
+    for (size_t f = 0; f < frames; ++f) {
+      const float t = static_cast<float>(f + 1) * options.dt;
+      crowd->scheduler.plan_all(static_cast<CrowdTier>(tier));
+      for (size_t i = 0; i < n; ++i) {
+        step_character(*crowd, i, t, options.dt, search);
+        const std::span<const Transform> pose = crowd->scheduler.pose(i);
+        for (size_t j = 0; j < pose.size(); ++j) probes[i]->positions[j] = pose[j].translation;
+        GroundFrame frame;
+        frame.joints = probes[i]->positions;
+        probes[i]->ground.add(frame);
+      }
+    }
+    CrowdTierQuality& q = quality[static_cast<size_t>(tier)];
+    q.toe_clearance_cm_min = 1e30;
+    for (const auto& probe : probes) {
+      const GroundMetrics m = probe->ground.metrics();
+      q.foot_skate_geom_cm_s_mean += m.foot_skate_geom_cm_s_mean / static_cast<double>(n);
+      q.foot_penetration_cm_mean += m.foot_penetration_cm_mean / static_cast<double>(n);
+      q.hips_vertical_accel_p99_m_s2 += m.hips_vertical_accel_p99_m_s2 / static_cast<double>(n);
+      q.foot_penetration_cm_max = std::max(q.foot_penetration_cm_max, m.foot_penetration_cm_max);
+      q.toe_clearance_cm_min = std::min(q.toe_clearance_cm_min, m.toe_clearance_cm_min);
+    }
+  }
+  return quality;
 }
 
 }  // namespace mm

@@ -13,6 +13,7 @@
 #include "allocation_counter.hpp"
 #include "analytic_world.hpp"
 #include "controller_support.hpp"
+#include "mm/controller/crowd_scheduler.hpp"
 
 namespace mm {
 namespace {
@@ -67,6 +68,58 @@ TEST(ControllerNoAllocationTest, UpdateInAWorldNeverAllocates) {
       test::AnalyticBox{glm::vec2(-3.0f, 0.0f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
   expect_updates_never_allocate(&world);
   EXPECT_GT(world.sweeps.load(), 3000);
+}
+
+// The crowd's scheduler (crowd_scheduler.hpp) plans and steps a budgeted crowd whose
+// significances keep changing, so characters change tiers every few frames (updates at every
+// rate, holds, moves, promotions with their blends): none of it allocates.
+TEST(ControllerNoAllocationTest, TheCrowdSchedulerNeverAllocates) {
+  const auto shared = test::normal_controller_database();
+  constexpr size_t kCharacters = 12;
+  std::vector<Controller> crowd;
+  for (size_t i = 0; i < kCharacters; ++i) {
+    Result<Controller> made = Controller::create(shared);
+    ASSERT_TRUE(made.ok()) << made.message();
+    made->teleport(glm::vec3(static_cast<float>(i) * 3.0f, 0.0f, 0.0f), 0.0f);
+    crowd.push_back(std::move(made).value());
+  }
+  CrowdSchedulerSettings settings;
+  // 22.25 us: one at full rate, one at half, four at quarter, six moved (the tests of
+  // crowd_scheduler_test.cpp work these out).
+  settings.cost_us = {8.0f, 3.0f, 2.0f, 0.5f};
+  settings.budget_ms = 0.02225f;
+  Result<CrowdScheduler> made =
+      CrowdScheduler::create(kCharacters, crowd[0].global_transforms().size(), settings);
+  ASSERT_TRUE(made.ok()) << made.message();
+  CrowdScheduler& scheduler = *made;
+  std::vector<float> significance(kCharacters);
+  std::array<bool, kCrowdTierCount> seen{};
+  int changes = 0;
+  std::vector<uint8_t> before(kCharacters, 0);
+
+  const long start = g_allocations.load();
+  for (int f = 0; f < 1200; ++f) {
+    for (size_t i = 0; i < kCharacters; ++i) {
+      // A camera sweeping back and forth along the row.
+      const float camera = 18.0f + 18.0f * std::sin(0.01f * static_cast<float>(f));
+      significance[i] = -std::abs(static_cast<float>(i) * 3.0f - camera);
+    }
+    scheduler.plan(significance);
+    for (size_t i = 0; i < kCharacters; ++i) {
+      const ControllerInput input =
+          test::push_toward(static_cast<float>(f / 90 * 60 + i), f % 400 > 300);
+      scheduler.step(i, crowd[i], 1.0f / 60.0f, input);
+      const uint8_t t = static_cast<uint8_t>(scheduler.tier(i));
+      seen[t] = true;
+      changes += t != before[i];
+      before[i] = t;
+    }
+  }
+  EXPECT_EQ(g_allocations.load() - start, 0);
+  for (int t = 0; t < kCrowdTierCount; ++t) {
+    EXPECT_TRUE(seen[static_cast<size_t>(t)]) << crowd_tier_name(static_cast<CrowdTier>(t));
+  }
+  EXPECT_GT(changes, 20);
 }
 
 }  // namespace

@@ -115,6 +115,61 @@ TEST(CrowdThreads, InAWorldTwoThreadsGiveTheOneThreadCrowd) {
   }
 }
 
+// Under a frame budget (crowd_scheduler.hpp) the crowd runs at every tier, and its displayed
+// poses on 2 and 4 threads are exactly those on 1: the tiers come from the cost model, never
+// from timings, and the plan is for the settings' thread count, not the run's.
+TEST(CrowdThreads, UnderABudgetTwoAndFourThreadsShowTheOneThreadPoses) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 40;
+  options.seconds = 4.0f;
+  CrowdSchedulerSettings lod;
+  lod.cost_us = {8.0f, 3.0f, 2.0f, 0.5f};
+  lod.threads = 2;
+  lod.budget_ms = 0.06f;  // 120 us of work for 40 characters: 320 at full rate, 20 all moved
+  options.lod = lod;
+  std::vector<Transform> reference;
+  for (const int threads : {1, 2, 4}) {
+    options.threads = threads;
+    Result<CrowdResult> run = run_crowd(shared, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    int sum = 0;
+    for (const int count : run->tier_counts) sum += count;
+    EXPECT_EQ(sum, 40);
+    EXPECT_GT(run->tier_counts[0], 0);
+    EXPECT_GT(run->tier_counts[2] + run->tier_counts[3], 0);
+    EXPECT_LE(run->planned_cost_us_mean, 120.0 * (1.0 + 1e-6));
+    EXPECT_GT(run->frame_ms_p99, 0.0);
+    EXPECT_GE(run->frame_ms_p99, run->frame_ms_mean * 0.5);
+    ASSERT_EQ(run->final_poses.size(), 40 * shared->database().skeleton().joint_count());
+    if (threads == 1) {
+      reference = run->final_poses;
+      continue;
+    }
+    for (size_t k = 0; k < reference.size(); ++k) {
+      ASSERT_EQ(run->final_poses[k].translation, reference[k].translation)
+          << threads << " threads, transform " << k;
+      ASSERT_EQ(run->final_poses[k].rotation, reference[k].rotation)
+          << threads << " threads, transform " << k;
+    }
+  }
+}
+
+TEST(CrowdThreads, AnInvalidBudgetIsRefusedByMessage) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 2;
+  CrowdSchedulerSettings lod;
+  lod.cost_us = {1.0f, 2.0f, 0.5f, 0.1f};
+  options.lod = lod;
+  Result<CrowdResult> run = run_crowd(shared, options);
+  ASSERT_FALSE(run.ok());
+  EXPECT_EQ(run.message(),
+            "crowd: crowd scheduler: the cost of tier half is above the cost of tier full");
+}
+
 TEST(CrowdThreads, TheReplayedFirstWindowEndsWhereTheRunsFirstWindowDid) {
   const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
   ASSERT_NE(shared, nullptr);

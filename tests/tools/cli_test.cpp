@@ -376,7 +376,9 @@ TEST(Cli, EveryCommandsHelpListsItsOptions) {
       {"retarget",
        {"--to", "-o,--output", "--map", "--target-map", "--rest-frame", "--rate", "--clip"}},
       {"eval", {"--db", "--script", "--dt", "--ik", "--set", "--json", "--dump"}},
-      {"crowd-bench", {"--db", "--characters", "--seconds", "--threads", "--set", "--json"}},
+      {"crowd-bench",
+       {"--db", "--characters", "--seconds", "--threads", "--set", "--budget-ms", "--tier-costs-us",
+        "--json"}},
       {"search-bench", {"--db", "--queries"}},
   };
   for (const auto& [command, options] : commands) {
@@ -432,6 +434,8 @@ TEST(Cli, NumberOptionsRefuseNanInfinityAndOutOfRange) {
       {"eval --db none.mmdb --script none.txt --dt nan", "--dt: 'nan' is not a finite number"},
       {"crowd-bench --db none.mmdb --characters 2 --seconds nan",
        "--seconds: 'nan' is not a finite number"},
+      {"crowd-bench --db none.mmdb --characters 2 --seconds 1 --budget-ms 0",
+       "--budget-ms: 0 is outside (0, 1000]"},
   };
   for (const auto& [arguments, message] : cases) {
     const CommandRun run = run_mm(arguments);

@@ -322,6 +322,53 @@ TEST(ControllerCli, CrowdBenchGivesTheSameCrowdOnOneAndTwoThreads) {
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 
+// Under --budget-ms the crowd runs at lower tiers too, the same on one and two threads, and the
+// JSON says how many characters ran at each tier, the frame time and each tier's quality.
+TEST(ControllerCli, CrowdBenchUnderABudgetReportsTiersAndFrameTimes) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path json_path = dir / "crowd-budget.json";
+  const CommandRun run = run_mm("crowd-bench --db '" + small_database().string() +
+                                "' --characters 24 --seconds 2 --budget-ms 0.05 --tier-costs-us "
+                                "8,3,2,0.5 --json '" +
+                                json_path.string() + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
+  EXPECT_TRUE(json["same_result_every_thread_count"].get<bool>());
+  EXPECT_EQ(json["budget_ms"].get<double>(), 0.05);
+  for (const char* key : {"frame_ms_mean", "frame_ms_p99", "max_characters_60hz_1_thread"}) {
+    ASSERT_TRUE(json.contains(key)) << key;
+    EXPECT_GT(json[key].get<double>(), 0.0) << key;
+  }
+  // 100 us of work (two threads) for 24 characters: all at quarter (48 us), five raised to full
+  // within 40 us (+6 each), the next 19 to half (+1 each).
+  const nlohmann::json& tiers = json["tier_counts"];
+  ASSERT_EQ(tiers.size(), 4u);
+  EXPECT_EQ(tiers.begin().key(), "full");
+  EXPECT_EQ(tiers["full"].get<int>(), 5);
+  EXPECT_EQ(tiers["half"].get<int>(), 19);
+  EXPECT_EQ(tiers["quarter"].get<int>(), 0);
+  EXPECT_EQ(tiers["move_only"].get<int>(), 0);
+  ASSERT_EQ(json["budget_runs"].size(), 2u);
+  for (const nlohmann::json& budget_run : json["budget_runs"]) {
+    EXPECT_EQ(budget_run["tier_counts"], tiers);
+  }
+  for (const char* tier : {"full", "half", "quarter", "move_only"}) {
+    ASSERT_TRUE(json["tier_quality"].contains(tier)) << tier;
+    EXPECT_GE(json["tier_quality"][tier]["foot_skate_geom_cm_s_mean"].get<double>(), 0.0);
+  }
+  EXPECT_EQ(json["tier_cost_us"]["quarter"].get<double>(), 2.0);
+  EXPECT_NE(run.output.find("tiers at the end: full 5, half 19"), std::string::npos) << run.output;
+
+  const CommandRun bad =
+      run_mm("crowd-bench --db '" + small_database().string() +
+             "' --characters 4 --seconds 1 --budget-ms 1 --tier-costs-us 1,2,1,1");
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(
+      bad.output.find("crowd scheduler: the cost of tier half is above the cost of tier full"),
+      std::string::npos)
+      << bad.output;
+}
+
 // `mm eval --world`: the run in the shipped course (Bullet), measured against its ground; a level
 // that cannot be read is refused naming the file.
 TEST(ControllerCli, EvalRunsInALevelAndRefusesABadOne) {

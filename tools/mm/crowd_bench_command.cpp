@@ -1,6 +1,8 @@
 // `mm crowd-bench`: many controllers over one database at 60 Hz; cost per character and the
 // largest crowd one frame holds, on 1 and 2 threads.
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -29,7 +31,17 @@ struct Arguments {
   std::string world_path;
   CrowdOptions options;
   int extra_threads = 0;
+  double budget_ms = 0.0;            // 0: none
+  std::vector<float> tier_costs_us;  // empty: calibrated
 };
+
+// The full-rate runs beside a budgeted one are this long at most (s of game time): their figures
+// are per character, and a full-rate crowd of the budget's size is many times slower than real
+// time.
+constexpr float kFullRateSecondsBesideBudget = 10.0f;
+// The per-tier quality runs' crowd.
+constexpr int kQualityCharacters = 16;
+constexpr float kQualitySeconds = 20.0f;
 
 // The length of crowd.hpp's comparison windows, whole seconds, for the help and the table.
 std::string window_seconds() {
@@ -74,17 +86,39 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "bounds: the cost with the world against without, and the world's queries' "
                  "share of it")
       ->type_name("LEVEL");
+  app.add_option("--budget-ms", out.budget_ms,
+                 "also run the crowd under a frame budget of MS milliseconds for all characters "
+                 "together (level of detail, docs/performance.md): tiers by the distance to a "
+                 "camera point circling through the crowd, planned for the largest thread count "
+                 "of the run; the full-rate runs beside it then last at most 10 s")
+      ->check(number_over(0.0, 1000.0))
+      ->type_name("MS");
+  app.add_option("--tier-costs-us", out.tier_costs_us,
+                 "the budget's cost model: work per character per frame (us) at full, half, "
+                 "quarter and move_only; default: measured before the runs")
+      ->expected(4)
+      ->delimiter(',')
+      ->type_name("F,H,Q,M");
   app.add_option("--json", out.json_path, "also write the results as JSON")->type_name("FILE");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   return check_settings(app, out.options.settings);
 }
 
+// Characters per tier as JSON: tier name to count (the names sort with full first).
+nlohmann::json tier_counts_json(const std::array<int, kCrowdTierCount>& counts) {
+  nlohmann::json json = nlohmann::json::object();
+  for (int t = 0; t < kCrowdTierCount; ++t) {
+    json[std::string(crowd_tier_name(static_cast<CrowdTier>(t)))] = counts[static_cast<size_t>(t)];
+  }
+  return json;
+}
+
 // The JSON of one run, and its figures printed as a table row.
 nlohmann::json report_run(const CrowdResult& run) {
   const double ratio = run.update_us_last_window / run.update_us_first_window;
-  std::printf("%8d %14.2f %14.2f %12.1f%% %12.1f%% %14.3f %16d %12.2f %12.2f %10.2f\n", run.threads,
-              run.update_us_mean, run.update_us_p99, 100.0 * run.search_share,
-              100.0 * run.world_share, run.frame_ms_mean, run.max_characters_60hz,
+  std::printf("%8d %14.2f %14.2f %12.1f%% %12.1f%% %14.3f %13.3f %16d %12.2f %12.2f %10.2f\n",
+              run.threads, run.update_us_mean, run.update_us_p99, 100.0 * run.search_share,
+              100.0 * run.world_share, run.frame_ms_mean, run.frame_ms_p99, run.max_characters_60hz,
               run.update_us_first_window, run.update_us_last_window, ratio);
   std::fflush(stdout);
   return {{"threads", run.threads},
@@ -96,7 +130,24 @@ nlohmann::json report_run(const CrowdResult& run) {
           {"search_share", run.search_share},
           {"world_share", run.world_share},
           {"frame_ms_mean", run.frame_ms_mean},
+          {"frame_ms_p99", run.frame_ms_p99},
+          {"tier_counts", tier_counts_json(run.tier_counts)},
+          {"full_min", run.full_min},
+          {"planned_cost_us_mean", run.planned_cost_us_mean},
           {"max_characters_60hz", run.max_characters_60hz}};
+}
+
+// Whether a run ends in the reference's poses, exactly.
+bool same_poses(const std::vector<Transform>& reference, const CrowdResult& run) {
+  if (reference.size() != run.final_poses.size()) return false;
+  for (size_t k = 0; k < reference.size(); ++k) {
+    const Transform& a = reference[k];
+    const Transform& b = run.final_poses[k];
+    if (a.translation != b.translation || a.rotation != b.rotation || a.scale != b.scale) {
+      return false;
+    }
+  }
+  return true;
 }
 
 // Runs the crowd on every thread count into `json`; returns whether every run ended with the
@@ -116,10 +167,11 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
   };
   const std::string first = window_label("first ");
   const std::string last = window_label("last ");
-  std::printf("%8s %14s %14s %13s %13s %14s %16s %12s %12s %10s\n", "threads", "update us mean",
-              "update us p99", "search share", "world share", "frame ms mean", "max chars 60 Hz",
-              first.c_str(), last.c_str(), "last/first");
+  std::printf("%8s %14s %14s %13s %13s %14s %13s %16s %12s %12s %10s\n", "threads",
+              "update us mean", "update us p99", "search share", "world share", "frame ms mean",
+              "frame ms p99", "max chars 60 Hz", first.c_str(), last.c_str(), "last/first");
   std::vector<glm::vec3> reference;
+  std::vector<Transform> reference_poses;
   bool same = true;
   for (int threads : thread_counts) {
     options.threads = threads;
@@ -129,11 +181,23 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
       return std::nullopt;
     }
     json["runs"].push_back(report_run(*run));
+    if (options.lod) {
+      std::printf(
+          "%8s tiers at the end: full %d, half %d, quarter %d, move_only %d; fewest at "
+          "full %d; planned %.2f ms of work per frame\n",
+          "", run->tier_counts[0], run->tier_counts[1], run->tier_counts[2], run->tier_counts[3],
+          run->full_min, run->planned_cost_us_mean * 1e-3);
+    }
     if (reference.empty()) {
       reference = run->final_positions;
+      reference_poses = std::move(run->final_poses);
     } else {
-      same = same && reference == run->final_positions;
+      same = same && reference == run->final_positions && same_poses(reference_poses, *run);
     }
+    // The figures of the run with the most threads.
+    json["frame_ms_mean"] = run->frame_ms_mean;
+    json["frame_ms_p99"] = run->frame_ms_p99;
+    json["tier_counts"] = tier_counts_json(run->tier_counts);
     // Built with append: GCC 12 gives a false -Wrestrict on chains of operator+ with literals.
     std::string key = "max_characters_60hz_";
     key.append(std::to_string(threads)).append(threads == 1 ? "_thread" : "_threads");
@@ -147,6 +211,98 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
       json["update_us_window_ratio"] = run->update_us_last_window / run->update_us_first_window;
     }
   }
+  return same;
+}
+
+// The budget's cost model: given, or measured on this machine now.
+std::optional<std::array<float, kCrowdTierCount>> tier_costs(
+    const std::shared_ptr<const ControllerDatabase>& shared, const Arguments& arguments) {
+  std::array<float, kCrowdTierCount> costs{};
+  if (arguments.tier_costs_us.size() == costs.size()) {
+    std::copy(arguments.tier_costs_us.begin(), arguments.tier_costs_us.end(), costs.begin());
+    return costs;
+  }
+  std::printf("calibrating the cost model (the crowd, 2 s at each tier on %d threads)...\n",
+              arguments.options.lod->threads);
+  std::fflush(stdout);
+  Result<std::array<float, kCrowdTierCount>> measured =
+      calibrate_crowd_tiers(shared, arguments.options, arguments.options.characters);
+  if (!measured) {
+    std::fprintf(stderr, "mm crowd-bench: %s\n", measured.message().c_str());
+    return std::nullopt;
+  }
+  return *measured;
+}
+
+// The ground metrics of each tier's displayed poses, printed and as JSON.
+std::optional<nlohmann::json> report_tier_quality(
+    const std::shared_ptr<const ControllerDatabase>& shared, const CrowdOptions& options) {
+  Result<std::array<CrowdTierQuality, kCrowdTierCount>> quality =
+      crowd_tier_quality(shared, options, kQualityCharacters, kQualitySeconds);
+  if (!quality) {
+    std::fprintf(stderr, "mm crowd-bench: %s\n", quality.message().c_str());
+    return std::nullopt;
+  }
+  std::printf("quality per tier (%d characters, %.0f s, all at the tier, displayed poses):\n",
+              kQualityCharacters, static_cast<double>(kQualitySeconds));
+  std::printf("%10s %18s %17s %16s %16s %18s\n", "tier", "geom skate cm/s", "penetration cm",
+              "penetration max", "toe clear. min", "hips vert acc p99");
+  nlohmann::json json = nlohmann::json::object();
+  for (int t = 0; t < kCrowdTierCount; ++t) {
+    const CrowdTierQuality& q = (*quality)[static_cast<size_t>(t)];
+    const std::string name(crowd_tier_name(static_cast<CrowdTier>(t)));
+    std::printf("%10s %18.3f %17.3f %16.3f %16.3f %18.2f\n", name.c_str(),
+                q.foot_skate_geom_cm_s_mean, q.foot_penetration_cm_mean, q.foot_penetration_cm_max,
+                q.toe_clearance_cm_min, q.hips_vertical_accel_p99_m_s2);
+    json[name] = {{"foot_skate_geom_cm_s_mean", q.foot_skate_geom_cm_s_mean},
+                  {"foot_penetration_cm_mean", q.foot_penetration_cm_mean},
+                  {"foot_penetration_cm_max", q.foot_penetration_cm_max},
+                  {"toe_clearance_cm_min", q.toe_clearance_cm_min},
+                  {"hips_vertical_accel_p99_m_s2", q.hips_vertical_accel_p99_m_s2}};
+  }
+  return json;
+}
+
+// The crowd under --budget-ms on every thread count, planned for the most of them, into `json`;
+// returns whether every run ended with the same poses, or nothing when a run failed.
+std::optional<bool> run_budget(const std::shared_ptr<const ControllerDatabase>& shared,
+                               const Arguments& arguments, nlohmann::json& json) {
+  Arguments budgeted = arguments;
+  CrowdSchedulerSettings lod;
+  lod.budget_ms = static_cast<float>(arguments.budget_ms);
+  lod.threads = std::max(2, arguments.extra_threads);
+  budgeted.options.lod = lod;
+  const std::optional<std::array<float, kCrowdTierCount>> costs = tier_costs(shared, budgeted);
+  if (!costs) return std::nullopt;
+  lod.cost_us = *costs;
+  budgeted.options.lod = lod;
+  if (Status valid = lod.validate(); !valid) {
+    std::fprintf(stderr, "mm crowd-bench: %s\n", valid.message().c_str());
+    return std::nullopt;
+  }
+  nlohmann::json costs_json = nlohmann::json::object();
+  for (int t = 0; t < kCrowdTierCount; ++t) {
+    costs_json[std::string(crowd_tier_name(static_cast<CrowdTier>(t)))] =
+        (*costs)[static_cast<size_t>(t)];
+  }
+  std::printf(
+      "under a budget of %.2f ms per frame, planned for %d threads; cost model (us per character "
+      "per frame): full %.2f, half %.2f, quarter %.2f, move_only %.2f\n",
+      arguments.budget_ms, lod.threads, static_cast<double>((*costs)[0]),
+      static_cast<double>((*costs)[1]), static_cast<double>((*costs)[2]),
+      static_cast<double>((*costs)[3]));
+  nlohmann::json runs;
+  const std::optional<bool> same = run_thread_counts(shared, budgeted, runs);
+  if (!same) return std::nullopt;
+  json["budget_ms"] = arguments.budget_ms;
+  json["budget_threads"] = lod.threads;
+  json["tier_cost_us"] = costs_json;
+  json["budget_runs"] = runs["runs"];
+  for (const char* key : {"frame_ms_mean", "frame_ms_p99", "tier_counts"}) json[key] = runs[key];
+  json["full_min"] = runs["runs"].back()["full_min"];
+  std::optional<nlohmann::json> quality = report_tier_quality(shared, budgeted.options);
+  if (!quality) return std::nullopt;
+  json["tier_quality"] = *quality;
   return same;
 }
 
@@ -193,8 +349,19 @@ int run_crowd_bench(const std::vector<std::string>& args) {
     world.emplace(std::move(made).value());
     arguments.options.start_area = inner_area(*level);
   }
-  std::optional<bool> same = run_thread_counts(*shared, arguments, json);
+  // Beside a budget, the full-rate runs are short (kFullRateSecondsBesideBudget).
+  Arguments full_rate = arguments;
+  if (arguments.budget_ms > 0.0) {
+    full_rate.options.seconds = std::min(arguments.options.seconds, kFullRateSecondsBesideBudget);
+    std::printf("at full rate:\n");
+  }
+  std::optional<bool> same = run_thread_counts(*shared, full_rate, json);
   if (!same) return 1;
+  if (arguments.budget_ms > 0.0) {
+    const std::optional<bool> same_budgeted = run_budget(*shared, arguments, json);
+    if (!same_budgeted) return 1;
+    same = *same && *same_budgeted;
+  }
   if (world) {
     // The same crowd in the level: its cost against the flat runs above (1 thread).
     std::printf("in %s (Bullet):\n", arguments.world_path.c_str());

@@ -367,6 +367,12 @@ class Controller {
   // Advances by dt seconds of game time. dt <= 0 or non-finite changes nothing; dt above
   // settings.max_dt is clamped to it; non-finite or out-of-range input is sanitized.
   void update(float dt, const ControllerInput& input);
+  // Level of detail (controller_lod.cpp; crowd_scheduler.hpp): advances only the simulation
+  // object under this input and carries the character along with it rigidly. The root keeps
+  // its offset to the simulation object; the pose, playback and transitions are held (no
+  // search, sampling, IK or forward kinematics), foot locks are released. A later update()
+  // goes on from there. dt as in update().
+  void update_move_only(float dt, const ControllerInput& input);
 
   // Places the character and its simulation object (cold; clears any transition).
   void teleport(const glm::vec3& position, float yaw);

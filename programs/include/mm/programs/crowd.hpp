@@ -3,13 +3,16 @@
 // its own varied scripted input, updated at a fixed rate on one or more threads. Characters are
 // independent, so the result (every character's final pose) does not depend on the thread count.
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "mm/controller/controller.hpp"
+#include "mm/controller/crowd_scheduler.hpp"
 #include "mm/controller/script.hpp"
 #include "mm/controller/world.hpp"
 #include "mm/runtime/result.hpp"
@@ -38,7 +41,20 @@ struct CrowdOptions {
   // Where the characters start: their 3 m grid wrapped into this rectangle (x0, z0, x1, z1,
   // world metres) when it has an area, else the grid from the origin on.
   glm::vec4 start_area{0.0f};
+  // Level of detail under a frame budget (crowd_scheduler.hpp); none: every character updated
+  // every frame, as a plain loop of Controller::update. With it, every character is stepped by
+  // the scheduler, threads take characters in chunks off a shared counter (the tiers are not
+  // spread evenly over the index), and there is no replay: the windows are the run's own first
+  // and last. The significance of a character is minus its distance to a camera point that
+  // circles through the crowd's start area (crowd_camera), so tiers change during the run.
+  // What such a crowd shows is the scheduler's poses, so its controllers compute no skinning
+  // matrices (settings.compute_skinning is off for them): skinning is the renderer's work.
+  std::optional<CrowdSchedulerSettings> lod;
 };
+
+// The camera point of a budgeted run at game time t (s): on an ellipse through the middle of
+// the characters' start area (half its extent across), once round every 60 s.
+glm::vec3 crowd_camera(const CrowdOptions& options, float t);
 
 // The steady figures (mean, p99, search share, frame time, max characters) are over the frames
 // before the last window when the run has a replay (its frames carry twice the work), else over
@@ -53,16 +69,48 @@ struct CrowdResult {
   double update_us_last_window = 0.0;
   double search_share = 0.0;   // time in search / time in update
   double world_share = 0.0;    // time in the world's queries / time in update (0 without one)
-  double frame_ms_mean = 0.0;  // wall time per frame for the whole crowd
+  double frame_ms_mean = 0.0;  // wall time per frame for the whole crowd (planning included)
+  double frame_ms_p99 = 0.0;   // nearest rank
   // Characters one frame of 1/60 s could update at this run's rate per character and thread
   // count: characters * (1/60 s) / frame time.
   int max_characters_60hz = 0;
   std::vector<glm::vec3> final_positions;         // root of each character after the run
   std::vector<glm::vec3> replay_final_positions;  // after the replay; empty without one
+  // The displayed pose of every character after the run (character-major, global transforms):
+  // the scheduler's with a budget, else the controllers' own.
+  std::vector<Transform> final_poses;
+  // Characters per tier on the last steady frame (all at full rate without a budget), the
+  // fewest at full rate on any steady frame, and the cost model's mean planned work per frame
+  // (us, all threads; 0 without a budget).
+  std::array<int, kCrowdTierCount> tier_counts{};
+  int full_min = 0;
+  double planned_cost_us_mean = 0.0;
 };
 
 // Runs the crowd. Fails on invalid options or settings.
 Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
                               const CrowdOptions& options);
+
+// The scheduler's cost model measured on this machine: each tier's frame time over the last of
+// two seconds of `characters` of the options' crowd, every one at that tier, stepped on the
+// threads the budget is planned for (options.lod), as thread time per character (us). Measured
+// at the crowd's size and thread count, it holds the cache misses of a large crowd and the
+// threads' imperfect scaling.
+Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
+    std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options,
+    int characters);
+
+// The ground metrics (ground_metrics.hpp) of the displayed poses of a crowd all at one tier,
+// averaged over its characters.
+struct CrowdTierQuality {
+  double foot_skate_geom_cm_s_mean = 0.0;
+  double foot_penetration_cm_mean = 0.0;
+  double foot_penetration_cm_max = 0.0;  // the deepest of any character
+  double toe_clearance_cm_min = 0.0;     // the lowest of any character
+  double hips_vertical_accel_p99_m_s2 = 0.0;
+};
+Result<std::array<CrowdTierQuality, kCrowdTierCount>> crowd_tier_quality(
+    std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options, int characters,
+    float seconds);
 
 }  // namespace mm
