@@ -918,8 +918,8 @@ void Controller::synchronize(float dt) {
 // local pose before forward kinematics.
 float Controller::body_yaw() const {
   const std::span<const int> parents = db_->skeleton().parents();
-  const glm::vec3 left = forward_kinematics_joint(parents, locals_, leg_joints_[0][0]).translation;
-  const glm::vec3 right = forward_kinematics_joint(parents, locals_, leg_joints_[1][0]).translation;
+  const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
+  const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
   return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
 }
 
@@ -979,8 +979,8 @@ void Controller::turn_chest_to_facing(float dt) {
   float goal = 0.0f;
   if (strafing_) {
     const float chest_yaw =
-        pair_yaw(forward_kinematics_joint(parents, locals_, roles.left_upper_arm).translation,
-                 forward_kinematics_joint(parents, locals_, roles.right_upper_arm).translation,
+        pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
+                 forward_kinematics_position(parents, locals_, roles.right_upper_arm),
                  quat_yaw(locals_[0].rotation));
     const float error = wrap_angle(quat_yaw(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
@@ -994,7 +994,7 @@ void Controller::turn_chest_to_facing(float dt) {
     if (joint < 0) continue;
     // A turn about the world's vertical, expressed in the joint's parent frame.
     const glm::quat parent =
-        forward_kinematics_joint(parents, locals_, db_->skeleton().parent(joint)).rotation;
+        forward_kinematics_rotation(parents, locals_, db_->skeleton().parent(joint));
     const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
     Transform& local = locals_[static_cast<size_t>(joint)];
     local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
