@@ -330,7 +330,9 @@ void Controller::place(const glm::vec3& position, float yaw) {
   chest_twist_ = chest_twist_velocity_ = 0.0f;
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
-    sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
+    sampled_at_ = playback_point();
+    sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, true);
+    sampled_body_velocities_ = true;
     std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
     move_root(glm::vec3(sim_position_.x, 0.0f, sim_position_.z), rotation);
     if (world_ || game_capsule_) locals_[0].translation.y += ground_height_;
@@ -357,7 +359,9 @@ void Controller::update(float dt, const ControllerInput& input) {
   since_transition_ += dt;
   if (should_search()) search();
   advance_playback(dt);
-  sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_);
+  sampled_at_ = playback_point();
+  sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, false);
+  sampled_body_velocities_ = false;
   show_transitions(dt);
   // Only the root's displayed motion is needed (by the synchronization): the playing root's
   // plus its offsets' rates.
@@ -586,13 +590,17 @@ void Controller::transition_to(int frame) {
   if (had_clip) {
     transition_src_position_ = sampled_[0].translation;
     transition_src_rotation_ = sampled_[0].rotation;
+    // The outgoing body's velocities, where the update sampled it (start_transition reads them).
+    if (!sampled_body_velocities_) {
+      sample_body_velocities(sampled_at_, sampled_velocities_, sampled_angular_velocities_);
+    }
   }
   const size_t k = static_cast<size_t>(frame) * static_cast<size_t>(db.joint_count());
   transition_dst_position_ = db.local_positions()[k];
   transition_dst_rotation_ = db.local_rotations()[k];
   clip_ = clip;
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
-  sample_playback(other_, other_velocities_, other_angular_velocities_);
+  sample_playback(other_, other_velocities_, other_angular_velocities_, true);
   if (had_clip) {
     start_transition();
     ++debug_.transitions;
@@ -602,6 +610,7 @@ void Controller::transition_to(int frame) {
   std::swap(sampled_, other_);
   std::swap(sampled_velocities_, other_velocities_);
   std::swap(sampled_angular_velocities_, other_angular_velocities_);
+  sampled_body_velocities_ = true;
 }
 
 // At a jump, the outgoing clip (sampled_) hands over to the incoming one (other_).
@@ -680,40 +689,33 @@ Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const 
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
+// The root's velocities always; the body's (joints 1..) only when `body_velocities`.
 void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
-                                 std::span<glm::vec3> angular_velocities) const {
+                                 std::span<glm::vec3> angular_velocities,
+                                 bool body_velocities) const {
   const Database& db = *db_;
   const PlaybackPoint at = playback_point();
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t k0 = static_cast<size_t>(at.frame0) * joints;
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
-  for (size_t j = 0; j < joints; ++j) {
-    local[j] = sample_joint(at, j);
-    velocities[j] =
-        glm::mix(db.local_velocities()[k0 + j], db.local_velocities()[k1 + j], at.weight);
-    angular_velocities[j] = glm::mix(db.local_angular_velocities()[k0 + j],
-                                     db.local_angular_velocities()[k1 + j], at.weight);
-  }
+  for (size_t j = 0; j < joints; ++j) local[j] = sample_joint(at, j);
+  velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
+  angular_velocities[0] =
+      glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
+  if (body_velocities) sample_body_velocities(at, velocities, angular_velocities);
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
   // locals relative to the simulation root differ between takes by whole metres, and offsets
   // between such values would swing the body around during a transition.
   for (const int j : folded_joints_) {
     const Transform folded = local[static_cast<size_t>(j)];
-    const glm::vec3 v = velocities[static_cast<size_t>(j)];
-    const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
     const int end = j + db.skeleton().subtree_size(j);
     for (int c = j + 1; c < end; ++c) {
       if (db.skeleton().parent(c) != j) continue;
       const size_t k = static_cast<size_t>(c);
-      const glm::vec3 offset = folded.rotation * local[k].translation;
-      velocities[k] = v + glm::cross(w, offset) + folded.rotation * velocities[k];
-      angular_velocities[k] = w + folded.rotation * angular_velocities[k];
       local[k] = compose(folded, local[k]);
     }
     local[static_cast<size_t>(j)] = Transform{};
-    velocities[static_cast<size_t>(j)] = angular_velocities[static_cast<size_t>(j)] =
-        glm::vec3(0.0f);
   }
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
   local[0].translation =
@@ -721,6 +723,37 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   local[0].rotation = glm::normalize(map * local[0].rotation);
   velocities[0] = map * velocities[0];
   angular_velocities[0] = map * angular_velocities[0];
+}
+
+// The body's (joints 1..) velocities at a playback point, folded like sample_playback folds the
+// pose.
+void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
+                                        std::span<glm::vec3> angular_velocities) const {
+  const Database& db = *db_;
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const size_t k0 = static_cast<size_t>(at.frame0) * joints;
+  const size_t k1 = static_cast<size_t>(at.frame1) * joints;
+  for (size_t j = 1; j < joints; ++j) {
+    velocities[j] =
+        glm::mix(db.local_velocities()[k0 + j], db.local_velocities()[k1 + j], at.weight);
+    angular_velocities[j] = glm::mix(db.local_angular_velocities()[k0 + j],
+                                     db.local_angular_velocities()[k1 + j], at.weight);
+  }
+  for (const int j : folded_joints_) {
+    const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
+    const glm::vec3 v = velocities[static_cast<size_t>(j)];
+    const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
+    const int end = j + db.skeleton().subtree_size(j);
+    for (int c = j + 1; c < end; ++c) {
+      if (db.skeleton().parent(c) != j) continue;
+      const size_t k = static_cast<size_t>(c);
+      const glm::vec3 offset = folded * sample_joint(at, k).translation;
+      velocities[k] = v + glm::cross(w, offset) + folded * velocities[k];
+      angular_velocities[k] = w + folded * angular_velocities[k];
+    }
+    velocities[static_cast<size_t>(j)] = angular_velocities[static_cast<size_t>(j)] =
+        glm::vec3(0.0f);
+  }
 }
 
 void Controller::simulate(float dt) {
@@ -896,8 +929,8 @@ void Controller::synchronize(float dt) {
 // local pose before forward kinematics.
 float Controller::body_yaw() const {
   const std::span<const int> parents = db_->skeleton().parents();
-  const glm::vec3 left = forward_kinematics_joint(parents, locals_, leg_joints_[0][0]).translation;
-  const glm::vec3 right = forward_kinematics_joint(parents, locals_, leg_joints_[1][0]).translation;
+  const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
+  const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
   return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
 }
 
@@ -957,8 +990,8 @@ void Controller::turn_chest_to_facing(float dt) {
   float goal = 0.0f;
   if (strafing_) {
     const float chest_yaw =
-        pair_yaw(forward_kinematics_joint(parents, locals_, roles.left_upper_arm).translation,
-                 forward_kinematics_joint(parents, locals_, roles.right_upper_arm).translation,
+        pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
+                 forward_kinematics_position(parents, locals_, roles.right_upper_arm),
                  quat_yaw(locals_[0].rotation));
     const float error = wrap_angle(quat_yaw(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
@@ -972,7 +1005,7 @@ void Controller::turn_chest_to_facing(float dt) {
     if (joint < 0) continue;
     // A turn about the world's vertical, expressed in the joint's parent frame.
     const glm::quat parent =
-        forward_kinematics_joint(parents, locals_, db_->skeleton().parent(joint)).rotation;
+        forward_kinematics_rotation(parents, locals_, db_->skeleton().parent(joint));
     const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
     Transform& local = locals_[static_cast<size_t>(joint)];
     local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);

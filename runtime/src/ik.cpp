@@ -145,10 +145,13 @@ TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transf
   const TwoBoneIkResult r = solve_two_bone_ik(in);
   local[root].rotation = r.root_local;
   local[mid].rotation = r.mid_local;
-  // Parents come first, so one pass from the root on refreshes every descendant.
-  for (size_t i = static_cast<size_t>(root); i < parents.size(); ++i) {
-    const int p = parents[i];
-    global[i] = p < 0 ? local[i] : compose(global[p], local[i]);
+  // Parents come first, so one pass from the root on refreshes every descendant. Only the root's
+  // descendants move: every other joint's global already is the FK of its unchanged local.
+  global[root] = parents[root] < 0 ? local[root] : compose(global[parents[root]], local[root]);
+  for (size_t i = static_cast<size_t>(root) + 1; i < parents.size(); ++i) {
+    int ancestor = parents[i];
+    while (ancestor > root) ancestor = parents[ancestor];
+    if (ancestor == root) global[i] = compose(global[parents[i]], local[i]);
   }
   return r;
 }

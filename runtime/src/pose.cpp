@@ -23,6 +23,25 @@ Transform forward_kinematics_joint(std::span<const int> parents, std::span<const
   return t;
 }
 
+glm::vec3 forward_kinematics_position(std::span<const int> parents,
+                                      std::span<const Transform> local, int joint) {
+  MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < parents.size());
+  glm::vec3 position = local[joint].translation;
+  // compose(parent, t).translation, step by step up the chain.
+  for (int p = parents[joint]; p >= 0; p = parents[p]) {
+    position = local[p].rotation * (local[p].scale * position) + local[p].translation;
+  }
+  return position;
+}
+
+glm::quat forward_kinematics_rotation(std::span<const int> parents,
+                                      std::span<const Transform> local, int joint) {
+  MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < parents.size());
+  glm::quat rotation = local[joint].rotation;
+  for (int p = parents[joint]; p >= 0; p = parents[p]) rotation = local[p].rotation * rotation;
+  return rotation;
+}
+
 void bone_lengths(std::span<const int> parents, std::span<const Transform> global,
                   std::span<float> lengths) {
   MM_ASSERT(global.size() == parents.size() && lengths.size() == parents.size());

@@ -130,6 +130,22 @@ TEST(ForwardKinematics, SingleJointChainEqualsFullPass) {
   }
 }
 
+// The position-only and rotation-only walks are the full walk's parts to the bit: callers swap
+// one for the other without changing a result.
+TEST(ForwardKinematics, PositionAndRotationWalksEqualTheFullWalkExactly) {
+  Branching s;
+  for (size_t j = 0; j < s.local.size(); ++j) {
+    s.local[j].scale = glm::vec3(1.0f + 0.1f * static_cast<float>(j), 0.9f, 1.1f);
+  }
+  for (int j = 0; j < static_cast<int>(s.parents.size()); ++j) {
+    const Transform full = forward_kinematics_joint(s.parents, s.local, j);
+    const glm::vec3 position = forward_kinematics_position(s.parents, s.local, j);
+    const glm::quat rotation = forward_kinematics_rotation(s.parents, s.local, j);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(position[k], full.translation[k]) << j;
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(rotation[k], full.rotation[k]) << j;
+  }
+}
+
 TEST(ForwardKinematics, BoneLengthsOfRootIsItsTranslationLength) {
   const std::vector<int> parents{-1, 0};
   std::vector<Transform> local{at(3, 4, 0), at(0, 0, 2)};

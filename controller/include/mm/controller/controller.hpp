@@ -501,7 +501,9 @@ class Controller {
   PlaybackPoint playback_point() const;
   Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
   void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
-                       std::span<glm::vec3> angular_velocities) const;
+                       std::span<glm::vec3> angular_velocities, bool body_velocities) const;
+  void sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> angular_velocities) const;
   void root_motion(float dt);
   void synchronize(float dt);
   void move_root(const glm::vec3& position, const glm::quat& rotation);
@@ -581,6 +583,10 @@ class Controller {
   std::vector<Transform> sampled_;  // the playing animation (root in world space)
   std::vector<glm::vec3> sampled_velocities_;
   std::vector<glm::vec3> sampled_angular_velocities_;
+  // Where sampled_ was sampled, and whether its body (joints 1..) has velocities: only a
+  // transition reads them, so each update samples the root's alone and a transition the rest.
+  PlaybackPoint sampled_at_;
+  bool sampled_body_velocities_ = false;
   std::vector<Transform> other_;  // the other side of a transition
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;

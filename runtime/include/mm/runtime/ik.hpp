@@ -46,7 +46,7 @@ struct TwoBoneIkResult {
 TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& input);
 
 // Solves the chain root -> mid -> end of a pose in place: writes the new local rotations of
-// root and mid and recomputes the global transforms of every joint from root on. Requires
+// root and mid and recomputes the global transforms of root and its descendants. Requires
 // parents[mid] == root, parents[end] == mid, and `global` to be the FK of `local`.
 TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
                                   std::span<Transform> global, int root, int mid, int end,

@@ -20,6 +20,15 @@ void forward_kinematics(std::span<const int> parents, std::span<const Transform>
 Transform forward_kinematics_joint(std::span<const int> parents, std::span<const Transform> local,
                                    int joint);
 
+// forward_kinematics_joint(...).translation, to the bit, without the rotations and scales of the
+// chain (a position depends only on its ancestors' transforms, never on the accumulated
+// rotation below them).
+glm::vec3 forward_kinematics_position(std::span<const int> parents,
+                                      std::span<const Transform> local, int joint);
+// forward_kinematics_joint(...).rotation, to the bit, without the chain's translations.
+glm::quat forward_kinematics_rotation(std::span<const int> parents,
+                                      std::span<const Transform> local, int joint);
+
 // The facing of a body from a left/right pair of joints' global positions (the hips' from the
 // upper legs, the chest's from the upper arms): the yaw (radians about +Y, atan2(x, z), as
 // quat_yaw) of the horizontal vector (left - right) x up, or `fallback` when the pair has no
