@@ -57,8 +57,10 @@ struct ScriptEvent {
   float time = 0.0f;      // seconds
   ControllerInput input;  // camera_yaw in radians; input.tag views `tag` below
   std::string tag;        // owns the tag text (empty: none)
-  std::string style;      // the style=NAME text (empty: none); input.style is its id once resolved
   int line = 0;           // line number in the source, for messages
+  // The style=NAME text (empty: none); input.style is its id once resolved. Last, with an
+  // initializer, so that positional initializers of the fields above stay complete.
+  std::string style = {};
 };
 
 class InputScript {
