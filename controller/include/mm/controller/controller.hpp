@@ -193,7 +193,7 @@ struct ControllerSettings {
   // (normalized feature units; clips without a style pay none). Not a filter: where the style
   // has nothing close to what the stick asks, another style's frame wins (docs/controller.md,
   // Styles).
-  float style_cost = 2.0f;
+  float style_cost = 8.0f;
   // Frames within this time of the playing frame are not jumped to (s).
   float ignore_window = 0.2f;
   // The same while standing on an idle clip of the data (s). Such a clip plays through without
