@@ -16,6 +16,8 @@
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
 
+#include "controller_style.hpp"
+
 namespace mm {
 
 namespace {
@@ -422,6 +424,8 @@ void Controller::desired_motion(const ControllerInput& input) {
   if (world_ && !input.strafe && !facing_given) face_along_obstacle();
 
   tag_bits_ = resolve_tag(input.tag);
+  style_ = input.style >= 0 && input.style < shared_->style_count() ? input.style : -1;
+  debug_.requested_style = style_;
   const bool released = glm::length(move) == 0.0f;
   stopping_ = released && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
               glm::length(sim_velocity_) < settings_.stop_speed;
@@ -462,7 +466,10 @@ bool Controller::should_search() const {
       since_transition_ >= settings_.transition_cooldown && !playing_idle_through()) {
     return true;
   }
-  if (tag_bits_ != tag_bits_at_search_ || stopping_ != stopping_at_search_) return true;
+  if (tag_bits_ != tag_bits_at_search_ || stopping_ != stopping_at_search_ ||
+      style_ != style_at_search_) {
+    return true;
+  }
   if (glm::length(desired_velocity_ - desired_velocity_at_search_) >
       settings_.replan_velocity_change) {
     return true;
@@ -521,6 +528,7 @@ void Controller::search() {
   desired_velocity_at_search_ = desired_velocity_;
   desired_rotation_at_search_ = desired_rotation_;
   tag_bits_at_search_ = tag_bits_;
+  style_at_search_ = style_;
   stopping_at_search_ = stopping_;
   record_search(best);
   debug_.search_seconds =
@@ -539,10 +547,11 @@ SearchResult Controller::search_candidates() const {
   if (tag_bits_ == 0) {
     if (stopping_) {
       constraints.include_tags = shared_->idle_tags();
-    } else {
-      constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
+      return searcher_->search(query_, constraints);
     }
-    return searcher_->search(query_, constraints);
+    constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
+    return search_in_style(*searcher_, query_, constraints, shared_->style_tags(style_),
+                           shared_->all_style_tags(), settings_.style_cost);
   }
   // Any of the requested tags will do: one search per tag, the cheapest wins.
   SearchResult best;

@@ -129,6 +129,7 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   out->options_ = options;
   out->action_tags_ = tag_bit(db, "action");
   out->idle_tags_ = tag_bit(db, kIdleTag);
+  out->resolve_style_tags();
 
   const int excluded =
       clamped_integer<int>(std::round(options.clip_end_exclusion / db.frame_time()));

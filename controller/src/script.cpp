@@ -1,5 +1,7 @@
 #include "mm/controller/script.hpp"
 
+#include "mm/controller/controller.hpp"
+
 #include "mm/database/files.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 
@@ -154,6 +156,23 @@ InputScript::InputScript(std::vector<ScriptEvent> events) : events_(std::move(ev
 
 // A copied ScriptEvent still views the tag of the event it was copied from; `tag` is the owner,
 // so every view is rebuilt from it. (Moves keep the vector's buffer, hence the strings.)
+Status InputScript::resolve_styles(const ControllerDatabase& database,
+                                   std::string_view name_for_messages, int default_style) {
+  for (ScriptEvent& event : events_) {
+    if (event.style.empty()) {
+      event.input.style = default_style;
+      continue;
+    }
+    Result<int> id = database.style_id(event.style);
+    if (!id) {
+      return Error{std::string(name_for_messages) + ":" + std::to_string(event.line) + ": " +
+                   id.message()};
+    }
+    event.input.style = *id;
+  }
+  return Status::success();
+}
+
 void InputScript::repoint_tags() {
   for (ScriptEvent& event : events_) event.input.tag = event.tag;
 }
@@ -235,10 +254,11 @@ Status parse_time_and_sticks(const ScriptLine& line, const std::vector<ScriptEve
   return Status::success();
 }
 
-// The optional flags after the sticks, each at most once: run, strafe, tag=NAME,
+// The optional flags after the sticks, each at most once: run, strafe, tag=NAME, style=NAME,
 // camera=DEGREES.
 Status parse_flags(const ScriptLine& line, ScriptEvent& event) {
-  bool seen_run = false, seen_strafe = false, seen_tag = false, seen_camera = false;
+  bool seen_run = false, seen_strafe = false, seen_tag = false, seen_camera = false,
+       seen_style = false;
   // True the second time a flag is seen on this line.
   auto repeated = [](bool& seen) { return std::exchange(seen, true); };
   for (size_t index = 5; index < line.tokens.size(); ++index) {
@@ -262,6 +282,15 @@ Status parse_flags(const ScriptLine& line, ScriptEvent& event) {
                      quoted(token)};
       }
       event.tag = name;
+    } else if (token.starts_with("style=")) {
+      if (repeated(seen_style)) return twice("style=NAME");
+      const std::string_view name = token.substr(6);
+      if (name.empty() || !std::all_of(name.begin(), name.end(), is_tag_char)) {
+        return Error{line.where +
+                     "expected style=NAME with a name of letters, digits and _-.:+, found " +
+                     quoted(token)};
+      }
+      event.style = name;
     } else if (token.starts_with("camera=")) {
       if (repeated(seen_camera)) return twice("camera=DEGREES");
       float degrees = 0.0f;
@@ -272,7 +301,8 @@ Status parse_flags(const ScriptLine& line, ScriptEvent& event) {
       }
       event.input.camera_yaw = static_cast<float>(degrees * kRadiansPerDegree);
     } else {
-      return Error{line.where + "expected run, strafe, tag=NAME or camera=DEGREES, found " +
+      return Error{line.where +
+                   "expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found " +
                    quoted(token)};
     }
   }

@@ -209,6 +209,7 @@ DatabaseView::DatabaseView(const Database& db)
       contacts(db.contacts()),
       clips(db.clips()),
       tag_names(db.tag_names()),
+      style_names(db.style_names()),
       schema(db.schema()),
       features(db.features()),
       feature_offset(db.feature_offset()),
@@ -228,6 +229,7 @@ DatabaseView::DatabaseView(const DatabaseContents& db)
       contacts(db.contacts),
       clips(db.clips),
       tag_names(db.tag_names),
+      style_names(db.style_names),
       schema(db.schema),
       features(db.features),
       feature_offset(db.feature_offset),
@@ -288,6 +290,7 @@ Database& Database::operator=(Database&& other) noexcept {
   frame_count_ = std::exchange(other.frame_count_, 0);
   clips_ = std::move(other.clips_);
   tag_names_ = std::move(other.tag_names_);
+  style_names_ = std::move(other.style_names_);
   schema_ = std::move(other.schema_);
   // The block moves with its owner, so the views into it stay valid; the source keeps none.
   block_ = std::move(other.block_);
@@ -373,6 +376,7 @@ Result<Database> Database::create(const DatabaseContents& contents) {
   db.frame_count_ = contents.frame_count;
   db.clips_ = contents.clips;
   db.tag_names_ = contents.tag_names;
+  db.style_names_ = contents.style_names;
   db.schema_ = contents.schema;
   db.allocate(static_cast<size_t>(contents.frame_count),
               static_cast<size_t>(contents.joint_count()),
@@ -432,6 +436,7 @@ DatabaseContents Database::contents() const {
   out.contacts.assign(contacts_.begin(), contacts_.end());
   out.clips = clips_;
   out.tag_names = tag_names_;
+  out.style_names = style_names_;
   out.schema = schema_;
   out.features.assign(features_.begin(), features_.end());
   out.feature_offset.assign(feature_offset_.begin(), feature_offset_.end());
@@ -613,6 +618,34 @@ Status check_tags(const DatabaseView& db) {
   return Status::success();
 }
 
+// Style names: at most kMaxStyles, non-empty, distinct; every clip's style one of them or -1.
+Status check_styles(const DatabaseView& db) {
+  if (db.style_names.size() > kMaxStyles) {
+    return Error{"database: " + std::to_string(db.style_names.size()) + " style names; at most " +
+                 std::to_string(kMaxStyles) + " are allowed"};
+  }
+  for (size_t i = 0; i < db.style_names.size(); ++i) {
+    if (db.style_names[i].empty())
+      return Error{"database: style name " + std::to_string(i) + " is empty"};
+    for (size_t k = 0; k < i; ++k) {
+      if (db.style_names[k] == db.style_names[i]) {
+        return Error{"database: duplicate style name '" + db.style_names[i] + "' (styles " +
+                     std::to_string(k) + " and " + std::to_string(i) + ")"};
+      }
+    }
+  }
+  const int style_count = static_cast<int>(db.style_names.size());
+  for (size_t c = 0; c < db.clips.size(); ++c) {
+    const ClipRange& clip = db.clips[c];
+    if (clip.style < -1 || clip.style >= style_count) {
+      return Error{"database: clip " + std::to_string(c) + " '" + clip.name + "' has style " +
+                   std::to_string(clip.style) + ", but only " + std::to_string(style_count) +
+                   " styles exist (-1: none)"};
+    }
+  }
+  return Status::success();
+}
+
 // Clips tile [0, frame_count) in order (frame_clip is derived from them).
 Status check_clips(const DatabaseView& db) {
   return validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size());
@@ -687,7 +720,7 @@ Status validate_except_joint_values(const DatabaseView& db) {
   }
   for (Status (*check)(const DatabaseView&) :
        {check_skeleton, check_roles, check_frame_arrays, check_schema_and_features, check_tags,
-        check_clips, check_other_values}) {
+        check_styles, check_clips, check_other_values}) {
     if (Status s = check(db); !s) return s;
   }
   return Status::success();

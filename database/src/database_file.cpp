@@ -440,6 +440,8 @@ SectionSize expected_section_size(DatabaseSection section, const DatabaseFileInf
       return {dims * 4, 0, 0, 1, "feature_dims x 4"};
     case DatabaseSection::Searchable:
       return {frames, 0, 0, 1, "frame_count"};
+    case DatabaseSection::StyleNames:
+      return {0, 4, std::numeric_limits<uint64_t>::max(), 1, "a count and the style names"};
     case DatabaseSection::Count:
       break;
   }
@@ -546,6 +548,23 @@ Status read_string_list(std::span<const std::byte> file, const DatabaseFileInfo&
   return r.finish();
 }
 
+Status read_style_names(std::span<const std::byte> file, const DatabaseFileInfo& info,
+                        std::string_view name, std::vector<std::string>& out) {
+  SectionReader r(section_bytes(file, info, DatabaseSection::StyleNames),
+                  DatabaseSection::StyleNames, name);
+  uint32_t count = 0;
+  if (Status s = r.pod(count, "style count"); !s) return s;
+  if (count > kMaxStyles) {
+    return r.fail("style count " + std::to_string(count) + " is above the limit of " +
+                  std::to_string(kMaxStyles));
+  }
+  out.resize(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    if (Status s = r.string(out[i], "style " + std::to_string(i)); !s) return s;
+  }
+  return r.finish();
+}
+
 Status read_schema(std::span<const std::byte> file, const DatabaseFileInfo& info,
                    std::string_view name, FeatureSchema& schema) {
   SectionReader r(section_bytes(file, info, DatabaseSection::Schema), DatabaseSection::Schema,
@@ -599,7 +618,10 @@ Status read_clips(std::span<const std::byte> file, const DatabaseFileInfo& info,
       return r.fail(where + ": mirrored flag is " + std::to_string(mirrored) + ", expected 0 or 1");
     }
     if (Status s = r.zero_padding(3, where + " padding"); !s) return s;
+    int32_t style = -1;
+    if (Status s = r.pod(style, where + " style"); !s) return s;
     if (Status s = r.string(c.name, where + " name"); !s) return s;
+    c.style = style;
     c.start = start;
     c.end = end;
     c.mirrored = mirrored != 0;
@@ -715,6 +737,7 @@ Status read_small_sections(std::span<const std::byte> file, const DatabaseFileIn
       !s) {
     return s;
   }
+  if (Status s = read_style_names(file, info, name, db.style_names); !s) return s;
   // The per-clip sections are laid out by the clips, so these must tile the frames first.
   if (Status s = validate_clip_ranges(db.clips, db.frame_count, db.tag_names.size()); !s) {
     return Error{std::string(name) + ": " + s.message()};
@@ -912,6 +935,8 @@ const char* database_section_name(DatabaseSection section) {
       return "feature_scale";
     case DatabaseSection::Searchable:
       return "searchable";
+    case DatabaseSection::StyleNames:
+      return "style_names";
     case DatabaseSection::Count:
       break;
   }

@@ -145,11 +145,27 @@ Result<std::vector<Clip>> import_file(const fs::path& path, const BuildOptions& 
   return clips;
 }
 
-// Sets db.tag_names (sorted) and every clip's tag bits from its tag list (one per clip).
+// Sets db.tag_names (sorted) and every clip's tag bits from its tag list (one per clip), and
+// db.style_names (sorted) and every clip's style from its style name ("" for none).
 using Assembly = detail::DatabaseAssembly;
 
-Status assign_tags(Assembly::Parts db,
-                   const std::vector<std::vector<std::string>>& clip_tag_lists) {
+Status assign_tags(Assembly::Parts db, const std::vector<std::vector<std::string>>& clip_tag_lists,
+                   const std::vector<std::string>& clip_styles) {
+  std::set<std::string> style_set(clip_styles.begin(), clip_styles.end());
+  style_set.erase(std::string());
+  if (style_set.size() > kMaxStyles) {
+    return Error{"build: " + std::to_string(style_set.size()) + " distinct styles, at most " +
+                 std::to_string(kMaxStyles) + " fit a database"};
+  }
+  db.style_names.assign(style_set.begin(), style_set.end());
+  for (size_t r = 0; r < db.clips.size(); ++r) {
+    const std::string& style = clip_styles[r];
+    db.clips[r].style = style.empty()
+                            ? -1
+                            : static_cast<int>(std::lower_bound(db.style_names.begin(),
+                                                                db.style_names.end(), style) -
+                                               db.style_names.begin());
+  }
   std::set<std::string> tag_set;
   for (const std::vector<std::string>& tags : clip_tag_lists)
     tag_set.insert(tags.begin(), tags.end());
@@ -260,6 +276,7 @@ struct BuildState {
   std::vector<int> mirror_map;  // per source joint (only with options.mirror)
   std::vector<ClipJob> jobs;
   std::vector<std::vector<std::string>> clip_tag_lists;  // per database clip
+  std::vector<std::string> clip_styles;                  // per database clip, "" for none
   size_t total_frames = 0;
   // BuildOptions::target with its roles, when given: the database skeleton's input.
   std::optional<InputResult> target;
@@ -543,6 +560,7 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
         state.jobs.push_back({i, c, mirrored, db.clips.size()});
         db.clips.push_back(std::move(range));
         state.clip_tag_lists.push_back(clip_tags(clip.name, mirrored, state.context.tag_rules));
+        state.clip_styles.push_back(clip_style(clip.name, state.context.tag_rules));
       }
     }
   }
@@ -570,8 +588,9 @@ Status lay_out_clips(BuildState& state, int idle_frames) {
     std::sort(tags.begin(), tags.end());
     tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
     state.clip_tag_lists.push_back(std::move(tags));
+    state.clip_styles.push_back(clip_style(kIdleClipName, state.context.tag_rules));
   }
-  if (Status s = assign_tags(db, state.clip_tag_lists); !s) return s;
+  if (Status s = assign_tags(db, state.clip_tag_lists, state.clip_styles); !s) return s;
   if (data_idles) {
     state.data_idle_tag = state.db.tag_mask(std::vector<std::string>{kIdleTag});
   }
@@ -662,7 +681,9 @@ Status add_idle_clip(BuildState& state) {
   state.total_frames -= static_cast<size_t>(idle.frame_count());
   db.clips.pop_back();
   state.clip_tag_lists.pop_back();
-  if (Status s = assign_tags(db, state.clip_tag_lists); !s) return Error{s.message()};
+  state.clip_styles.pop_back();
+  if (Status s = assign_tags(db, state.clip_tag_lists, state.clip_styles); !s)
+    return Error{s.message()};
   Assembly::keep_frames(state.db, state.total_frames);
   return Status::success();
 }

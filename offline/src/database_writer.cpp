@@ -193,6 +193,7 @@ void write_clips(ByteWriter& w, std::span<const ClipRange> clips) {
     w.pod(c.tags);
     w.pod(static_cast<uint8_t>(c.mirrored ? 1 : 0));
     w.zeros(3);
+    w.pod(static_cast<int32_t>(c.style));
     w.string(c.name);
   }
 }
@@ -268,6 +269,8 @@ size_t expected_file_size(const DatabaseView& db, const PositionLayout& layout) 
   size_t bytes = kDatabaseHeaderSize + 16 * kDatabaseSectionCount + kChecksumSize;
   for (const std::string& s : db.skeleton.names()) bytes += s.size() + 4;
   for (const std::string& s : db.tag_names) bytes += s.size() + 4;
+  bytes += 4;
+  for (const std::string& s : db.style_names) bytes += s.size() + 4;
   for (const ClipRange& c : db.clips) bytes += c.name.size() + kMinClipBytes;
   for (const FeatureChannel& c : db.schema.channels) {
     bytes += c.name.size() + c.bone.size() + c.times.size() * 4 + kMinChannelBytes;
@@ -345,6 +348,10 @@ std::vector<std::byte> serialize_database(const DatabaseView& db) {
   section(DatabaseSection::FeatureOffset, [&] { w.array(db.feature_offset); });
   section(DatabaseSection::FeatureScale, [&] { w.array(db.feature_scale); });
   section(DatabaseSection::Searchable, [&] { w.array(db.searchable); });
+  section(DatabaseSection::StyleNames, [&] {
+    w.pod(static_cast<uint32_t>(db.style_names.size()));
+    for (const std::string& n : db.style_names) w.string(n);
+  });
 
   for (size_t i = 0; i < kDatabaseSectionCount; ++i) {
     w.patch(kOffSectionTable + 16 * i, table[i].offset);

@@ -82,12 +82,23 @@ Result<std::vector<TagRule>> parse_tag_manifest(std::string_view text,
     const std::string where =
         std::string(path_for_messages) + ":" + std::to_string(line_number) + ": ";
     if (words.size() < 2) {
-      return Error{where + "expected '<glob> <tag> [<tag> ...]', found only '" + words[0] + "'"};
+      return Error{where + "expected '<glob> <tag>|style=NAME ...', found only '" + words[0] + "'"};
     }
     TagRule rule;
     rule.pattern = words[0];
     rule.line = line_number;
     for (size_t w = 1; w < words.size(); ++w) {
+      if (words[w].starts_with("style=")) {
+        const std::string style = words[w].substr(6);
+        if (!rule.style.empty()) return Error{where + "two styles on one line"};
+        if (style.empty() || !std::all_of(style.begin(), style.end(), is_tag_char)) {
+          return Error{where +
+                       "expected style=NAME with a name of letters, digits and _-.:+, found '" +
+                       words[w] + "'"};
+        }
+        rule.style = style;
+        continue;
+      }
       const std::string& tag = words[w];
       const auto bad = std::find_if(tag.begin(), tag.end(), [](char c) { return !is_tag_char(c); });
       if (bad != tag.end()) {
@@ -130,6 +141,20 @@ std::vector<std::string> tags_from_name(std::string_view clip_name) {
   return tags;
 }
 
+std::string clip_style(std::string_view clip_name, const std::vector<TagRule>& rules) {
+  std::string style;
+  for (const TagRule& rule : rules) {
+    if (!rule.style.empty() && glob_match(rule.pattern, clip_name)) style = rule.style;
+  }
+  if (!style.empty()) return style;
+  const std::vector<std::string_view> parts = split(clip_name, '_');
+  if (parts.size() == 4 && parts[0].starts_with("dataset-") && all_digits(parts[0].substr(8)) &&
+      !parts[1].empty() && !parts[2].empty() && all_digits(parts[3])) {
+    return std::string(parts[2]);
+  }
+  return {};
+}
+
 std::string swap_left_right(std::string_view tag) {
   // Only whole words swap: "left" not preceded by a letter, and no word continues in lower
   // case after it ("leftover", "straight" stay); "Left"/"Right" may also start a camel-case
@@ -165,8 +190,9 @@ std::vector<std::string> clip_tags(std::string_view clip_name, bool mirrored,
                                    const std::vector<TagRule>& rules) {
   std::vector<std::string> tags = tags_from_name(clip_name);
   for (const TagRule& rule : rules) {
-    if (glob_match(rule.pattern, clip_name))
-      tags.insert(tags.end(), rule.tags.begin(), rule.tags.end());
+    if (!glob_match(rule.pattern, clip_name)) continue;
+    tags.insert(tags.end(), rule.tags.begin(), rule.tags.end());
+    if (!rule.style.empty()) tags.push_back(rule.style);
   }
   if (mirrored) {
     for (std::string& tag : tags) tag = swap_left_right(tag);

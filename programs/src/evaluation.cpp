@@ -114,6 +114,12 @@ struct ResponseEvent {
 
 // Everything the metrics need from earlier frames, and their running sums.
 struct EvaluationAccumulator::State {
+  // Styles: moving frames with a request and those matching it; the open request.
+  int style_frames = 0, style_matches = 0;
+  int style_requests = 0;
+  int style_request_start = -1;  // frame of the open request, -1 when none is open
+  RunningMean style_times;
+  void measure_style(const EvaluationFrame& r);
   JointRoleIndices roles;
   size_t joint_count = 0;
   float dt = 0.0f;
@@ -201,6 +207,7 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   s.measure_stand_turn(frame, hips_rate);
   s.measure_chest_and_head(frame);
   s.measure_transition_accel(frame);
+  s.measure_style(frame);
   GroundFrame ground;
   ground.joints = frame.joints;
   std::copy(std::begin(frame.toe_ground), std::end(frame.toe_ground), ground.toe_ground);
@@ -210,6 +217,25 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   ground.stuck = frame.stuck;
   s.ground->add(ground);
   s.remember(frame);
+}
+
+void EvaluationAccumulator::State::measure_style(const EvaluationFrame& r) {
+  const bool requested = r.requested_style >= 0;
+  if (requested && (frames == 0 || r.requested_style != previous.requested_style)) {
+    ++style_requests;
+    style_request_start = frames;
+  } else if (!requested) {
+    style_request_start = -1;
+  }
+  const bool match = requested && r.clip_style == r.requested_style;
+  if (match && style_request_start >= 0) {
+    style_times.add(static_cast<double>(frames - style_request_start) * dt);
+    style_request_start = -1;
+  }
+  if (requested && glm::length(r.desired_velocity) > kStyleMovingSpeed) {
+    ++style_frames;
+    style_matches += match ? 1 : 0;
+  }
 }
 
 // The earlier frames' positions shifted into this frame's origin (a whole number of metres,
@@ -425,6 +451,11 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.stand_foot_speed_cm_s_mean = s.stand_foot.value();
   m.stand_frames = s.stand_root.count;
   m.transitions_per_s = m.seconds > 0.0 ? s.transitions / m.seconds : 0.0;
+  m.style_frames = s.style_frames;
+  m.style_match = s.style_frames > 0 ? static_cast<double>(s.style_matches) / s.style_frames : -1.0;
+  m.style_requests = s.style_requests;
+  m.style_requests_reached = static_cast<int>(s.style_times.count);
+  m.style_response_s = s.style_times.value();
   m.search_us_mean = s.searches.value();
   m.update_us_mean = s.updates.value();
   m.transition_accel_p99 = s.accelerations.percentile(99.0);
@@ -504,6 +535,11 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.desired_yaw = quat_yaw(d.desired_rotation);
   r.transition = d.transitioned;
   r.clip = d.clip;
+  r.clip_style =
+      d.clip >= 0
+          ? controller.controller_database().database().clips()[static_cast<size_t>(d.clip)].style
+          : -1;
+  r.requested_style = d.requested_style;
   r.frame = d.frame;
   r.contact[0] = d.contact[0];
   r.contact[1] = d.contact[1];

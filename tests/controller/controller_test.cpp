@@ -10,6 +10,7 @@
 
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/script.hpp"
 
 namespace mm {
 namespace {
@@ -616,6 +617,58 @@ TEST(ControllerTest, ALongStandLeavesNoSubnormalState) {
   }
   EXPECT_EQ(c.debug().simulation_velocity, glm::vec3(0.0f));
   EXPECT_EQ(c.debug().simulation_acceleration, glm::vec3(0.0f));
+}
+
+}  // namespace
+}  // namespace mm
+
+namespace mm {
+namespace {
+
+TEST(ControllerStyles, StyleNamesResolveToIdsAndAnUnknownOneIsAClearError) {
+  const auto shared = normal_controller_database();
+  const Result<int> normal = shared->style_id("normal");
+  ASSERT_TRUE(normal) << normal.message();
+  EXPECT_EQ(shared->database().style_names()[static_cast<size_t>(*normal)], "normal");
+  EXPECT_NE(shared->style_tags(*normal), 0u);
+  EXPECT_EQ(shared->style_tags(-1), 0u);
+  const Result<int> elderly = shared->style_id("elderly");
+  ASSERT_FALSE(elderly);
+  EXPECT_EQ(elderly.message(), "unknown style 'elderly'; the database's styles are normal");
+}
+
+TEST(ControllerStyles, AScriptStyleResolvesAndAnUnknownOneNamesTheLine) {
+  const auto shared = normal_controller_database();
+  Result<InputScript> script =
+      parse_input_script("0 0 1 0 0 style=normal\n1 0 1 0 0\n", "styles.txt");
+  ASSERT_TRUE(script) << script.message();
+  ASSERT_TRUE(script->resolve_styles(*shared, "styles.txt", -1).ok());
+  EXPECT_EQ(script->at(0.5f).style, *shared->style_id("normal"));
+  EXPECT_EQ(script->at(1.5f).style, -1);  // no style on the line, no default: any
+
+  Result<InputScript> bad = parse_input_script("0 0 1 0 0\n\n2 0 1 0 0 style=proud\n", "bad.txt");
+  ASSERT_TRUE(bad) << bad.message();
+  const Status s = bad->resolve_styles(*shared, "bad.txt", -1);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message(), "bad.txt:3: unknown style 'proud'; the database's styles are normal");
+}
+
+TEST(ControllerStyles, TheRequestedStyleIsWhatPlaysOnTheNormalData) {
+  const auto shared = normal_controller_database();
+  Result<Controller> made = Controller::create(shared);
+  ASSERT_TRUE(made) << made.message();
+  Controller& controller = *made;
+  ControllerInput input;
+  input.left_stick = {0.0f, 1.0f};
+  input.style = *shared->style_id("normal");
+  for (int i = 0; i < 120; ++i) controller.update(1.0f / 60.0f, input);
+  EXPECT_EQ(controller.debug().requested_style, input.style);
+  const int clip = controller.debug().clip;
+  ASSERT_GE(clip, 0);
+  EXPECT_EQ(shared->database().clips()[static_cast<size_t>(clip)].style, input.style);
+  input.style = 99;  // not a style of the database: any
+  controller.update(1.0f / 60.0f, input);
+  EXPECT_EQ(controller.debug().requested_style, -1);
 }
 
 }  // namespace

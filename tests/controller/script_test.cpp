@@ -284,19 +284,23 @@ TEST(InputScript, EveryMalformedLineIsRefusedWithItsMessage) {
        "walk.txt:4: expected a time >= 3 (the time of line 3), found '2.999'"},
       // Unknown words.
       {"0 0 0 0 0 jump\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'jump'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'jump'"},
       {"0 0 0 0 0 0.5\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found '0.5'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found '0.5'"},
       {"0 0 0 0 0 Run\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'Run'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'Run'"},
       {"0 0 0 0 0 running\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'running'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'running'"},
       {"0 0 0 0 0 tag\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'tag'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'tag'"},
       {"0 0 0 0 0 camera\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'camera'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'camera'"},
       {"0 0 0 0 0 yaw=90\n",
-       "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found 'yaw=90'"},
+       "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found 'yaw=90'"},
+      {"0 0 0 0 0 style=\n",
+       "walk.txt:1: expected style=NAME with a name of letters, digits and _-.:+, found 'style='"},
+      {"0 0 0 0 0 style=a style=b\n",
+       "walk.txt:1: expected style=NAME at most once on a line, found 'style=b' again"},
       // Duplicate flags.
       {"0 0 0 0 0 run strafe run\n",
        "walk.txt:1: expected run at most once on a line, found 'run' again"},
@@ -343,7 +347,8 @@ TEST(InputScript, MessagesGiveTheNameAndTheLineOfALongFile) {
   for (int i = 0; i < 40; ++i) text += std::to_string(i) + " 0 1 0 0\n";
   text += "40 0 1 0 0 walk\n";  // line 42
   EXPECT_EQ(parse_error(text, "scripts/input/long.txt"),
-            "scripts/input/long.txt:42: expected run, strafe, tag=NAME or camera=DEGREES, found "
+            "scripts/input/long.txt:42: expected run, strafe, tag=NAME, style=NAME or "
+            "camera=DEGREES, found "
             "'walk'");
   // The first malformed line is the one reported.
   EXPECT_EQ(parse_error("0 0 0 0 0\n1 x 0 0 0\n2 y 0 0 0\n", "a.txt"),
@@ -403,8 +408,9 @@ TEST(InputScript, RunsOutsideTheLimitsAreRefusedWithTheirValues) {
 TEST(InputScript, ALongTokenIsCutInTheMessage) {
   const std::string token(500, 'z');
   const std::string message = parse_error("0 0 0 0 0 " + token + "\n");
-  EXPECT_EQ(message, "walk.txt:1: expected run, strafe, tag=NAME or camera=DEGREES, found '" +
-                         std::string(40, 'z') + "...'");
+  EXPECT_EQ(message,
+            "walk.txt:1: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found '" +
+                std::string(40, 'z') + "...'");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -573,9 +579,10 @@ TEST(InputScript, LoadReadsAFileAndNamesItInMessages) {
   std::ofstream(bad) << "0 0 1 0 0\n1 0 0 0 0 jump\n";
   Result<InputScript> refused = load_input_script(bad);
   ASSERT_FALSE(refused.ok());
-  EXPECT_EQ(refused.message(), bad.string() +
-                                   ":2: expected run, strafe, tag=NAME or camera=DEGREES, found "
-                                   "'jump'");
+  EXPECT_EQ(refused.message(),
+            bad.string() +
+                ":2: expected run, strafe, tag=NAME, style=NAME or camera=DEGREES, found "
+                "'jump'");
 }
 
 TEST(InputScript, LoadOfAMissingFileOrAFolderNamesThePath) {

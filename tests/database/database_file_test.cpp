@@ -177,7 +177,7 @@ TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
   std::memcpy(&version, bytes.data() + 8, 4);
   std::memcpy(&marker, bytes.data() + 12, 4);
   std::memcpy(&size, bytes.data() + 16, 8);
-  EXPECT_EQ(version, 3u);
+  EXPECT_EQ(version, 4u);
   EXPECT_EQ(marker, 0x01020304u);
   EXPECT_EQ(size, bytes.size());
 
@@ -233,8 +233,8 @@ TEST(DatabaseFile, LayoutMatchesTheDocumentedFormat) {
   std::memcpy(&predicted_bits, &predicted, 4);
   std::memcpy(&actual_bits, &magnitude, 4);
   EXPECT_EQ(actual_bits - predicted_bits, (code >> 3) - 16);
-  // Velocities are not stored at all.
-  EXPECT_EQ(bytes.size(), info->section(DatabaseSection::Searchable).offset + 20 + 8);
+  // Velocities are not stored at all; the style names (none here: a count of 0) come last.
+  EXPECT_EQ(bytes.size(), info->section(DatabaseSection::StyleNames).offset + 4 + 8);
   // The last 8 bytes are the checksum of everything before them.
   uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
@@ -474,11 +474,11 @@ TEST(DatabaseFile, WrongMagicVersionAndEndiannessHaveSpecificMessages) {
   }
   EXPECT_TRUE(contains(load_error(mangled), "text-mode")) << load_error(mangled);
 
-  const std::string newer = load_error(patched(bytes, 8, uint32_t{4}));
-  EXPECT_TRUE(contains(newer, "format version 4 is newer than the version this program reads (3)"))
+  const std::string newer = load_error(patched(bytes, 8, uint32_t{5}));
+  EXPECT_TRUE(contains(newer, "format version 5 is newer than the version this program reads (4)"))
       << newer;
   const std::string older = load_error(patched(bytes, 8, uint32_t{0}));
-  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (3)"))
+  EXPECT_TRUE(contains(older, "format version 0 is older than the version this program reads (4)"))
       << older;
 
   const std::string swapped = load_error(patched(bytes, 12, uint32_t{0x04030201}));
@@ -587,7 +587,7 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
   const std::vector<std::byte> bytes = serialize_database(db);
   const uint64_t parents = section_offset(bytes, DatabaseSection::SkeletonParents);
   const uint64_t clips = section_offset(bytes, DatabaseSection::Clips);
-  const uint64_t clip1 = clips + 24 + db.clips[0].name.size();
+  const uint64_t clip1 = clips + 28 + db.clips[0].name.size();
   const uint64_t features = section_offset(bytes, DatabaseSection::Features);
   const uint64_t scale = section_offset(bytes, DatabaseSection::FeatureScale);
   const uint64_t rotations = section_offset(bytes, DatabaseSection::RotationComponents);
@@ -607,6 +607,8 @@ TEST(DatabaseFile, ResealedCorruptionsAreFoundBySemanticValidation) {
        "clip 0 'walk_take' has range [0, 25)"},
       {"clips overlap", patched(bytes, clip1, int32_t{10}),
        "clip 1 'run_take_mirror' starts at frame 10, expected 12"},
+      {"style out of range", patched(bytes, clips + 20, int32_t{3}),
+       "clip 0 'walk_take' has style 3, but only 0 styles exist (-1: none)"},
       {"unknown tag bit", patched(bytes, clip1 + 8, uint64_t{1} << 5),
        "clip 1 'run_take_mirror' has tag bit 5 set, but only 3 tags exist"},
       {"NaN feature", patched(bytes, features + 4 * (3 * kDims + 2), nan),
@@ -640,9 +642,54 @@ TEST(DatabaseFile, FormatVersion1FileIsRefusedWithARebuildMessage) {
                                      read_database_header(path).message()}) {
     EXPECT_TRUE(contains(message,
                          "format version 1 is older than the version this program "
-                         "reads (3); rebuild the database with `mm build`"))
+                         "reads (4); rebuild the database with `mm build`"))
         << message;
   }
+}
+
+TEST(DatabaseFile, Version3FileWithoutStylesIsRefusedWithARebuildMessage) {
+  const std::vector<std::byte> version3 = patched(serialize_database(make_database()), 8, 3u);
+  EXPECT_TRUE(contains(load_error(version3),
+                       "format version 3 is older than the version this program reads (4); "
+                       "rebuild the database with `mm build`"))
+      << load_error(version3);
+}
+
+TEST(DatabaseFile, ClipStylesAndStyleNamesRoundTrip) {
+  DatabaseContents contents = make_database().contents();
+  ASSERT_GE(contents.clips.size(), 1u);
+  contents.style_names = {"proud", "tired"};
+  contents.clips[0].style = 1;
+  for (size_t c = 1; c < contents.clips.size(); ++c) contents.clips[c].style = -1;
+  Result<Database> db = Database::create(contents);
+  ASSERT_TRUE(db) << db.message();
+  const auto path = test::scratch_dir() / "styles.mmdb";
+  write_file(path, serialize_database(*db));
+  Result<Database> loaded = load_database(path);
+  ASSERT_TRUE(loaded) << loaded.message();
+  ASSERT_EQ(loaded->style_names().size(), 2u);
+  EXPECT_EQ(loaded->style_names()[0], "proud");
+  EXPECT_EQ(loaded->style_names()[1], "tired");
+  EXPECT_EQ(loaded->clips()[0].style, 1);
+  if (loaded->clips().size() > 1) {
+    EXPECT_EQ(loaded->clips()[1].style, -1);
+  }
+}
+
+TEST(DatabaseFile, AClipStyleOutsideTheStyleNamesIsRefused) {
+  DatabaseContents contents = make_database().contents();
+  contents.style_names = {"proud"};
+  contents.clips[0].style = 1;
+  const Result<Database> db = Database::create(contents);
+  ASSERT_FALSE(db);
+  EXPECT_TRUE(contains(db.message(), "has style 1, but only 1 styles exist (-1: none)"))
+      << db.message();
+  contents.clips[0].style = 0;
+  contents.style_names = {"proud", "proud"};
+  const Result<Database> twice = Database::create(contents);
+  ASSERT_FALSE(twice);
+  EXPECT_TRUE(contains(twice.message(), "duplicate style name 'proud' (styles 0 and 1)"))
+      << twice.message();
 }
 
 // ---------------------------------------------------------------------------------------------

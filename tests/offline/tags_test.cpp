@@ -123,3 +123,36 @@ TEST(TagsFromName, ReActIdleNamesAreIdle) {
 
 }  // namespace
 }  // namespace mm
+
+namespace mm {
+namespace {
+
+using StyleTags = std::vector<std::string>;
+
+TEST(ClipStyle, FromBandaiNamesAndManifestLines) {
+  EXPECT_EQ(clip_style("dataset-1_run_not-confident_002", {}), "not-confident");
+  EXPECT_EQ(clip_style("dataset-2_walk-turn-left_elderly_031", {}), "elderly");
+  EXPECT_EQ(clip_style("003_genuine", {}), "");  // idle: serves every style
+  EXPECT_EQ(clip_style("my_walk", {}), "");
+  auto rules = parse_tag_manifest("my_* walk style=sneaky\nmy_run* style=hurried\n", "m.txt");
+  ASSERT_TRUE(rules) << rules.message();
+  EXPECT_EQ(clip_style("my_walk", *rules), "sneaky");
+  EXPECT_EQ(clip_style("my_run_01", *rules), "hurried");  // the last matching line wins
+  // The style is a tag too (its search filter bit), and "style=..." is not a tag.
+  EXPECT_EQ(clip_tags("my_walk", false, *rules), (StyleTags{"sneaky", "walk"}));
+}
+
+TEST(ClipStyle, BadManifestStylesAreRefusedWithTheLine) {
+  auto empty = parse_tag_manifest("a* walk style=\n", "m.txt");
+  ASSERT_FALSE(empty);
+  EXPECT_NE(empty.message().find("m.txt:1: expected style=NAME with a name of letters"),
+            std::string::npos)
+      << empty.message();
+  auto twice = parse_tag_manifest("\na* style=x style=y\n", "m.txt");
+  ASSERT_FALSE(twice);
+  EXPECT_NE(twice.message().find("m.txt:2: two styles on one line"), std::string::npos)
+      << twice.message();
+}
+
+}  // namespace
+}  // namespace mm

@@ -41,6 +41,44 @@ void print_joint_map(FILE* out, const Skeleton& skeleton, const JointRoleIndices
   }
 }
 
+// One line per style: clips, duration, and which kinds of motion it has, from the clips' motion
+// tags (a Bandai name's content word).
+void print_styles(FILE* out, const Database& db) {
+  if (db.style_names().empty()) return;
+  const std::pair<const char*, const char*> kinds[] = {
+      {"walk", "walk"},         {"run", "run"},           {"dash", "run"},
+      {"walk-turn", "turns"},   {"walk-left", "strafes"}, {"walk-right", "strafes"},
+      {"walk-back", "backward"}};
+  std::fprintf(out, "styles:      %zu (clips without one, such as idle, serve every style)\n",
+               db.style_names().size());
+  for (size_t s = 0; s < db.style_names().size(); ++s) {
+    int clips = 0;
+    long long frames = 0;
+    std::vector<std::string> covers;
+    for (const ClipRange& c : db.clips()) {
+      if (c.style != static_cast<int>(s)) continue;
+      ++clips;
+      frames += c.frame_count();
+      for (size_t t = 0; t < db.tag_names().size() && t < 64; ++t) {
+        if (!(c.tags & (uint64_t{1} << t))) continue;
+        for (const auto& [prefix, kind] : kinds) {
+          if (db.tag_names()[t].starts_with(prefix) &&
+              std::find(covers.begin(), covers.end(), kind) == covers.end())
+            covers.emplace_back(kind);
+        }
+      }
+    }
+    std::string list;
+    for (const std::string& k : covers) list += (list.empty() ? "" : ", ") + k;
+    std::fprintf(out, "  %-24s %5d clips %8.1f s  %s\n", db.style_names()[s].c_str(), clips,
+                 static_cast<double>(frames) * db.frame_time(), list.c_str());
+  }
+  int styleless = 0;
+  for (const ClipRange& c : db.clips()) styleless += c.style < 0 ? 1 : 0;
+  std::fprintf(out, "  %-24s %5d clips (idle: %s)\n", "(none)", styleless,
+               db.tag_mask(std::vector<std::string>{kIdleTag}) != 0 ? "yes" : "no");
+}
+
 void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
                             const std::string& idle_source) {
   int mirrored = 0;
@@ -84,8 +122,14 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
   std::fprintf(out, "features:    %d dimensions in %zu channels:", db.feature_dims(),
                db.schema().channels.size());
   for (const FeatureChannel& c : db.schema().channels) std::fprintf(out, " %s", c.name.c_str());
-  std::fprintf(out, "\ntags:        %zu\n", db.tag_names().size());
+  const auto is_style = [&](const std::string& tag) {
+    return std::find(db.style_names().begin(), db.style_names().end(), tag) !=
+           db.style_names().end();
+  };
+  std::fprintf(out, "\ntags:        %zu (motion and action tags; the styles' own tags below)\n",
+               db.tag_names().size());
   for (size_t t = 0; t < db.tag_names().size() && t < 64; ++t) {
+    if (is_style(db.tag_names()[t])) continue;
     int clips = 0;
     long long frames = 0;
     for (const ClipRange& c : db.clips()) {
@@ -96,6 +140,7 @@ void print_database_summary(FILE* out, const Database& db, uint64_t file_bytes,
     }
     std::fprintf(out, "  %-24s %5d clips %8lld frames\n", db.tag_names()[t].c_str(), clips, frames);
   }
+  print_styles(out, db);
   if (file_bytes > 0) std::fprintf(out, "file size:   %s\n", format_bytes(file_bytes).c_str());
 }
 

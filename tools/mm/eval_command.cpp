@@ -31,6 +31,7 @@ struct Arguments {
   std::string dump_path;
   std::string start;  // "X,Z", validated by the parser
   std::string world_path;
+  std::string style;  // --style: the style of every script line without one
 };
 
 // --start farther than this (m) is a typo, not a world: even a planet is smaller.
@@ -52,6 +53,10 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
   set_up_app(app);
   app.footer("exit status: 0 fine, 1 bad database or script, 2 bad usage");
   app.add_option("--db", out.db, "the database")->required()->type_name("FILE");
+  app.add_option("--style", out.style,
+                 "request this style on every script line without a style=NAME (an unknown "
+                 "style is an error listing the database's styles)")
+      ->type_name("NAME");
   app.add_option("--script", out.scripts, "the input script; repeatable")
       ->required()
       ->type_name("FILE")
@@ -167,6 +172,12 @@ void print_ground_metrics(const EvaluationMetrics& m) {
 }
 
 void print_metrics(const EvaluationMetrics& m) {
+  if (m.style_requests > 0) {
+    std::printf("style_match                 %10.3f   (%d moving frames with a style request)\n",
+                m.style_match, m.style_frames);
+    std::printf("style_response_s            %10.3f   (%d of %d requests reached)\n",
+                m.style_response_s, m.style_requests_reached, m.style_requests);
+  }
   std::printf("foot_skate_cm_s_mean        %10.3f\n", m.foot_skate_cm_s_mean);
   std::printf("foot_skate_cm_s_p95         %10.3f\n", m.foot_skate_cm_s_p95);
   std::printf("root_sim_distance_cm_mean   %10.3f\n", m.root_sim_distance_cm_mean);
@@ -234,8 +245,21 @@ int run_eval(const std::vector<std::string>& args) {
   nlohmann::json runs = nlohmann::json::array();
   std::vector<std::pair<std::string, EvaluationMetrics>> rows;
   nlohmann::json single;
+  int default_style = -1;
+  if (!arguments.style.empty()) {
+    Result<int> id = (*shared)->style_id(arguments.style);
+    if (!id) {
+      std::fprintf(stderr, "mm eval: --style: %s\n", id.message().c_str());
+      return 1;
+    }
+    default_style = *id;
+  }
   for (const std::string& path : arguments.scripts) {
     Result<InputScript> script = load_input_script(path);
+    if (script) {
+      if (Status s = script->resolve_styles(**shared, path, default_style); !s)
+        script = Error{s.message()};
+    }
     if (!script) {
       std::fprintf(stderr, "mm eval: %s\n", script.message().c_str());
       return 1;

@@ -120,6 +120,17 @@ class ControllerDatabase {
   // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
   uint64_t action_tags() const { return action_tags_; }
   uint64_t idle_tags() const { return idle_tags_; }
+  // Styles (controller_style.cpp). The id of a style name of the database, or an error naming
+  // the style and the styles there are; call it outside update() and pass the id in
+  // ControllerInput::style.
+  Result<int> style_id(std::string_view name) const;
+  int style_count() const { return static_cast<int>(style_tags_.size()); }
+  // The tag bit that filters a style's clips (the builder makes every style a tag too), 0 for
+  // an id out of range; and the bits of every style.
+  uint64_t style_tags(int style) const {
+    return style >= 0 && style < style_count() ? style_tags_[static_cast<size_t>(style)] : 0;
+  }
+  uint64_t all_style_tags() const { return all_style_tags_; }
   // The candidate flags the searchers are built over (searchable and not near a clip end).
   std::span<const uint8_t> candidates() const { return candidates_; }
 
@@ -135,6 +146,9 @@ class ControllerDatabase {
   float lowest_foot_end_[2] = {0.0f, 0.0f};
   uint64_t action_tags_ = 0;
   uint64_t idle_tags_ = 0;
+  std::vector<uint64_t> style_tags_;  // per style id
+  uint64_t all_style_tags_ = 0;
+  void resolve_style_tags();
   struct SearcherEntry {
     std::string method;
     std::unique_ptr<Searcher> searcher;
@@ -176,6 +190,11 @@ struct ControllerSettings {
   float search_interval = 0.1f;           // s between searches while nothing changes
   // Extra cost every candidate but the continuation pays (normalized feature units).
   float transition_cost = 1.0f;
+  // Extra cost a locomotion frame pays when its clip has a style other than the requested one
+  // (normalized feature units; clips without a style pay none). Not a filter: where the style
+  // has nothing close to what the stick asks, another style's frame wins (docs/controller.md,
+  // Styles).
+  float style_cost = 8.0f;
   // Frames within this time of the playing frame are not jumped to (s).
   float ignore_window = 0.2f;
   // The same while standing on an idle clip of the data (s). Such a clip plays through without
@@ -319,6 +338,7 @@ struct ControllerDebug {
 
   // Playback.
   int clip = -1;              // index into database().clips()
+  int requested_style = -1;   // ControllerInput::style as understood (-1: any)
   int frame = -1;             // the database frame nearest the playback time
   float clip_time = 0.0f;     // seconds since the clip's first frame
   bool transitioned = false;  // this update jumped to a new frame
@@ -556,6 +576,8 @@ class Controller {
   glm::quat desired_rotation_at_search_{1.0f, 0.0f, 0.0f, 0.0f};
   uint64_t tag_bits_ = 0;  // resolved tag request (0: locomotion)
   uint64_t tag_bits_at_search_ = 0;
+  int style_ = -1;  // requested style id (-1: any)
+  int style_at_search_ = -1;
   bool stopping_ = false;  // stick released and slow: the idle clip only
   bool stopping_at_search_ = false;
   float search_timer_ = 0.0f;

@@ -27,6 +27,10 @@ struct ControllerInput {
   // is it ("wave" matches "wave-both-hands" and "wave-left-hand"). Empty: locomotion. The view
   // is read during update() only; it need not outlive the call.
   std::string_view tag;
+  // The requested style, an id from ControllerDatabase::style_id() (resolved once, outside
+  // update()); -1 (or an id the database does not have): any style. Frames of other styles pay
+  // ControllerSettings::style_cost in the search (docs/controller.md, Styles).
+  int style = -1;
 };
 
 }  // namespace mm

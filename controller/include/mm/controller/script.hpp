@@ -3,12 +3,14 @@
 // without a gamepad (mm eval, mm crowd-bench, mm-viewer --script, tests).
 //
 // Format: one line per change of state,
-//   t lx ly rx ry [run] [strafe] [tag=NAME] [camera=DEGREES]
+//   t lx ly rx ry [run] [strafe] [tag=NAME] [style=NAME] [camera=DEGREES]
 // - t: seconds, non-decreasing from line to line (equal times: the later line wins), at most
 //   kMaxScriptSeconds;
 // - lx ly: the left stick, rx ry: the right stick, each in [-1, 1] (see input.hpp for axes);
 // - run, strafe: the buttons held (absent: released);
 // - tag=NAME: request clips carrying the tag NAME (absent: locomotion);
+// - style=NAME: request the style NAME (absent: any); names are resolved against a database by
+//   InputScript::resolve_styles() before the run;
 // - camera=DEGREES: the camera's yaw about +Y in degrees (absent: 0, looking along world +Z).
 // Each line is a whole state: it holds until the next line, and the last holds forever. Before
 // the first line's time the input is neutral (sticks released, camera 0). '#' starts a
@@ -25,6 +27,8 @@
 #include "mm/runtime/result.hpp"
 
 namespace mm {
+
+class ControllerDatabase;
 
 // Bounded runs. A scripted run (mm eval, mm-viewer --headless) is refused up front, with a
 // message, when it would be longer than these limits, instead of running for days or converting
@@ -54,6 +58,9 @@ struct ScriptEvent {
   ControllerInput input;  // camera_yaw in radians; input.tag views `tag` below
   std::string tag;        // owns the tag text (empty: none)
   int line = 0;           // line number in the source, for messages
+  // The style=NAME text (empty: none); input.style is its id once resolved. Last, with an
+  // initializer, so that positional initializers of the fields above stay complete.
+  std::string style = {};
 };
 
 class InputScript {
@@ -75,6 +82,11 @@ class InputScript {
   ControllerInput at(float t) const;
   // Index of the line in effect at t, or -1 before the first line.
   int index_at(float t) const;
+  // Sets every line's input.style from its style name (a line without one gets
+  // `default_style`, -1: any). An unknown name fails with "<name_for_messages>:<line>: " and
+  // ControllerDatabase::style_id()'s message.
+  Status resolve_styles(const ControllerDatabase& database, std::string_view name_for_messages,
+                        int default_style = -1);
 
  private:
   void repoint_tags();

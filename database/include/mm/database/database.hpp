@@ -34,6 +34,10 @@ struct ClipRange {
   int end = 0;        // one past the last frame
   uint64_t tags = 0;  // bit i set when the clip carries the database's tag name i
   bool mirrored = false;
+  // The clip's style: an index into the database's style names, or -1 for a clip without one
+  // (idle clips), which serves every style (docs/controller.md, Styles). Last, so that the
+  // positional initializers of the fields above keep their meaning.
+  int style = -1;
   int frame_count() const { return end - start; }
 };
 
@@ -57,8 +61,9 @@ struct DatabaseContents {
   // Per-frame foot contacts: [frame * 2 + 0] left, [frame * 2 + 1] right; 1 = in contact.
   std::vector<uint8_t> contacts;
 
-  std::vector<ClipRange> clips;        // tile [0, frame_count) in order
-  std::vector<std::string> tag_names;  // at most 64
+  std::vector<ClipRange> clips;          // tile [0, frame_count) in order
+  std::vector<std::string> tag_names;    // at most 64
+  std::vector<std::string> style_names;  // at most kMaxStyles, distinct, not empty
 
   // The feature matrix: frame_count rows of schema.dims() floats, row-major, normalized:
   // features[f * dims + c] = (raw - feature_offset[c]) / feature_scale[c]. The plain squared
@@ -94,6 +99,7 @@ struct DatabaseView {
   std::span<const uint8_t> contacts;
   std::span<const ClipRange> clips;
   std::span<const std::string> tag_names;
+  std::span<const std::string> style_names;
   const FeatureSchema& schema;
   std::span<const float> features;
   std::span<const float> feature_offset;
@@ -170,6 +176,7 @@ class Database {
   std::span<const uint8_t> contacts() const { return contacts_; }
   std::span<const ClipRange> clips() const { return clips_; }
   std::span<const std::string> tag_names() const { return tag_names_; }
+  std::span<const std::string> style_names() const { return style_names_; }
 
   const FeatureSchema& schema() const { return schema_; }
   int feature_dims() const { return schema_.dims(); }
@@ -211,6 +218,7 @@ class Database {
   int frame_count_ = 0;
   std::vector<ClipRange> clips_;
   std::vector<std::string> tag_names_;
+  std::vector<std::string> style_names_;
   FeatureSchema schema_;
   std::unique_ptr<std::byte[], FreeBlock> block_;
   std::span<glm::vec3> local_positions_;
@@ -238,6 +246,9 @@ Status validate_database(const DatabaseView& db);
 // The name and the tag of the idle clip the builder synthesizes (mm/offline/idle.hpp).
 inline constexpr const char* kIdleClipName = "idle";
 inline constexpr const char* kIdleTag = "idle";
+
+// Most distinct styles a database holds (a clip's style is an index below it).
+inline constexpr size_t kMaxStyles = 256;
 
 // True for that clip: named kIdleClipName, tagged kIdleTag, not mirrored. (A source file that
 // happens to be called "idle.bvh" carries no such tag.)

@@ -5,7 +5,7 @@
 // string length, a 64-bit checksum over the whole file and finally Database::validate() are all
 // checked, and any failure comes back as a message naming the file, the section and the index.
 //
-// Layout of format version 3 (all integers and floats in the writer's native byte order, which
+// Layout of format version 4 (all integers and floats in the writer's native byte order, which
 // the endianness marker pins down; offsets in bytes from the start of the file). docs/
 // database-file.md explains the choices and the measurements behind them.
 //
@@ -47,9 +47,11 @@
 // w), translation (x, y, z), scale (x, y, z). Variable sections are records packed back to back
 // with no padding:
 //   string list (skeleton names, tag names): uint32 length, then the bytes (no terminator);
+//   style_names: uint32 count (at most kMaxStyles), then that many strings;
 //   schema channel: uint8 kind, 3 zero bytes, string name, string bone, uint32 time count, that
 //     many float32 times, float32 axis x, y, z, float32 weight;
-//   clip: int32 start, int32 end, uint64 tags, uint8 mirrored (0 or 1), 3 zero bytes, string name.
+//   clip: int32 start, int32 end, uint64 tags, uint8 mirrored (0 or 1), 3 zero bytes, int32 style
+//     (an index into style_names, or -1 for none), string name.
 // frame_clip is not stored: it is derived from the clips on load.
 
 #include <array>
@@ -68,8 +70,9 @@ namespace mm {
 
 // The format version this program writes and the only one it reads. Older versions are refused
 // with a message to rebuild: version 1 stored every array per frame and joint, velocities
-// included; version 2 held six joint roles in the header instead of the humanoid map's section.
-inline constexpr uint32_t kDatabaseFormatVersion = 3;
+// included; version 2 held six joint roles in the header instead of the humanoid map's section;
+// version 3 had no styles (no style in the clip records, no style_names section).
+inline constexpr uint32_t kDatabaseFormatVersion = 4;
 // The value written in the endianness field; read back byte-swapped on a machine of the other
 // byte order.
 inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
@@ -77,7 +80,7 @@ inline constexpr uint32_t kDatabaseEndianMarker = 0x01020304u;
 inline constexpr std::array<unsigned char, 8> kDatabaseMagic = {0x8A, 'M',  'M',  'D',
                                                                 '\r', '\n', 0x1A, '\n'};
 
-// The sections of a version-3 file, in the order they appear in the table and in the file.
+// The sections of a version-4 file, in the order they appear in the table and in the file.
 enum class DatabaseSection : uint32_t {
   Schema = 0,          // feature channels (variable records)
   SkeletonNames,       // joint names (string list)
@@ -97,9 +100,10 @@ enum class DatabaseSection : uint32_t {
   FeatureOffset,       // float32 x feature_dims
   FeatureScale,        // float32 x feature_dims
   Searchable,          // uint8 per frame
+  StyleNames,          // uint32 count, then a string list
   Count,               // not a section: the number of sections
 };
-// Number of sections in a version-3 file.
+// Number of sections in a version-4 file.
 inline constexpr size_t kDatabaseSectionCount = static_cast<size_t>(DatabaseSection::Count);
 // Size of the fixed header including the section table (88 + 16 per section), rounded up to 16
 // bytes.

@@ -23,6 +23,7 @@ class DatabaseAssembly {
     int& frame_count;
     std::vector<ClipRange>& clips;
     std::vector<std::string>& tag_names;
+    std::vector<std::string>& style_names;
     FeatureSchema& schema;
     std::span<glm::vec3>& local_positions;
     std::span<glm::quat>& local_rotations;
@@ -46,6 +47,7 @@ class DatabaseAssembly {
             db.frame_count_,
             db.clips_,
             db.tag_names_,
+            db.style_names_,
             db.schema_,
             db.local_positions_,
             db.local_rotations_,

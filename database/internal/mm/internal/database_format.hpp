@@ -42,7 +42,7 @@ static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::quat) == 16);
 // Smallest encoded size of one record of each variable section (with empty strings and lists).
 constexpr uint64_t kMinStringBytes = 4;
 constexpr uint64_t kMinChannelBytes = 4 + 4 + 4 + 4 + 12 + 4;
-constexpr uint64_t kMinClipBytes = 4 + 4 + 8 + 4 + 4;
+constexpr uint64_t kMinClipBytes = 4 + 4 + 8 + 4 + 4 + 4;
 constexpr uint64_t kRestTransformBytes = 10 * 4;
 constexpr uint64_t kRotationExceptionBytes = 16;
 

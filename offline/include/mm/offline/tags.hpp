@@ -28,6 +28,17 @@
 // "walk-turn-right"), plus "mirrored".
 //
 // A database holds at most 64 distinct tags (one bit each in a clip's mask).
+//
+// Styles. A clip also has one style (how it moves: "tired", "proud"), kept apart from its tags
+// in the database (ClipRange::style, Database::style_names) and requested by the controller as
+// a cost, not a filter (docs/controller.md, Styles). It comes from
+//   - a Bandai name's {style} (which also stays a tag, for `tag=` filters);
+//   - a manifest word "style=NAME" on a matching line (NAME of the tag characters); the last
+//     matching line with one wins over the name's. The style is added to the clip's tags too,
+//     so that every style has a search filter bit.
+// Idle clips (ReActIdle names, the synthesized idle) and other names have none, unless a
+// manifest line gives one: a clip without a style serves every style. Mirrored clips keep
+// their original's style.
 
 #include <filesystem>
 #include <string>
@@ -41,7 +52,8 @@ namespace mm {
 // One manifest line: clips whose name matches `pattern` get `tags`.
 struct TagRule {
   std::string pattern;            // glob over the clip name: '*' and '?'
-  std::vector<std::string> tags;  // at least one
+  std::vector<std::string> tags;  // tags to add (a line may have only a style)
+  std::string style;              // "style=NAME" on the line; empty: none
   int line = 0;                   // line in the manifest, for messages
 };
 
@@ -65,6 +77,10 @@ std::vector<std::string> tags_from_name(std::string_view clip_name);
 // ORIGINAL clip's name and mirrored = true. Sorted, without duplicates.
 std::vector<std::string> clip_tags(std::string_view clip_name, bool mirrored,
                                    const std::vector<TagRule>& rules);
+
+// The style of a clip (see the top of this file): the last matching rule's style, else a Bandai
+// name's {style}, else "" (none). For a mirrored clip pass the original's name.
+std::string clip_style(std::string_view clip_name, const std::vector<TagRule>& rules);
 
 // "left" <-> "right" (and "Left" <-> "Right") inside a tag.
 std::string swap_left_right(std::string_view tag);

@@ -155,6 +155,17 @@ struct EvaluationMetrics {
   double stand_foot_speed_cm_s_mean = 0.0;
   int stand_frames = 0;
   double transitions_per_s = 0.0;
+  // Styles (docs/controller.md, Styles): the share of moving frames (desired speed above
+  // kStyleMovingSpeed) with a style requested whose clip has that style (a clip without a
+  // style does not count as a match: while moving it is the idle playing, not the style); -1
+  // when no such frame. style_response_s: the mean time from a request of a style to the first
+  // frame of a clip of it, over the requests that got one before the next (style_requests of
+  // them, style_requests_reached reached).
+  double style_match = -1.0;
+  int style_frames = 0;
+  double style_response_s = 0.0;
+  int style_requests = 0;
+  int style_requests_reached = 0;
   double transition_accel_ratio = 0.0;
   double transition_accel_p99 = 0.0;              // m/s^2
   double database_accel_p99 = 0.0;                // m/s^2, linear interpolation
@@ -202,6 +213,8 @@ struct EvaluationFrame {
   bool contact[2] = {false, false};  // left, right
   bool locked[2] = {false, false};   // the foot lock holds the toe (left, right)
   int clip = -1;                     // playing: index into the database's clips
+  int clip_style = -1;               // the playing clip's style (-1: none)
+  int requested_style = -1;          // the input's style (-1: any)
   int frame = -1;                    // playing: the database frame
   double update_seconds = 0.0;
   bool searched = false;
@@ -263,6 +276,9 @@ struct EvaluationOptions {
   // (the Python module's run_script) keeps the run frame by frame.
   std::function<void(const EvaluationFrame&)> on_frame;
 };
+
+// Desired speeds above this count as moving for style_match (m/s).
+inline constexpr float kStyleMovingSpeed = 0.1f;
 
 struct EvaluationResult {
   EvaluationMetrics metrics;
