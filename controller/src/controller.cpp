@@ -46,15 +46,10 @@ constexpr float kSettleHeading = 0.25f;
 // A step lands once its heading too has come this close (radians) to the animation's, so a
 // foot never plants with the twist it stepped to undo.
 constexpr float kRelockHeading = 0.05f;
-// A step lifts the toe by this share of the distance it still has to go, at least
-// kStepMinLift and at most kStepHeight (m), and over its last kStepLanding (m) comes down in
-// proportion: it rises, moves, and lands as it arrives. It moves once it has risen
-// kStepMoveLift (m): a foot that shuffles along low is a foot sliding on the ground.
+// A step lifts the toe by this share of the distance it still has to go, at most kStepHeight
+// (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 0.5f;
-constexpr float kStepMinLift = 0.05f;
 constexpr float kStepHeight = 0.08f;
-constexpr float kStepLanding = 0.03f;
-constexpr float kStepMoveLift = 0.035f;
 // Halflife (s) of the lift's spring: short beside a step, long beside a frame.
 constexpr float kLiftHalflife = 0.06f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
