@@ -1,8 +1,9 @@
 // libFuzzer target for the tag manifest (database/include/mm/offline/tags.hpp). Whatever the
 // text, parse_tag_manifest must return, and:
 // - a refusal reads "fuzz.tags:<line>: <what was expected>";
-// - an accepted manifest's rules each have a glob, at least one tag of letters, digits and
-//   "_-.:+", and a line number in the text; matching them against clip names (clip_tags,
+// - an accepted manifest's rules each have a glob, at least one tag or a style (a line may
+//   give only a style), tags and style of letters, digits and "_-.:+", and a line number in
+//   the text; matching them against clip names (clip_tags,
 //   glob_match, mirrored or not) gives sorted tags without duplicates.
 // Seeds: manifests like the ones tests/offline/tags_test.cpp reads (written into the corpus
 // by fuzz/CMakeLists.txt).
@@ -49,7 +50,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   const size_t lines = static_cast<size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
   for (const mm::TagRule& rule : *rules) {
-    if (rule.pattern.empty() || rule.tags.empty()) fail("rule without glob or tags", rule.pattern);
+    if (rule.pattern.empty() || (rule.tags.empty() && rule.style.empty())) {
+      fail("rule without glob, tags or style", rule.pattern);
+    }
+    if (!std::all_of(rule.style.begin(), rule.style.end(), tag_char)) fail("bad style", rule.style);
     if (rule.line < 1 || static_cast<size_t>(rule.line) > lines) {
       fail("rule line out of the text", std::to_string(rule.line));
     }
