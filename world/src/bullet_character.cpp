@@ -18,18 +18,6 @@
 namespace mm {
 namespace {
 
-bool finite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-bool within(const glm::dvec3& v, double reach) {
-  return std::abs(v.x) <= reach && std::abs(v.y) <= reach && std::abs(v.z) <= reach;
-}
-
-btVector3 to_bullet(const glm::dvec3& v) {
-  return {static_cast<btScalar>(v.x), static_cast<btScalar>(v.y), static_cast<btScalar>(v.z)};
-}
-
 // One capsule: its shape, the ghost object Bullet's controller moves, and the controller.
 struct Capsule {
   CapsuleSettings settings;

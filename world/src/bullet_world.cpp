@@ -33,18 +33,6 @@ bool finite(double v) {
   return std::isfinite(v);
 }
 
-bool finite(const glm::dvec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-bool within(const glm::dvec3& v, double reach) {
-  return std::abs(v.x) <= reach && std::abs(v.y) <= reach && std::abs(v.z) <= reach;
-}
-
-btVector3 to_bullet(const glm::dvec3& v) {
-  return {static_cast<btScalar>(v.x), static_cast<btScalar>(v.y), static_cast<btScalar>(v.z)};
-}
-
 glm::dvec3 from_bullet(const btVector3& v) {
   return {v.x(), v.y(), v.z()};
 }

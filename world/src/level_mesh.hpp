@@ -5,6 +5,7 @@
 #include <BulletCollision/CollisionShapes/btBvhTriangleMeshShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleIndexVertexArray.h>
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -14,6 +15,19 @@
 #include "mm/world/level.hpp"
 
 namespace mm {
+
+inline bool finite(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+// Every coordinate within `reach` of zero.
+inline bool within(const glm::dvec3& v, double reach) {
+  return std::abs(v.x) <= reach && std::abs(v.y) <= reach && std::abs(v.z) <= reach;
+}
+
+inline btVector3 to_bullet(const glm::dvec3& v) {
+  return {static_cast<btScalar>(v.x), static_cast<btScalar>(v.y), static_cast<btScalar>(v.z)};
+}
 
 // Triangles per part of Bullet's mesh: its quantized tree keeps a triangle's index in 21 bits
 // of a node (and the part in the 10 above them), so one part holds at most 2^21 triangles;
