@@ -48,7 +48,7 @@ constexpr float kSettleHeading = 0.25f;
 constexpr float kRelockHeading = 0.05f;
 // A step lifts the toe by this share of the distance it still has to go, at most kStepHeight
 // (m): it rises as it leaves and lands as it arrives.
-constexpr float kStepLift = 0.5f;
+constexpr float kStepLift = 1.0f;
 constexpr float kStepHeight = 0.08f;
 // Halflife (s) of the lift's spring: short beside a step, long beside a frame.
 constexpr float kLiftHalflife = 0.06f;
@@ -99,6 +99,12 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 // the shorter span it leaves makes knees snap straight at the transitions.
 constexpr float kSoftReach = 0.96f;
 constexpr float kMinSoftSpan = 0.01f;
+// The most (radians) the root turns to bring a standing pose's hips onto the facing, and the
+// halflife (s) over which it follows their lasting offset.
+constexpr float kMaxHipsAlign = 0.2f;
+constexpr float kHipsAlignHalflife = 0.15f;
+// The most (radians) a held foot's heel lifts about its toe for a leg that falls short of it.
+constexpr float kMaxHeelRise = 0.5f;
 // Halflife (s) of the easing between keeping the animation's extension (standing) and not.
 constexpr float kStandingReachHalflife = 0.1f;
 // The width (m) of the smooth maximum that keeps a toe target above the data's lowest toe: the
@@ -121,6 +127,28 @@ glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, flo
   const float span = std::max(length - kept, kMinSoftSpan * length);
   const float reached = kept + span * (1.0f - std::exp(-(d - kept) / span));
   return hip_to_ankle * (reached / d);
+}
+
+// The turn (radians, at most kMaxHeelRise) about the held toe that brings the ankle to `distance`
+// from the hip, turning the toe-to-ankle line toward the toe-to-hip line about `axis` so that the
+// heel lifts; 0 where the ankle is already that close. `axis` is left as it was where the lines
+// give none (a turn easing out keeps its last axis).
+float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
+                      float distance, glm::vec3& axis) {
+  const glm::vec3 a = ankle - toe, h = hip - toe;
+  const float foot = glm::length(a), to_hip = glm::length(h);
+  const glm::vec3 normal = glm::cross(a, h);
+  if (foot < 1e-4f || to_hip < 1e-4f || glm::length(normal) < 1e-6f * foot * to_hip) return 0.0f;
+  axis = glm::normalize(normal);
+  if (glm::length(ankle - hip) <= distance) return 0.0f;
+  const float angle = std::acos(std::clamp(glm::dot(a, h) / (foot * to_hip), -1.0f, 1.0f));
+  // The angle between the two lines at which the ankle is `distance` from the hip (law of
+  // cosines); pointing straight at the hip where even that falls short.
+  const float wanted = std::acos(std::clamp(
+      (foot * foot + to_hip * to_hip - distance * distance) / (2.0f * foot * to_hip), -1.0f, 1.0f));
+  // A turn that would lower the heel (the hip below the foot) is no heel rise.
+  if ((glm::angleAxis(angle - wanted, axis) * a).y <= a.y) return 0.0f;
+  return std::clamp(angle - wanted, 0.0f, kMaxHeelRise);
 }
 
 // The root (joint 0) and the body (joints 1..) of a pose and its velocities: transitions treat
@@ -324,6 +352,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   for (FootLock& f : feet_) f = FootLock{};
   standing_reach_ = 0.0f;
   body_yaw_known_ = false;
+  hips_align_ = 0.0f;
   chest_twist_ = chest_twist_velocity_ = 0.0f;
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
@@ -886,7 +915,8 @@ void Controller::synchronize(float dt) {
   glm::vec3 position = root.translation + step;
 
   const float root_yaw = quat_yaw(root.rotation);
-  float angle = wrap_angle(quat_yaw(sim_rotation_) - root_yaw) * fraction;
+  align_hips(dt);
+  float angle = wrap_angle(quat_yaw(sim_rotation_) - hips_align_ - root_yaw) * fraction;
   // At least as fast as the simulation itself turns: held to the character's own turning, a
   // clip that does not turn would leave the root behind a turning simulation until the clamp
   // dragged it.
@@ -955,6 +985,17 @@ void Controller::limit_body_turn(float dt) {
   }
   body_yaw_ = yaw;
   body_yaw_known_ = true;
+  hips_offset_ = wrap_angle(yaw - quat_yaw(locals_[0].rotation));
+}
+
+// Standing, the idle pose's hips may face a few degrees off its root for seconds (a weight
+// shift), and a turn on the spot would end that far off the facing. The root's facing goal is
+// turned the other way by the hips' lasting offset (followed slowly, so the pose's own sway
+// stays, and bounded), and eases back to none once the character moves.
+void Controller::align_hips(float dt) {
+  const float goal =
+      stopping_ && body_yaw_known_ ? std::clamp(hips_offset_, -kMaxHipsAlign, kMaxHipsAlign) : 0.0f;
+  hips_align_ += (goal - hips_align_) * pull_fraction(kHipsAlignHalflife, dt);
 }
 
 // Orientation warping. The data has no side steps: strafing, the simulation (and with it the
@@ -1112,8 +1153,9 @@ void Controller::foot_lock(float dt) {
     debug_.ik_target[side] = target;
     // A stepping foot is in the air, whatever the playing frame says.
     debug_.contact[side] = debug_.contact[side] && !feet_[side].stepping;
+    ease_heel_down(side, dt);
     if (glm::length(target - animated) >= 1e-5f || std::abs(feet_[side].heading_offset) > 1e-5f ||
-        (world_ && foot_placement_.tilted(side))) {
+        feet_[side].heel_rise > 0.0f || (world_ && foot_placement_.tilted(side))) {
       reach(side, animated, target);
     }
   }
@@ -1289,8 +1331,29 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
       target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
   const float animated_reach =
       glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
-  ankle_target = hip_position + soft_reach(ankle_target - hip_position, animated_reach,
-                                           standing_reach_, leg_length(side));
+  glm::vec3 reached =
+      soft_reach(ankle_target - hip_position, animated_reach, standing_reach_, leg_length(side));
+  // A held toe the softened leg falls short of is reached by lifting the heel, not by dragging
+  // the toe: the leg keeps the softened length, so the knee bends as it would, and the toe
+  // stays put (up to the heel's limit).
+  // The heel lifts as far as the held toe needs and comes down on a spring (ease_heel_down), not
+  // at once, when the need ends or the lock does.
+  FootLock& f = feet_[side];
+  glm::quat heel_rise(1.0f, 0.0f, 0.0f, 0.0f);
+  if (leg[3] >= 0 && (f.locked || f.heel_rise > 0.0f)) {
+    const float length = glm::length(reached);
+    const float needed = heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis);
+    if (f.locked && needed > f.heel_rise) {
+      f.heel_rise = needed;
+      f.heel_rise_velocity = 0.0f;
+    }
+    if (f.heel_rise > 0.0f) {
+      heel_rise = glm::angleAxis(f.heel_rise, f.heel_axis);
+      reached = target + heel_rise * (ankle_target - target) - hip_position;
+      reached *= std::min(1.0f, length / glm::length(reached));
+    }
+  }
+  ankle_target = hip_position + reached;
   // The knee bends toward where it points now; a nearly straight leg has no such direction
   // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
   // so the character's forward breaks the tie.
@@ -1298,8 +1361,14 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
                          kKneeForwardBias * (globals_[0].rotation * kForward);
   apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
+  const glm::quat raised_foot = glm::normalize(heel_rise * foot_rotation);
   locals_[static_cast<size_t>(foot)].rotation =
-      glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * foot_rotation);
+      glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * raised_foot);
+  // The toe stays flat on the ground while the heel rises: it bends at the ball of the foot.
+  if (leg[3] >= 0) {
+    Transform& toe = locals_[static_cast<size_t>(leg[3])];
+    toe.rotation = glm::normalize(glm::conjugate(raised_foot) * foot_rotation * toe.rotation);
+  }
   refresh_subtree(foot);
   restore_leg_lengths(side);
 }
@@ -1340,6 +1409,15 @@ void Controller::restore_leg_lengths(int side) {
     locals_[joint].rotation = glm::normalize(glm::conjugate(parent_rotation) * global);
     refresh_subtree(leg[i]);
   }
+}
+
+// The heel's lift decays toward none on a spring; reach raises it again as a held toe needs.
+void Controller::ease_heel_down(int side, float dt) {
+  FootLock& f = feet_[side];
+  if (f.heel_rise <= 0.0f) return;
+  critical_spring_update(f.heel_rise, f.heel_rise_velocity, 0.0f,
+                         settings_.foot_lock_release_halflife, dt);
+  if (f.heel_rise < 1e-4f) f.heel_rise = f.heel_rise_velocity = 0.0f;
 }
 
 // The foot's length, ankle to toe, in the pose being played (0 without a toe).

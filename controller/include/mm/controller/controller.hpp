@@ -537,7 +537,9 @@ class Controller {
   int leg_end(int side) const;
   bool in_early_blend() const;
   float foot_heading(int side) const;
+  void align_hips(float dt);
   void reach(int side, const glm::vec3& animated, const glm::vec3& target);
+  void ease_heel_down(int side, float dt);
   void restore_leg_lengths(int side);
   void refresh_subtree(int joint);    // globals of a joint and its descendants from the locals
   float leg_length(int side) const;   // upper plus lower leg in the played pose (m)
@@ -639,6 +641,11 @@ class Controller {
     float heading_offset = 0.0f;
     float heading_offset_velocity = 0.0f;
     bool heading_held = false;  // on the last update
+    // How far (radians) the heel is lifted about the held toe (reach), about which axis, and
+    // the rate at which it comes down after a release.
+    float heel_rise = 0.0f;
+    float heel_rise_velocity = 0.0f;
+    glm::vec3 heel_axis{1.0f, 0.0f, 0.0f};
     // The animated toe on its ground last update, and whether it was low and slow then.
     glm::vec3 animated{0.0f};
     bool has_animated = false;
@@ -650,6 +657,10 @@ class Controller {
   // The body's facing after the last update (see body_max_turn_rate), unknown after a placement.
   float body_yaw_ = 0.0f;
   bool body_yaw_known_ = false;
+  // The displayed hips' yaw off the root's (radians, last update), and how far the root's
+  // standing facing goal is turned against it (align_hips).
+  float hips_offset_ = 0.0f;
+  float hips_align_ = 0.0f;
   // Strafing (the strafe button held, the stick pushed), and the chest's twist toward the
   // facing (radians about the vertical) with its rate.
   bool strafing_ = false;
