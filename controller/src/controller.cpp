@@ -409,7 +409,10 @@ void Controller::update(float dt, const ControllerInput& input) {
 // (or a teleport or adjustment) from the local pose.
 void Controller::refresh_outputs(float dt) {
   finish_pose();
-  if (world_) place_feet(dt);
+  if (world_) {
+    place_feet(dt);
+    keep_body_off_walls(dt);
+  }
   foot_lock(dt);
   publish_world_transforms();
   if (settings_.compute_skinning) {
@@ -1144,9 +1147,11 @@ void Controller::foot_lock(float dt) {
       debug_.lock_position[side] = debug_.ik_target[side] = animated;
       continue;
     }
-    const glm::vec3 on_ground = animated + glm::vec3(0.0f, ground_offset_[side], 0.0f);
+    // The feet stay where the animation has them when the body is kept off a wall.
+    const glm::vec3 unshifted = animated - body_shift_;
+    const glm::vec3 on_ground = unshifted + glm::vec3(0.0f, ground_offset_[side], 0.0f);
     const bool contact = debug_.contact[side] || low_and_slow(side, on_ground, dt);
-    const glm::vec3 target = foot_target(side, animated, on_ground, contact, settling, dt);
+    const glm::vec3 target = foot_target(side, unshifted, on_ground, contact, settling, dt);
     hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
@@ -1198,8 +1203,8 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     const std::vector<int>& leg = leg_joints_[side];
     const glm::vec3 ankle = globals_[static_cast<size_t>(leg[2])].translation;
     const glm::vec3 hip = globals_[static_cast<size_t>(leg[0])].translation;
-    const bool out_of_reach =
-        glm::length(f.position - (animated - ankle) - hip) > kStepReach * leg_length(side);
+    const bool out_of_reach = glm::length(f.position - (animated + body_shift_ - ankle) - hip) >
+                              kStepReach * leg_length(side);
     const bool dragged = glm::length(drag) > settings_.foot_unlock_radius || out_of_reach;
     if (!contact || dragged || settle) {
       // A foot that has to move while its frame says "contact" steps there rather than slides.

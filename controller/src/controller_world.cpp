@@ -24,6 +24,11 @@ constexpr float kSlideFacingShare = 0.3f;
 // The simulation object is still beside the wall it last met while no farther from it than
 // this (m).
 constexpr float kBesideObstacle = 0.05f;
+// Halflife (s) of the body's return from a wall it was kept out of.
+constexpr float kWallPushHalflife = 0.15f;
+// The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
+// feet, which stay.
+constexpr float kMaxWallPush = 0.1f;
 
 }  // namespace
 
@@ -34,6 +39,7 @@ void Controller::set_world(const WorldQueries* world) {
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = glm::vec3(0.0f);
+  wall_push_ = wall_push_velocity_ = 0.0f;
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
 }
 
@@ -210,6 +216,44 @@ void Controller::settle_on_ground() {
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);
+  wall_push_ = wall_push_velocity_ = 0.0f;
+}
+
+// The body kept out of the wall the simulation object stands against: the capsule keeps the
+// root a radius away, but an arm swinging forward or an idle hand reaches past it. Everything
+// above the root is moved back along the wall's normal by as far as the deepest joint higher
+// than a step is past the wall's plane, at once (a hand must not go in), and eases back on a
+// spring once nothing is (the legs' IK keeps planted feet where they are).
+void Controller::keep_body_off_walls(float dt) {
+  float depth = 0.0f;
+  glm::vec3 n(obstacle_normal_.x, 0.0f, obstacle_normal_.z);
+  // Only where the wall was met: its plane goes on past its end.
+  const bool beside =
+      glm::length(n) > 0.5f &&
+      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) <= kBesideObstacle &&
+      glm::distance(sim_position_, obstacle_point_) <= settings_.character_radius;
+  if (beside) {
+    n = glm::normalize(n);
+    wall_push_normal_ = n;
+    const glm::vec3 wall = obstacle_point_ - n * settings_.character_radius;
+    const float above = ground_height_ + settings_.step_height;
+    for (size_t j = 1; j < globals_.size(); ++j) {
+      const glm::vec3& p = globals_[j].translation;
+      if (p.y > above) depth = std::max(depth, glm::dot(wall - p, n));
+    }
+  }
+  critical_spring_update(wall_push_, wall_push_velocity_, 0.0f, kWallPushHalflife, dt);
+  depth = std::min(depth, kMaxWallPush);
+  if (depth > wall_push_) {
+    wall_push_ = depth;
+    wall_push_velocity_ = 0.0f;
+  }
+  if (wall_push_ < 1e-5f) {
+    wall_push_ = wall_push_velocity_ = 0.0f;
+    return;
+  }
+  for (size_t j = 1; j < globals_.size(); ++j)
+    globals_[j].translation += wall_push_normal_ * wall_push_;
 }
 
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the

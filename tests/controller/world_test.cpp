@@ -77,6 +77,35 @@ TEST(ControllerWorld, HeadOnIntoAWallTheCharacterStopsBeforeItAndStands) {
   EXPECT_TRUE(c.debug().simulation_blocked);
 }
 
+// The capsule keeps the root a radius from the wall, but the arms swing and an idle's hands may
+// hang farther forward: the upper body is kept out of the wall, at every rate.
+TEST(ControllerWorld, HeadOnAtAWallNoJointAboveTheHipsGoesIntoIt) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    AnalyticWorld world;
+    world.boxes.push_back(wall_across_z(4.0f));
+    Controller c = make_controller();
+    // A thin capsule, so that the arms surely reach the wall (the legs are the capsule's to
+    // keep out).
+    ControllerSettings settings = c.settings();
+    settings.character_radius = 0.15f;
+    ASSERT_TRUE(c.set_settings(settings).ok());
+    c.set_world(&world);
+    const int frames = static_cast<int>(7.0f / dt);
+    float deepest = -1.0f;
+    for (int f = 0; f < frames; ++f) {
+      // Walking into it, then standing there.
+      c.update(dt, f * dt < 4.0f ? push_toward(0.0f) : ControllerInput{});
+      const float hips = hips_height(c);
+      for (const Transform& joint : c.global_transforms()) {
+        if (joint.translation.y > hips) deepest = std::max(deepest, joint.translation.z - 4.0f);
+      }
+    }
+    EXPECT_LT(deepest, 0.005f) << "dt " << dt;
+    // It did come close: a hand within 15 cm of the wall.
+    EXPECT_GT(deepest, -0.15f) << "dt " << dt;
+  }
+}
+
 TEST(ControllerWorld, DiagonallyIntoAWallTheCharacterWalksAlongIt) {
   AnalyticWorld world;
   const float yaw = glm::radians(30.0f);

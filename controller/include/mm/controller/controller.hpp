@@ -488,6 +488,7 @@ class Controller {
   void move_displayed_root(const glm::vec3& position, const glm::quat& rotation);
   void lift_to_ground(float dt);
   void settle_on_ground();
+  void keep_body_off_walls(float dt);
   void place_feet(float dt);
   void face_along_obstacle();
   void desired_motion(const ControllerInput& input);
@@ -689,6 +690,11 @@ class Controller {
   // The wall the simulation object last met (its horizontal normal; zero: none) and where.
   glm::vec3 obstacle_normal_{0.0f};
   glm::vec3 obstacle_point_{0.0f};
+  // How far (m) the body above the root is moved back from that wall, its rate, and along what.
+  float wall_push_ = 0.0f;
+  float wall_push_velocity_ = 0.0f;
+  glm::vec3 wall_push_normal_{0.0f};
+  glm::vec3 body_shift_{0.0f};  // what moved the body above the root this update
   float ground_offset_[2] = {0.0f, 0.0f};
 
   ControllerDebug debug_;
