@@ -1184,8 +1184,14 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
       (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
     f.locked = true;
     f.position = f.target;
+    f.lock_ground = toe_ground(side);
     f.offset = f.offset_velocity = glm::vec3(0.0f);
   } else if (f.locked) {
+    // The lock holds its point, but its height rides on the ground found under it: a foot that
+    // swung up toward a step it then landed short of comes down onto the tread it is over.
+    const float ground = toe_ground(side);
+    f.position.y += ground - f.lock_ground;
+    f.lock_ground = ground;
     glm::vec3 drag = animated - f.position;
     drag.y = 0.0f;
     // Standing, a step is due by where the idle clip itself puts the toe, not by where the blend

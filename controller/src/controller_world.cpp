@@ -270,6 +270,14 @@ void Controller::place_feet(float dt) {
     p.hip = globals_[static_cast<size_t>(leg[0])].translation;
     p.ankle = globals_[static_cast<size_t>(leg[2])].translation;
     p.toe = globals_[static_cast<size_t>(leg_end(side))].translation;
+    // The ground is probed where the foot will be: a held foot where its lock holds it, a
+    // released one where its decaying offset still has it (so that the ground under it moves
+    // as continuously as the foot does), not where the animation has it.
+    const FootLock& f = feet_[side];
+    const glm::vec3 at = f.locked ? f.position : p.toe + f.offset;
+    const glm::vec3 moved(at.x - p.toe.x, 0.0f, at.z - p.toe.z);
+    p.toe += moved;
+    p.ankle += moved;
     p.length = leg_length(side);
     p.planted = feet_[side].locked || debug_.contact[side];
     p.near_ground =

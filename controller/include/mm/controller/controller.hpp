@@ -628,6 +628,7 @@ class Controller {
   struct FootLock {
     bool locked = false;
     glm::vec3 position{0.0f};  // the held toe position
+    float lock_ground = 0.0f;  // the toe's ground (toe_ground) when the lock last followed it
     glm::vec3 offset{0.0f};    // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
     glm::vec3 target{0.0f};  // the toe's target last update (without a step's lift)
