@@ -164,4 +164,12 @@ void CharacterMover::probe(const WorldQueries& world, const glm::dvec3& origin,
   for (size_t i = 0; i < probes.size(); ++i) accept(probes[i], hits[i]);
 }
 
+void CharacterMover::sweep(const WorldQueries& world, const glm::dvec3& origin,
+                           std::span<const ShapeSweep> sweeps, std::span<SweepHit> hits) {
+  std::fill(hits.begin(), hits.end(), SweepHit{});
+  if (sweeps.empty()) return;
+  world.sweep(origin, sweeps, hits);
+  for (size_t i = 0; i < sweeps.size(); ++i) accept(sweeps[i], hits[i]);
+}
+
 }  // namespace mm

@@ -1229,6 +1229,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
                            settings_.foot_lock_release_halflife, dt);
   }
   glm::vec3 target = (f.locked ? f.position : on_ground) + f.offset;
+  if (world_) keep_toe_off_wall(side, target);
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
   // toe dead at the floor, a jerk the legs show.

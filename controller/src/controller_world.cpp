@@ -29,6 +29,8 @@ constexpr float kWallPushHalflife = 0.15f;
 // The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
 // feet, which stay.
 constexpr float kMaxWallPush = 0.1f;
+// How far (m) a toe joint stays from a wall's face: the toes reach past their joint.
+constexpr float kToeWallMargin = 0.03f;
 
 }  // namespace
 
@@ -226,16 +228,9 @@ void Controller::settle_on_ground() {
 // spring once nothing is (the legs' IK keeps planted feet where they are).
 void Controller::keep_body_off_walls(float dt) {
   float depth = 0.0f;
-  glm::vec3 n(obstacle_normal_.x, 0.0f, obstacle_normal_.z);
-  // Only where the wall was met: its plane goes on past its end.
-  const bool beside =
-      glm::length(n) > 0.5f &&
-      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) <= kBesideObstacle &&
-      glm::distance(sim_position_, obstacle_point_) <= settings_.character_radius;
-  if (beside) {
-    n = glm::normalize(n);
+  glm::vec3 wall, n;
+  if (wall_beside(wall, n)) {
     wall_push_normal_ = n;
-    const glm::vec3 wall = obstacle_point_ - n * settings_.character_radius;
     const float above = ground_height_ + settings_.step_height;
     for (size_t j = 1; j < globals_.size(); ++j) {
       const glm::vec3& p = globals_[j].translation;
@@ -250,10 +245,65 @@ void Controller::keep_body_off_walls(float dt) {
   }
   if (wall_push_ < 1e-5f) {
     wall_push_ = wall_push_velocity_ = 0.0f;
+    body_shift_ = glm::vec3(0.0f);
     return;
   }
-  for (size_t j = 1; j < globals_.size(); ++j)
-    globals_[j].translation += wall_push_normal_ * wall_push_;
+  body_shift_ = wall_push_normal_ * wall_push_;
+  for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
+}
+
+// The wall the simulation object stands against, as a point on its face and its horizontal
+// normal; false when there is none. Only where the wall was met: its plane goes on past its end.
+bool Controller::wall_beside(glm::vec3& point, glm::vec3& normal) const {
+  const glm::vec3 n(obstacle_normal_.x, 0.0f, obstacle_normal_.z);
+  if (!world_ || glm::length(n) < 0.5f ||
+      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) > kBesideObstacle ||
+      glm::distance(sim_position_, obstacle_point_) > settings_.character_radius) {
+    return false;
+  }
+  normal = glm::normalize(n);
+  point = obstacle_point_ - normal * settings_.character_radius;
+  return true;
+}
+
+// Walls between the body and each toe: a small sphere swept from the root's vertical line out
+// to where the foot is, a step above the body's ground (lower things are steps the feet stand
+// on, not walls). One batched call for both feet.
+void Controller::find_walls_at_toes(const std::array<PlacementLeg, 2>& legs) {
+  std::array<ShapeSweep, 2> sweeps;
+  std::array<SweepHit, 2> hits;
+  const float y = ground_height_ + settings_.step_height;
+  const glm::vec3 root = locals_[0].translation;
+  for (size_t side = 0; side < 2; ++side) {
+    sweeps[side] =
+        ShapeSweep{glm::vec3(root.x, y, root.z), glm::vec3(legs[side].toe.x, y, legs[side].toe.z),
+                   kToeWallMargin, 2.0f * kToeWallMargin};
+  }
+  mover_.sweep(*world_, origin_, sweeps, hits);
+  for (size_t side = 0; side < 2; ++side) {
+    ToeWall& wall = toe_walls_[side];
+    const glm::vec3 n(hits[side].normal.x, 0.0f, hits[side].normal.z);
+    wall.found = hits[side].hit && glm::length(n) > 0.5f;
+    if (!wall.found) continue;
+    wall.normal = glm::normalize(n);
+    // The sphere's centre stopped a radius off the face.
+    const glm::vec3 centre = glm::mix(sweeps[side].from, sweeps[side].to, hits[side].fraction);
+    wall.point = centre - wall.normal * kToeWallMargin;
+  }
+}
+
+// A toe target is kept a margin out of the walls found between the body and the toes, and out of
+// the one the simulation object stands against: a step to the side or ahead would put the foot
+// into it (the capsule keeps only the root a radius away).
+void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
+  const auto push_out = [&target](const glm::vec3& wall, const glm::vec3& n) {
+    const float depth = glm::dot(wall - target, n) + kToeWallMargin;
+    if (depth > 0.0f) target += n * depth;
+  };
+  glm::vec3 wall, n;
+  if (wall_beside(wall, n)) push_out(wall, n);
+  const ToeWall& toe_wall = toe_walls_[side];
+  if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
 }
 
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the
@@ -291,6 +341,7 @@ void Controller::place_feet(float dt) {
   placement.max_step_down = settings_.max_step_down;
   foot_placement_.update(*world_, origin_, mover_, placement, legs, ground_height_, sim_velocity_,
                          dt);
+  find_walls_at_toes(legs);
   debug_.world_rejected = mover_.rejected();
   const float drop = foot_placement_.pelvis_drop();
   for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation.y -= drop;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
 
 namespace mm {
@@ -46,6 +47,8 @@ void FootPlacement::reset(float ground) {
   for (Foot& foot : feet_) {
     foot.ground = FootGround{ground, ground};
     foot.velocity = FootGround{};
+    foot.has_toe = false;
+    foot.toe_velocity = glm::vec3(0.0f);
   }
   pelvis_drop_ = pelvis_drop_velocity_ = drop_goal_ = drop_goal_velocity_ = 0.0f;
   probe_grounds_.fill(glm::vec3(0.0f, ground, 0.0f));
@@ -55,6 +58,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
                            CharacterMover& mover, const FootPlacementSettings& settings,
                            std::span<const PlacementLeg, 2> legs, float body_ground,
                            const glm::vec3& body_velocity, float dt) {
+  follow_toes(legs, dt);
   probe(world, origin, mover, settings, legs, body_ground, body_velocity);
   for (int side = 0; side < 2; ++side) {
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
@@ -72,9 +76,26 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   pelvis_drop_ = std::clamp(pelvis_drop_, 0.0f, settings.max_pelvis_drop);
 }
 
-// Heel and toe, where they are and (for a foot in the air) where the body's velocity takes them
-// shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only where
-// it is: ahead, up a slope, it would rise off the surface it stands on.
+// Each toe's horizontal velocity, from where it was on the last update (none on the first, or
+// after an update of no time).
+void FootPlacement::follow_toes(std::span<const PlacementLeg, 2> legs, float dt) {
+  for (int side = 0; side < 2; ++side) {
+    Foot& foot = feet_[side];
+    const glm::vec3 toe = legs[side].toe;
+    if (dt > 0.0f) {
+      foot.toe_velocity = foot.has_toe
+                              ? glm::vec3(toe.x - foot.toe.x, 0.0f, toe.z - foot.toe.z) / dt
+                              : glm::vec3(0.0f);
+      if (!finite(foot.toe_velocity)) foot.toe_velocity = glm::vec3(0.0f);
+    }
+    foot.toe = toe;
+    foot.has_toe = true;
+  }
+}
+
+// Heel and toe, where they are and (for a foot in the air) where its own or the body's velocity
+// takes them shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only
+// where it is: ahead, up a slope, it would rise off the surface it stands on.
 void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
                           CharacterMover& mover, const FootPlacementSettings& settings,
                           std::span<const PlacementLeg, 2> legs, float body_ground,
@@ -84,7 +105,9 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   const float reach = settings.step_height + settings.max_step_down + 2.0f * kProbeMargin;
   for (int side = 0; side < 2; ++side) {
     const PlacementLeg& leg = legs[side];
-    const glm::vec3 look = leg.planted ? glm::vec3(0.0f) : ahead;
+    const glm::vec3 own = feet_[side].toe_velocity * kToeLookahead;
+    const glm::vec3 farther = glm::length(own) > glm::length(ahead) ? own : ahead;
+    const glm::vec3 look = leg.planted ? glm::vec3(0.0f) : farther;
     probe_points_[slot(side, kHeel)] = leg.ankle;
     probe_points_[slot(side, kToe)] = leg.toe;
     probe_points_[slot(side, kHeelAhead)] = leg.ankle + look;

@@ -76,6 +76,9 @@ class CharacterMover {
   // (world.hpp) becomes no hit and is counted in rejected(). `hits` is as long as `probes`.
   void probe(const WorldQueries& world, const glm::dvec3& origin,
              std::span<const GroundProbe> probes, std::span<GroundHit> hits);
+  // Shape sweeps as given, in one call to the world, checked the same way.
+  void sweep(const WorldQueries& world, const glm::dvec3& origin,
+             std::span<const ShapeSweep> sweeps, std::span<SweepHit> hits);
 
   // Answers ignored because they failed the checks (world.hpp), since creation.
   int64_t rejected() const { return rejected_; }

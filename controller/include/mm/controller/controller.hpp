@@ -28,6 +28,7 @@
 // origin_transforms() (float, relative to it) instead, and places characters with
 // teleport_world() and adjust_root_world(). See docs/controller.md, "Big worlds".
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -489,6 +490,9 @@ class Controller {
   void lift_to_ground(float dt);
   void settle_on_ground();
   void keep_body_off_walls(float dt);
+  bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
+  void find_walls_at_toes(const std::array<PlacementLeg, 2>& legs);
+  void keep_toe_off_wall(int side, glm::vec3& target) const;
   void place_feet(float dt);
   void face_along_obstacle();
   void desired_motion(const ControllerInput& input);
@@ -695,6 +699,14 @@ class Controller {
   float wall_push_ = 0.0f;
   float wall_push_velocity_ = 0.0f;
   glm::vec3 wall_push_normal_{0.0f};
+  // A wall found between the body and each toe this update (find_walls_at_toes): a point on its
+  // face and its horizontal normal.
+  struct ToeWall {
+    bool found = false;
+    glm::vec3 point{0.0f};
+    glm::vec3 normal{0.0f};
+  };
+  ToeWall toe_walls_[2];
   glm::vec3 body_shift_{0.0f};  // what moved the body above the root this update
   float ground_offset_[2] = {0.0f, 0.0f};
 

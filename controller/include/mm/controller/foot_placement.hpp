@@ -63,8 +63,11 @@ class FootPlacement {
  public:
   // Heel and toe of each foot, now and ahead.
   static constexpr int kProbes = 8;
-  // How far ahead the probes look: the body's velocity times this (s).
+  // How far ahead the probes look: the body's velocity times this (s), or the toe's own
+  // (a step to the side or a turn's step goes where the body does not) times kToeLookahead,
+  // whichever goes farther.
   static constexpr float kLookahead = 0.2f;
+  static constexpr float kToeLookahead = 0.1f;
   // A leg may straighten to this share of its length to reach a lower foot's ground before
   // the pelvis has to drop.
   static constexpr float kMaxLegExtension = 0.97f;
@@ -100,10 +103,14 @@ class FootPlacement {
   struct Foot {
     FootGround ground;
     FootGround velocity;
+    glm::vec3 toe{0.0f};  // the toe's position last update, and its horizontal velocity
+    glm::vec3 toe_velocity{0.0f};
+    bool has_toe = false;
   };
   void probe(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
              const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
              float body_ground, const glm::vec3& body_velocity);
+  void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                   float body_ground) const;

@@ -30,7 +30,7 @@ namespace mm {
 
 // At most this many query calls per update: three moves (simulation, root, trajectory) of at
 // most three calls each, and the feet's ground probes (foot_placement.hpp).
-inline constexpr int kMaxWorldCallsPerUpdate = 10;
+inline constexpr int kMaxWorldCallsPerUpdate = 11;
 
 // From `from`, straight down (-Y), at most `max_distance` metres.
 struct GroundProbe {
