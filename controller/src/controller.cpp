@@ -16,7 +16,7 @@
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
 
-#include "controller_style.hpp"
+#include "mm/controller/style_search.hpp"
 
 namespace mm {
 

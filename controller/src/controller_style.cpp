@@ -1,4 +1,4 @@
-#include "controller_style.hpp"
+#include "mm/controller/style_search.hpp"
 
 #include <algorithm>
 #include <cmath>
