@@ -145,12 +145,22 @@ Status write_plot(const ViewerOptions& options, const Scene& scene) {
   return Status::success();
 }
 
+// A script with its style=NAME columns resolved against the scene's database.
+Result<InputScript> load_scene_script(const std::string& path, const Scene& scene) {
+  Result<InputScript> script = load_input_script(path);
+  if (!script) return script;
+  if (Status s = script->resolve_styles(scene.controller().controller_database(), path); !s) {
+    return Error{s.message()};
+  }
+  return script;
+}
+
 // ---- Headless.
 
 }  // namespace
 
 int run_headless(const ViewerOptions& options, Scene& scene) {
-  Result<InputScript> script = load_input_script(options.script_path);
+  Result<InputScript> script = load_scene_script(options.script_path, scene);
   if (!script) {
     std::fprintf(stderr, "mm-viewer: %s\n", script.message().c_str());
     return 1;
@@ -246,7 +256,7 @@ void poll_keys(GLFWwindow* window, WindowKeys& keys, bool (&was_down)[3]) {
 int run_windowed(const ViewerOptions& options, Scene& scene) {
   std::optional<InputScript> script;
   if (!options.script_path.empty()) {
-    Result<InputScript> loaded = load_input_script(options.script_path);
+    Result<InputScript> loaded = load_scene_script(options.script_path, scene);
     if (!loaded) {
       std::fprintf(stderr, "mm-viewer: %s\n", loaded.message().c_str());
       return 1;
