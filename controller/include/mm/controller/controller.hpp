@@ -208,7 +208,7 @@ struct ControllerSettings {
   // (normalized feature units; clips without a style pay none). Not a filter: where the style
   // has nothing close to what the stick asks, another style's frame wins (docs/controller.md,
   // Styles).
-  float style_cost = 8.0f;
+  float style_cost = 12.0f;
   // What each later step of a style's fallback order pays on top of style_cost: its nearest
   // rich style pays style_cost, "normal" style_cost + this, any other style style_cost + twice
   // this (normalized feature units).
