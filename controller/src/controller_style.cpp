@@ -37,6 +37,7 @@ StyleTiers style_tiers(const ControllerDatabase& database, int style, float styl
   t.own = database.style_tags(style);
   if (t.own == 0) return t;
   t.all = database.all_style_tags();
+  t.styleless_tags = database.styleless_clip_tags();
   for (int rank = 0; rank < 2; ++rank) {
     t.fallback[rank] = database.style_tags(database.style_fallback(style, rank));
     t.fallback_cost[rank] = style_cost + static_cast<float>(rank) * style_fallback_step;
@@ -51,9 +52,17 @@ SearchResult search_in_style(const Searcher& searcher, std::span<const float> qu
   // The requested style's own frames, then the clips without a style (they serve every style).
   SearchConstraints own = constraints;
   own.include_tags |= tiers.own;
-  SearchConstraints styleless = constraints;
-  styleless.exclude_tags |= tiers.all;
-  SearchResult best = better(searcher.search(query, own), searcher.search(query, styleless));
+  SearchResult best = searcher.search(query, own);
+  bool any_styleless = false;
+  for (const uint64_t tags : tiers.styleless_tags) {
+    any_styleless |= (tags & constraints.include_tags) == constraints.include_tags &&
+                     (tags & constraints.exclude_tags) == 0;
+  }
+  if (any_styleless) {
+    SearchConstraints styleless = constraints;
+    styleless.exclude_tags |= tiers.all;
+    best = better(best, searcher.search(query, styleless));
+  }
   uint64_t searched = tiers.own;
   // Tiers in order of their added cost: a frame of a later tier costs at least its added cost
   // (plain costs are >= 0), so once the best so far is within it nothing later can win.
@@ -80,6 +89,14 @@ void ControllerDatabase::resolve_style_tags() {
   for (size_t s = 0; s < db.style_names().size(); ++s) {
     style_tags_[s] = db.tag_mask(std::vector<std::string>{db.style_names()[s]});
     all_style_tags_ |= style_tags_[s];
+  }
+  styleless_clip_tags_.clear();
+  for (const ClipRange& clip : db.clips()) {
+    if (clip.style >= 0) continue;
+    if (std::find(styleless_clip_tags_.begin(), styleless_clip_tags_.end(), clip.tags) ==
+        styleless_clip_tags_.end()) {
+      styleless_clip_tags_.push_back(clip.tags);
+    }
   }
   resolve_style_fallbacks();
 }

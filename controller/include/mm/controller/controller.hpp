@@ -139,6 +139,8 @@ class ControllerDatabase {
     if (style < 0 || style >= style_count() || rank < 0 || rank > 1) return -1;
     return style_fallbacks_[static_cast<size_t>(style)][static_cast<size_t>(rank)];
   }
+  // The distinct tag masks of the clips without a style.
+  std::span<const uint64_t> styleless_clip_tags() const { return styleless_clip_tags_; }
   bool style_rich(int style) const {
     return style >= 0 && style < style_count() && style_rich_[static_cast<size_t>(style)] != 0;
   }
@@ -161,6 +163,7 @@ class ControllerDatabase {
   uint64_t all_style_tags_ = 0;
   std::vector<std::array<int, 2>> style_fallbacks_;  // per style id
   std::vector<uint8_t> style_rich_;                  // per style id
+  std::vector<uint64_t> styleless_clip_tags_;
   void resolve_style_tags();
   void resolve_style_fallbacks();
   struct SearcherEntry {

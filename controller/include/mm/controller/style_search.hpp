@@ -18,6 +18,10 @@ struct StyleTiers {
   uint64_t own = 0;               // the requested style's tag; 0: no request, one plain search
   uint64_t fallback[2] = {0, 0};  // its fallback styles' tags in order (0: none)
   uint64_t all = 0;               // every style's tag
+  // The distinct tag masks of the clips without a style: their search is skipped when none
+  // passes the constraints (a filter that excludes every style prunes no tree node, so that
+  // search would visit every row to find nothing).
+  std::span<const uint64_t> styleless_tags;
   float fallback_cost[2] = {0.0f, 0.0f};
   float other_cost = 0.0f;  // any style neither own nor a fallback
 };
