@@ -16,7 +16,7 @@
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
 
-#include "controller_style.hpp"
+#include "mm/controller/style_search.hpp"
 
 namespace mm {
 
@@ -577,8 +577,9 @@ SearchResult Controller::search_candidates() const {
       return searcher_->search(query_, constraints);
     }
     constraints.exclude_tags = shared_->action_tags() | shared_->idle_tags();
-    return search_in_style(*searcher_, query_, constraints, shared_->style_tags(style_),
-                           shared_->all_style_tags(), settings_.style_cost);
+    return search_in_style(
+        *searcher_, query_, constraints,
+        style_tiers(*shared_, style_, settings_.style_cost, settings_.style_fallback_step));
   }
   // Any of the requested tags will do: one search per tag, the cheapest wins.
   SearchResult best;

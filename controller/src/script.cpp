@@ -346,7 +346,8 @@ Result<InputScript> load_input_script(const std::filesystem::path& path) {
 // ---------------------------------------------------------------------------------------------
 // Formatting
 
-std::string format_script_line(float time, const ControllerInput& input) {
+std::string format_script_line(float time, const ControllerInput& input,
+                               std::string_view style_name) {
   // The line must parse whatever a live source hands over: a non-finite value prints as 0
   // (input.hpp: it counts as 0), a negative time as 0, and a stick with a component beyond
   // [-1, 1] is scaled back along its direction, which the controller's own scaling onto the
@@ -374,6 +375,12 @@ std::string format_script_line(float time, const ControllerInput& input) {
     MM_ASSERT(std::all_of(input.tag.begin(), input.tag.end(), is_tag_char));
     line += " tag=";
     line += input.tag;
+  }
+  if (!style_name.empty()) {
+    // Style names come from the database, whose builder takes them from tag characters.
+    MM_ASSERT(std::all_of(style_name.begin(), style_name.end(), is_tag_char));
+    line += " style=";
+    line += style_name;
   }
   const double degrees = finite_or_zero(input.camera_yaw) / kRadiansPerDegree;
   if (std::abs(degrees) >= 0.05) {  // absent means 0, which is what "camera=0.0" would say

@@ -41,6 +41,7 @@ constexpr FloatField kFloatFields[] = {
     {"search_interval", &ControllerSettings::search_interval, 0.0f, 10.0f},
     {"transition_cost", &ControllerSettings::transition_cost, 0.0f, 1e6f},
     {"style_cost", &ControllerSettings::style_cost, 0.0f, 1e6f},
+    {"style_fallback_step", &ControllerSettings::style_fallback_step, 0.0f, 1e6f},
     {"ignore_window", &ControllerSettings::ignore_window, 0.0f, 10.0f},
     {"idle_ignore_window", &ControllerSettings::idle_ignore_window, 0.0f, 60.0f},
     {"replan_velocity_change", &ControllerSettings::replan_velocity_change, 0.0f, 100.0f},

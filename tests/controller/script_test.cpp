@@ -498,6 +498,12 @@ TEST(InputScript, FormatPrintsTheDocumentedLine) {
   all.camera_yaw = -135.04f * kDegree;
   EXPECT_EQ(format_script_line(12.3456f, all),
             "12.346 -0.250 0.333 1.000 -1.000 run strafe tag=wave-both-hands camera=-135.0");
+  EXPECT_EQ(format_script_line(2.0f, input, "not-confident"),
+            "2.000 0.000 1.000 0.000 0.000 run tag=wave style=not-confident camera=90.0");
+  Result<InputScript> back =
+      parse_input_script(format_script_line(2.0f, input, "not-confident"), "styled");
+  ASSERT_TRUE(back) << back.message();
+  EXPECT_EQ(back->events()[0].style, "not-confident");
 
   // Values that round to zero print without a sign; a camera that rounds to zero is left out.
   ControllerInput tiny;

@@ -253,6 +253,14 @@ int run_eval(const std::vector<std::string>& args) {
       return 1;
     }
     default_style = *id;
+    const ControllerDatabase& cdb = **shared;
+    std::string order;
+    for (int rank = 0; rank < 2; ++rank) {
+      const int f = cdb.style_fallback(default_style, rank);
+      if (f >= 0) order += ", " + std::string(cdb.database().style_names()[static_cast<size_t>(f)]);
+    }
+    std::printf("style %s (%s), fallback order: own%s, any other\n", arguments.style.c_str(),
+                cdb.style_rich(default_style) ? "rich" : "thin", order.c_str());
   }
   for (const std::string& path : arguments.scripts) {
     Result<InputScript> script = load_input_script(path);

@@ -18,7 +18,8 @@ class InputRecorder {
   void stop() { active_ = false; }
   bool active() const { return active_; }
   // Adds a line when the input differs from the last recorded one (at the printed precision).
-  void record(float now, const ControllerInput& input);
+  // `style_name`: the name of input.style (empty: none), written as style=NAME.
+  void record(float now, const ControllerInput& input, std::string_view style_name = {});
   int line_count() const { return static_cast<int>(lines_.size()); }
   // Writes the script; fails with a message naming the file.
   Status save(const std::filesystem::path& path) const;

@@ -162,6 +162,12 @@ void draw_panel(Scene& scene, PanelState& state) {
   ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("motion matching");
   timings(scene, state);
+  // The style playing now as requested (a script's or the selector's), then the selector.
+  const ControllerDatabase& db = scene.controller().controller_database();
+  ImGui::Text(
+      "style: %s",
+      std::string(StyleSelector::name(db, scene.controller().debug().requested_style)).c_str());
+  if (state.styles) state.styles->draw(db);
   playback(scene);
   if (ImGui::CollapsingHeader("last search", ImGuiTreeNodeFlags_DefaultOpen)) last_search(scene);
   if (ImGui::CollapsingHeader("settings")) settings(scene, state);

@@ -8,6 +8,7 @@
 
 #include "input_recorder.hpp"
 #include "scene.hpp"
+#include "style_selector.hpp"
 
 namespace mm::viewer {
 
@@ -18,6 +19,7 @@ struct PanelState {
   bool paused = false;
   float time_scale = 1.0f;
   InputRecorder* recorder = nullptr;  // null: no recording (replaying a script)
+  StyleSelector* styles = nullptr;    // null: the style comes from a script
   std::string record_path;
   std::string input_source;  // "gamepad: ...", "keyboard and mouse", "script: FILE"
   std::string message;       // the outcome of the last action, shown until replaced

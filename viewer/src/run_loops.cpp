@@ -17,6 +17,7 @@
 #include "mm/controller/script.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 #include "panel.hpp"
+#include "style_selector.hpp"
 
 namespace mm::viewer {
 namespace {
@@ -145,12 +146,22 @@ Status write_plot(const ViewerOptions& options, const Scene& scene) {
   return Status::success();
 }
 
+// A script with its style=NAME columns resolved against the scene's database.
+Result<InputScript> load_scene_script(const std::string& path, const Scene& scene) {
+  Result<InputScript> script = load_input_script(path);
+  if (!script) return script;
+  if (Status s = script->resolve_styles(scene.controller().controller_database(), path); !s) {
+    return Error{s.message()};
+  }
+  return script;
+}
+
 // ---- Headless.
 
 }  // namespace
 
 int run_headless(const ViewerOptions& options, Scene& scene) {
-  Result<InputScript> script = load_input_script(options.script_path);
+  Result<InputScript> script = load_scene_script(options.script_path, scene);
   if (!script) {
     std::fprintf(stderr, "mm-viewer: %s\n", script.message().c_str());
     return 1;
@@ -246,7 +257,7 @@ void poll_keys(GLFWwindow* window, WindowKeys& keys, bool (&was_down)[3]) {
 int run_windowed(const ViewerOptions& options, Scene& scene) {
   std::optional<InputScript> script;
   if (!options.script_path.empty()) {
-    Result<InputScript> loaded = load_input_script(options.script_path);
+    Result<InputScript> loaded = load_scene_script(options.script_path, scene);
     if (!loaded) {
       std::fprintf(stderr, "mm-viewer: %s\n", loaded.message().c_str());
       return 1;
@@ -270,8 +281,10 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
   LiveInput live(window);  // before ImGui, which chains the callbacks it finds
   if (!start_imgui(stage)) std::fprintf(stderr, "mm-viewer: the panel cannot start\n");
   InputRecorder recorder;
+  StyleSelector styles;
   if (!script) {
     stage.panel.recorder = &recorder;
+    stage.panel.styles = &styles;
     stage.panel.record_path =
         options.record_path.empty() ? "mm-viewer-input.txt" : options.record_path;
     if (!options.record_path.empty()) recorder.start(0.0f);
@@ -293,16 +306,21 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
     if (!ui_keyboard) poll_keys(window, keys, was_down);
     ControllerInput input = live.read(stage.camera, wall_dt, ui_mouse, ui_keyboard);
     stage.panel.input_source = script ? "script: " + options.script_path : live.device();
+    const ControllerDatabase& db = scene.controller().controller_database();
     if (script) {
       input = script->at(scene.time());
       stage.camera.yaw = input.camera_yaw;
+    } else {
+      styles.poll(window, db, !ui_keyboard);
+      styles.apply(input);
     }
     const float dt = stage.panel.paused
                          ? 0.0f
                          : (options.dt > 0.0f ? options.dt : wall_dt) * stage.panel.time_scale;
     if (dt > 0.0f) {
       // Stamped with the time it takes effect, as a script's line is read (script.hpp).
-      recorder.record(scene.time(), input);
+      recorder.record(scene.time(), input,
+                      input.style >= 0 ? StyleSelector::name(db, input.style) : "");
       scene.step(dt, input, stage.panel.skinning);
     }
     stage.camera.follow(scene.controller().root_transform().translation, dt);

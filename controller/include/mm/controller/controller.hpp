@@ -132,6 +132,18 @@ class ControllerDatabase {
     return style >= 0 && style < style_count() ? style_tags_[static_cast<size_t>(style)] : 0;
   }
   uint64_t all_style_tags() const { return all_style_tags_; }
+  // A style's fallback order (docs/controller.md, Styles): rank 0 its nearest rich style,
+  // rank 1 "normal" (when neither the style itself nor rank 0); -1 where there is none. Rich:
+  // a style with at least a quarter of the largest style's searchable frames.
+  int style_fallback(int style, int rank) const {
+    if (style < 0 || style >= style_count() || rank < 0 || rank > 1) return -1;
+    return style_fallbacks_[static_cast<size_t>(style)][static_cast<size_t>(rank)];
+  }
+  // The distinct tag masks of the clips without a style.
+  std::span<const uint64_t> styleless_clip_tags() const { return styleless_clip_tags_; }
+  bool style_rich(int style) const {
+    return style >= 0 && style < style_count() && style_rich_[static_cast<size_t>(style)] != 0;
+  }
   // The candidate flags the searchers are built over (searchable and not near a clip end).
   std::span<const uint8_t> candidates() const { return candidates_; }
 
@@ -149,7 +161,11 @@ class ControllerDatabase {
   uint64_t idle_tags_ = 0;
   std::vector<uint64_t> style_tags_;  // per style id
   uint64_t all_style_tags_ = 0;
+  std::vector<std::array<int, 2>> style_fallbacks_;  // per style id
+  std::vector<uint8_t> style_rich_;                  // per style id
+  std::vector<uint64_t> styleless_clip_tags_;
   void resolve_style_tags();
+  void resolve_style_fallbacks();
   struct SearcherEntry {
     std::string method;
     std::unique_ptr<Searcher> searcher;
@@ -195,7 +211,11 @@ struct ControllerSettings {
   // (normalized feature units; clips without a style pay none). Not a filter: where the style
   // has nothing close to what the stick asks, another style's frame wins (docs/controller.md,
   // Styles).
-  float style_cost = 8.0f;
+  float style_cost = 12.0f;
+  // What each later step of a style's fallback order pays on top of style_cost: its nearest
+  // rich style pays style_cost, "normal" style_cost + this, any other style style_cost + twice
+  // this (normalized feature units).
+  float style_fallback_step = 4.0f;
   // Frames within this time of the playing frame are not jumped to (s).
   float ignore_window = 0.2f;
   // The same while standing on an idle clip of the data (s). Such a clip plays through without

@@ -101,8 +101,10 @@ Result<InputScript> parse_input_script(std::string_view text, std::string_view n
 Result<InputScript> load_input_script(const std::filesystem::path& path);
 
 // One line of the format for this state (used to record live input); parsing it gives the
-// same state back to the printed precision.
-std::string format_script_line(float time, const ControllerInput& input);
+// same state back to the printed precision. `style_name` (the name of input.style, which the
+// line cannot look up: the input holds only an id) is written as style=NAME when not empty.
+std::string format_script_line(float time, const ControllerInput& input,
+                               std::string_view style_name = {});
 
 // A reproducible input script of `seconds` for character `seed`: every 0.5 to 3 s the stick
 // takes a new direction (sometimes released, sometimes running, sometimes strafing with the
