@@ -14,15 +14,45 @@ namespace {
 // Bones shorter than this (metres) cannot be bent meaningfully.
 constexpr float kMinBoneLength = 1e-6f;
 
-// The unsigned angle between two vectors, accurate near 0 and pi (atan2 rather than acos).
-float angle_between(const glm::vec3& u, const glm::vec3& v) {
-  return std::atan2(glm::length(glm::cross(u, v)), glm::dot(u, v));
+// An angle as its cosine and sine: every angle of the solve is only ever turned
+// into a rotation, and a rotation's quaternion needs the half angle's cosine and sine, which
+// follow from these by algebra (rotation_about), so no angle is ever computed.
+struct Angle {
+  float cos = 1.0f;
+  float sin = 0.0f;
+};
+
+// The unsigned angle between two vectors (both non-zero), from their dot and cross products:
+// accurate near 0 and pi, where an arccosine of the dot product alone is not.
+Angle angle_between(const glm::vec3& u, const glm::vec3& v) {
+  const float d = glm::dot(u, v);
+  const float c = glm::length(glm::cross(u, v));
+  const float r = std::sqrt(d * d + c * c);
+  return r > 0.0f ? Angle{d / r, c / r} : Angle{};
 }
 
 // The interior angle opposite side c of a triangle with sides a, b, c (law of cosines).
-float triangle_angle(float a, float b, float opposite) {
-  const float cosine = (a * a + b * b - opposite * opposite) / (2.0f * a * b);
-  return std::acos(std::clamp(cosine, -1.0f, 1.0f));
+Angle triangle_angle(float a, float b, float opposite) {
+  const float cosine =
+      std::clamp((a * a + b * b - opposite * opposite) / (2.0f * a * b), -1.0f, 1.0f);
+  return {cosine, std::sqrt(std::max(0.0f, 1.0f - cosine * cosine))};
+}
+
+// The rotation by `to` minus `from` about the unit `axis`, t's cosine and sine by the
+// difference formulas. The half-angle identities make (1 + cos t, sin t axis) and
+// (sin t, (1 - cos t) axis) both proportional to the quaternion of angle t; the first loses
+// precision near a half turn and the second near none, so each is taken where the other is
+// worse (w >= 0: t lies in (-pi, pi]).
+glm::quat rotation_about(const Angle& to, const Angle& from, const glm::vec3& axis) {
+  const float c = to.cos * from.cos + to.sin * from.sin;
+  const float s = to.sin * from.cos - to.cos * from.sin;
+  glm::quat q;
+  if (c >= 0.0f) {
+    q = glm::quat(1.0f + c, s * axis);
+  } else {
+    q = glm::quat(std::abs(s), (s < 0.0f ? c - 1.0f : 1.0f - c) * axis);
+  }
+  return glm::normalize(q);
 }
 
 // A unit vector perpendicular to u (|u| > 0), preferring the direction of `hint`'s part
@@ -81,7 +111,7 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   const glm::vec3 ab = b - a;
   const glm::vec3 ac = c - a;
   glm::vec3 bend_axis = glm::cross(ac, ab);
-  float hip_angle_now = 0.0f;
+  Angle hip_angle_now;
   if (glm::length(bend_axis) > 1e-6f * upper * glm::length(ac) && glm::length(ac) > 1e-6f * total) {
     bend_axis = glm::normalize(bend_axis);
     hip_angle_now = angle_between(ac, ab);
@@ -89,11 +119,11 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
     // Straight or folded limb: no plane yet. Bend toward the pole; step 3 settles the twist.
     bend_axis = glm::normalize(glm::cross(ab, perpendicular(ab, in.pole)));
   }
-  const float knee_angle_now = angle_between(a - b, c - b);
-  const float hip_angle = triangle_angle(upper, reach, lower);
-  const float knee_angle = triangle_angle(upper, lower, reach);
-  const glm::quat hip_bend = glm::angleAxis(hip_angle - hip_angle_now, bend_axis);
-  const glm::quat knee_bend = glm::angleAxis(knee_angle - knee_angle_now, bend_axis);
+  const Angle knee_angle_now = angle_between(a - b, c - b);
+  const glm::quat hip_bend =
+      rotation_about(triangle_angle(upper, reach, lower), hip_angle_now, bend_axis);
+  const glm::quat knee_bend =
+      rotation_about(triangle_angle(upper, lower, reach), knee_angle_now, bend_axis);
 
   glm::vec3 knee = a + hip_bend * ab;
   glm::vec3 ankle = knee + knee_bend * (hip_bend * (c - b));
@@ -107,9 +137,12 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   const glm::vec3 knee_across = knee_offset - glm::dot(knee_offset, direction) * direction;
   const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
   if (glm::length(knee_across) > 1e-6f * upper && glm::length(pole_across) > 1e-6f) {
-    const float angle = std::atan2(glm::dot(direction, glm::cross(knee_across, pole_across)),
-                                   glm::dot(knee_across, pole_across));
-    twist = glm::angleAxis(angle, direction);
+    // The signed angle from the knee's side to the pole's about the direction, its sine the
+    // cross product's part along the direction.
+    const float cosine = glm::dot(knee_across, pole_across);
+    const float sine = glm::dot(direction, glm::cross(knee_across, pole_across));
+    const float r = std::sqrt(cosine * cosine + sine * sine);
+    if (r > 0.0f) twist = rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction);
   }
 
   const glm::quat hip_turn = twist * swing * hip_bend;

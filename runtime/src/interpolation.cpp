@@ -10,12 +10,6 @@ namespace mm {
 
 namespace {
 
-// sin(x) / x, with its Taylor series where the division would lose precision.
-float sinc(float x) {
-  if (std::abs(x) < 1e-3f) return 1.0f - x * x * (1.0f / 6.0f);
-  return std::sin(x) / x;
-}
-
 glm::quat negated_if_far(const glm::quat& from, const glm::quat& q) {
   return glm::dot(from, q) < 0.0f ? -q : q;
 }
@@ -26,9 +20,29 @@ glm::quat quat_abs(const glm::quat& q) {
   return q.w < 0.0f ? -q : q;
 }
 
+// Below these half angles (radians, squared) the exponential and the logarithm sum their Taylor
+// series instead of calling sin, cos and atan2: the series' first dropped term is below float
+// rounding there, and its terms need only the squared length, so no square root either. Every
+// update's small rotations (a frame's turn, an extrapolation step, the offsets of a blend
+// between similar poses) land here.
+constexpr float kExpSeriesLimit2 = 0.25f;    // |half angle| < 0.5
+constexpr float kLogSeriesLimit2 = 0.0625f;  // |tan(half angle)| < 0.25
+
 glm::vec3 quat_log(const glm::quat& q) {
   const glm::vec3 v(q.x, q.y, q.z);
-  const float s = glm::length(v);
+  const float s2 = glm::dot(v, v);
+  // atan2(s, w) / s = atan(x) / (x w) with x = s / w: the series of atan(x) / x in x^2 while
+  // w is positive and x small.
+  if (q.w > 0.0f && s2 < kLogSeriesLimit2 * q.w * q.w) {
+    const float x2 = s2 / (q.w * q.w);
+    const float atan_x_over_x =
+        1.0f + x2 * (-1.0f / 3.0f +
+                     x2 * (1.0f / 5.0f +
+                           x2 * (-1.0f / 7.0f +
+                                 x2 * (1.0f / 9.0f + x2 * (-1.0f / 11.0f + x2 * (1.0f / 13.0f))))));
+    return v * (atan_x_over_x / q.w);
+  }
+  const float s = std::sqrt(s2);
   // Only an exactly (or denormally) zero vector part is special; atan2(s, w) / s is accurate
   // for every other s, tiny ones included, because atan2 keeps relative precision near 0.
   if (s < 1e-30f) return q.w >= 0.0f ? v : glm::vec3(glm::pi<float>(), 0.0f, 0.0f);
@@ -36,8 +50,19 @@ glm::vec3 quat_log(const glm::quat& q) {
 }
 
 glm::quat quat_exp(const glm::vec3& half_angle_axis) {
-  const float a = glm::length(half_angle_axis);
-  const glm::vec3 v = half_angle_axis * sinc(a);
+  const float a2 = glm::dot(half_angle_axis, half_angle_axis);
+  if (a2 < kExpSeriesLimit2) {
+    const float cosine =
+        1.0f +
+        a2 * (-1.0f / 2.0f + a2 * (1.0f / 24.0f + a2 * (-1.0f / 720.0f + a2 * (1.0f / 40320.0f))));
+    const float sine_over_a =
+        1.0f + a2 * (-1.0f / 6.0f +
+                     a2 * (1.0f / 120.0f + a2 * (-1.0f / 5040.0f + a2 * (1.0f / 362880.0f))));
+    const glm::vec3 v = half_angle_axis * sine_over_a;
+    return glm::quat(cosine, v.x, v.y, v.z);
+  }
+  const float a = std::sqrt(a2);
+  const glm::vec3 v = half_angle_axis * (std::sin(a) / a);
   return glm::quat(std::cos(a), v.x, v.y, v.z);
 }
 
