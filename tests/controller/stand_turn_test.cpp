@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/script.hpp"
+#include "mm/programs/evaluation.hpp"
 
 namespace mm {
 namespace {
@@ -188,6 +191,31 @@ TEST(StandTurnTest, AnUnboundedTurnIsTooFast) {
   fast.stand_turn_acceleration = 1000.0f;
   fast.body_max_turn_rate = 0.0f;  // no limit: the body would hold the turn to its own
   EXPECT_GT(turn_on_the_spot(90.0f, 1.0f / 60.0f, 3.0f, fast).peak_rate_degrees, 400.0f);
+}
+
+// Under any input (issue 29): the shipped scripts of turns on the spot, one calm and one whose
+// facing jumps every 0.3 to 1.5 s, sometimes right after a walk, at every rate. Every turn given
+// time to finish ends within 5 degrees of its facing (the idle's hips may stand a few degrees off
+// its root for seconds), the planted feet pivot at most 25 degrees/s, and the body turns at
+// most 300 degrees/s (p99).
+TEST(StandTurnTest, ShippedTurnScriptsEndOnTheirFacingAtEveryRate) {
+  const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
+  for (const char* name : {"stand-turns.txt", "chaos-turns.txt"}) {
+    Result<InputScript> script =
+        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
+    ASSERT_TRUE(script.ok()) << script.message();
+    for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+      EvaluationOptions options;
+      options.dt = dt;
+      Result<EvaluationResult> run = evaluate_script(shared, *script, options);
+      ASSERT_TRUE(run.ok()) << run.message();
+      const EvaluationMetrics& m = run->metrics;
+      EXPECT_GT(m.stand_turns, m.stand_turn_interrupted) << name << " dt " << dt;
+      EXPECT_LE(m.stand_turn_final_error_deg_max, 5.0) << name << " dt " << dt;
+      EXPECT_LE(m.foot_pivot_deg_s_mean, 25.0) << name << " dt " << dt;
+      EXPECT_LE(m.body_turn_rate_deg_s_p99, 300.0) << name << " dt " << dt;
+    }
+  }
 }
 
 }  // namespace
