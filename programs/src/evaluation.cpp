@@ -573,7 +573,8 @@ class WorldReadings {
     const glm::vec3 along =
         r.desired_velocity -
         d.simulation_contact * glm::dot(r.desired_velocity, d.simulation_contact);
-    r.stuck = d.simulation_blocked && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed;
+    const bool at_wall = d.simulation_blocked && glm::length(d.simulation_contact) > 0.5f;
+    r.stuck = at_wall && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed;
     previous_sim_ = d.simulation_position;
   }
 

@@ -24,9 +24,10 @@
 //   kStraightKneeDegrees of straight;
 // - wall_depth_cm_max: the deepest any joint is inside a wall (EvaluationFrame::wall_depth,
 //   from the world's sweeps; 0 without a world);
-// - stuck_s: time the simulation object was blocked while the stick pushed at least
-//   kStuckAlongSpeed along the obstacle and it moved slower than kStuckSpeed: stuck where it
-//   could have slid.
+// - stuck_s: time the simulation object was blocked by a wall while the stick pushed at least
+//   kStuckAlongSpeed along the wall and it moved slower than kStuckSpeed: stuck where it could
+//   have slid. A stop at a ledge (no ground ahead, no wall: the mover does not step off) has no
+//   wall to slide along and is not counted.
 
 #include <cstddef>
 #include <cstdint>
