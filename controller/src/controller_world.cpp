@@ -29,8 +29,9 @@ constexpr float kWallPushHalflife = 0.15f;
 // The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
 // feet, which stay.
 constexpr float kMaxWallPush = 0.1f;
-// How far (m) a toe joint stays from a wall's face: the toes reach past their joint.
-constexpr float kToeWallMargin = 0.03f;
+// The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
+// joint stays from a wall's face (the toes reach past their joint).
+constexpr float kWallProbeRadius = 0.03f;
 
 }  // namespace
 
@@ -218,6 +219,8 @@ void Controller::settle_on_ground() {
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);
+  std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
+  std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
   wall_push_ = wall_push_velocity_ = 0.0f;
 }
 
@@ -235,6 +238,16 @@ void Controller::keep_body_off_walls(float dt) {
     for (size_t j = 1; j < globals_.size(); ++j) {
       const glm::vec3& p = globals_[j].translation;
       if (p.y > above) depth = std::max(depth, glm::dot(wall - p, n));
+    }
+  }
+  // Walls the arms or the head reach (find_walls), met at any angle, moving or not.
+  for (const WallHit& hit : body_walls_) {
+    if (!hit.found) continue;
+    const float past =
+        glm::dot(hit.point - globals_[static_cast<size_t>(hit.joint)].translation, hit.normal);
+    if (past > depth) {
+      depth = past;
+      wall_push_normal_ = hit.normal;
     }
   }
   critical_spring_update(wall_push_, wall_push_velocity_, 0.0f, kWallPushHalflife, dt);
@@ -266,29 +279,47 @@ bool Controller::wall_beside(glm::vec3& point, glm::vec3& normal) const {
   return true;
 }
 
-// Walls between the body and each toe: a small sphere swept from the root's vertical line out
-// to where the foot is, a step above the body's ground (lower things are steps the feet stand
-// on, not walls). One batched call for both feet.
-void Controller::find_walls_at_toes(const std::array<PlacementLeg, 2>& legs) {
-  std::array<ShapeSweep, 2> sweeps;
-  std::array<SweepHit, 2> hits;
-  const float y = ground_height_ + settings_.step_height;
+// Walls near the feet and the arms: a small sphere swept from the root's vertical line out to
+// each toe a step above the body's ground (lower things are steps the feet stand on, not
+// walls), and to each hand, elbow and the head at their own height when higher than a step.
+// One batched call. The capsule keeps only the root a radius from a wall; these reach past it.
+void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
+  const JointRoleIndices& roles = db_->roles();
+  const int reaching[kReachingJoints] = {roles.left_hand, roles.right_hand, roles.left_lower_arm,
+                                         roles.right_lower_arm, roles.head};
   const glm::vec3 root = locals_[0].translation;
-  for (size_t side = 0; side < 2; ++side) {
-    sweeps[side] =
-        ShapeSweep{glm::vec3(root.x, y, root.z), glm::vec3(legs[side].toe.x, y, legs[side].toe.z),
-                   kToeWallMargin, 2.0f * kToeWallMargin};
+  const float step = ground_height_ + settings_.step_height;
+  std::array<ShapeSweep, 2 + kReachingJoints> sweeps;
+  std::array<SweepHit, 2 + kReachingJoints> hits;
+  std::array<WallHit*, 2 + kReachingJoints> out;
+  size_t count = 0;
+  for (int side = 0; side < 2; ++side) {
+    const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
+    out[count] = &toe_walls_[side];
+    sweeps[count++] = ShapeSweep{glm::vec3(root.x, step, root.z), glm::vec3(toe.x, step, toe.z),
+                                 kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
-  mover_.sweep(*world_, origin_, sweeps, hits);
-  for (size_t side = 0; side < 2; ++side) {
-    ToeWall& wall = toe_walls_[side];
-    const glm::vec3 n(hits[side].normal.x, 0.0f, hits[side].normal.z);
-    wall.found = hits[side].hit && glm::length(n) > 0.5f;
+  for (int k = 0; k < kReachingJoints; ++k) {
+    body_walls_[k] = WallHit{};
+    if (reaching[k] < 0) continue;
+    const glm::vec3& p = globals_[static_cast<size_t>(reaching[k])].translation;
+    if (p.y < step) continue;
+    body_walls_[k].joint = reaching[k];
+    out[count] = &body_walls_[k];
+    sweeps[count++] = ShapeSweep{glm::vec3(root.x, p.y - kWallProbeRadius, root.z),
+                                 glm::vec3(p.x, p.y - kWallProbeRadius, p.z), kWallProbeRadius,
+                                 2.0f * kWallProbeRadius};
+  }
+  mover_.sweep(*world_, origin_, std::span(sweeps).first(count), std::span(hits).first(count));
+  for (size_t i = 0; i < count; ++i) {
+    WallHit& wall = *out[i];
+    const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
+    wall.found = hits[i].hit && glm::length(n) > 0.5f;
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.
-    const glm::vec3 centre = glm::mix(sweeps[side].from, sweeps[side].to, hits[side].fraction);
-    wall.point = centre - wall.normal * kToeWallMargin;
+    const glm::vec3 centre = glm::mix(sweeps[i].from, sweeps[i].to, hits[i].fraction);
+    wall.point = centre - wall.normal * kWallProbeRadius;
   }
 }
 
@@ -297,12 +328,12 @@ void Controller::find_walls_at_toes(const std::array<PlacementLeg, 2>& legs) {
 // into it (the capsule keeps only the root a radius away).
 void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
   const auto push_out = [&target](const glm::vec3& wall, const glm::vec3& n) {
-    const float depth = glm::dot(wall - target, n) + kToeWallMargin;
+    const float depth = glm::dot(wall - target, n) + kWallProbeRadius;
     if (depth > 0.0f) target += n * depth;
   };
   glm::vec3 wall, n;
   if (wall_beside(wall, n)) push_out(wall, n);
-  const ToeWall& toe_wall = toe_walls_[side];
+  const WallHit& toe_wall = toe_walls_[side];
   if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
 }
 
@@ -341,7 +372,7 @@ void Controller::place_feet(float dt) {
   placement.max_step_down = settings_.max_step_down;
   foot_placement_.update(*world_, origin_, mover_, placement, legs, ground_height_, sim_velocity_,
                          dt);
-  find_walls_at_toes(legs);
+  find_walls(legs);
   debug_.world_rejected = mover_.rejected();
   const float drop = foot_placement_.pelvis_drop();
   for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation.y -= drop;

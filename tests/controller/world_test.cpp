@@ -255,9 +255,10 @@ TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
   EXPECT_EQ(wall->metrics.ground.stuck_s, 0.0);
   EXPECT_LT(wall->metrics.ground.wall_depth_cm_max, 2.0);
 
-  // A wall through the character where it stands: the depth is seen.
+  // A wall through the character where it stands (farther in than the body is ever moved back
+  // from a wall): the depth is seen.
   AnalyticWorld through;
-  through.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 0.3f), glm::vec2(2.0f, 0.15f), 0.0f, 3.0f});
+  through.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 0.2f), glm::vec2(2.0f, 0.3f), 0.0f, 3.0f});
   options.world = &through;
   const Result<EvaluationResult> inside = evaluate_script(shared, script, options);
   ASSERT_TRUE(inside.ok()) << inside.message();

@@ -511,7 +511,7 @@ class Controller {
   void settle_on_ground();
   void keep_body_off_walls(float dt);
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
-  void find_walls_at_toes(const std::array<PlacementLeg, 2>& legs);
+  void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
   void place_feet(float dt);
   void face_along_obstacle();
@@ -719,14 +719,17 @@ class Controller {
   float wall_push_ = 0.0f;
   float wall_push_velocity_ = 0.0f;
   glm::vec3 wall_push_normal_{0.0f};
-  // A wall found between the body and each toe this update (find_walls_at_toes): a point on its
-  // face and its horizontal normal.
-  struct ToeWall {
+  // A wall found between the body and each toe, and each hand, elbow and the head, this update
+  // (find_walls): a point on its face and its horizontal normal.
+  struct WallHit {
     bool found = false;
+    int joint = -1;
     glm::vec3 point{0.0f};
     glm::vec3 normal{0.0f};
   };
-  ToeWall toe_walls_[2];
+  static constexpr int kReachingJoints = 5;
+  WallHit toe_walls_[2];
+  WallHit body_walls_[kReachingJoints];
   glm::vec3 body_shift_{0.0f};  // what moved the body above the root this update
   float ground_offset_[2] = {0.0f, 0.0f};
 
