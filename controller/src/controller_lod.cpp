@@ -2,6 +2,7 @@
 // (crowd_scheduler.hpp): the simulation object alone, the displayed character carried along.
 
 #include <cmath>
+#include <cstddef>
 
 #include "mm/controller/controller.hpp"
 #include "mm/runtime/interpolation.hpp"
@@ -39,6 +40,45 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
   if (settings_.compute_skinning) {
     mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
   }
+}
+
+namespace {
+
+// Every cache line of [begin, begin + bytes) to be written soon.
+void prefetch_lines(const void* begin, size_t bytes) {
+  constexpr size_t kLine = 64;
+  const char* first = static_cast<const char*>(begin);
+  for (size_t offset = 0; offset < bytes; offset += kLine) {
+    __builtin_prefetch(first + offset, 1);
+  }
+}
+
+template <typename T>
+void prefetch_vector(const std::vector<T>& values) {
+  prefetch_lines(values.data(), values.size() * sizeof(T));
+}
+
+}  // namespace
+
+void Controller::prefetch_move_only() const {
+  // The simulation object and the playback state it moves are members; the poses are heaps.
+  prefetch_lines(&origin_, sizeof(origin_));
+  prefetch_lines(&sim_position_,
+                 static_cast<size_t>(reinterpret_cast<const char*>(&clip_time_) -
+                                     reinterpret_cast<const char*>(&sim_position_)));
+  prefetch_lines(&transition_src_position_, sizeof(transition_src_position_) * 4);
+  prefetch_lines(&settings_.max_dt, sizeof(settings_.max_dt));
+  prefetch_lines(root_offsets_.rotations.data(), sizeof(glm::vec3));
+  prefetch_lines(root_offsets_.positions.data(), sizeof(glm::vec3));
+  prefetch_lines(&feet_, sizeof(feet_));
+  prefetch_lines(&last_root_, sizeof(last_root_));
+  prefetch_lines(&debug_.searched, sizeof(debug_.searched));
+  prefetch_lines(&debug_.transitioned, sizeof(debug_.transitioned));
+  prefetch_lines(&debug_.search_seconds, sizeof(debug_.search_seconds));
+  prefetch_lines(sampled_.data(), sizeof(Transform));
+  prefetch_lines(locals_.data(), sizeof(Transform));
+  prefetch_vector(globals_);
+  if (origin_ != glm::dvec3(0.0)) prefetch_vector(world_globals_);
 }
 
 }  // namespace mm

@@ -194,6 +194,19 @@ bool CrowdScheduler::updates(size_t i) const {
   return (frame_ + static_cast<int64_t>(i)) % period == 0 || held_frames_[i] + 1 >= period;
 }
 
+void CrowdScheduler::prefetch(size_t i, const Controller& controller) const {
+  constexpr size_t kLine = 64;
+  const auto lines = [](const void* begin, size_t bytes) {
+    const char* first = static_cast<const char*>(begin);
+    for (size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset, 1);
+  };
+  const size_t bytes = joints_ * sizeof(Transform);
+  lines(last_.data() + i * joints_, bytes);
+  lines(shown_.data() + i * joints_, bytes);
+  // A full update's own memory traffic dwarfs the latency this hides; a move is all latency.
+  if (tier(i) == CrowdTier::MoveOnly) controller.prefetch_move_only();
+}
+
 void CrowdScheduler::step(size_t i, Controller& controller, float dt,
                           const ControllerInput& input) {
   const std::span<const Transform> globals = controller.global_transforms();

@@ -247,6 +247,7 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
       sync.arrive_and_wait();
       for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
         for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
+          if (i + 1 < n) crowd.scheduler.prefetch(i + 1, crowd.controllers[i + 1]);
           times.update_us[f * n + i] = static_cast<float>(
               step_character(crowd, i, t, options.dt, times.search_seconds[i]) * 1e6);
         }

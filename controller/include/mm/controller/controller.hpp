@@ -414,6 +414,10 @@ class Controller {
   // search, sampling, IK or forward kinematics), foot locks are released. A later update()
   // goes on from there. dt as in update().
   void update_move_only(float dt, const ControllerInput& input);
+  // Asks the cache for what the next update_move_only() reads and writes (the simulation
+  // object, the root, the displayed pose), so a crowd's loop can overlap one character's
+  // memory latency with the step before it. No effect on any result.
+  void prefetch_move_only() const;
 
   // Places the character and its simulation object (cold; clears any transition).
   void teleport(const glm::vec3& position, float yaw);
