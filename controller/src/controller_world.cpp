@@ -43,6 +43,8 @@ void Controller::set_world(const WorldQueries* world) {
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = glm::vec3(0.0f);
   wall_push_ = wall_push_velocity_ = 0.0f;
+  // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
+  body_shift_ = glm::vec3(0.0f);
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
 }
 
@@ -224,11 +226,13 @@ void Controller::settle_on_ground() {
   wall_push_ = wall_push_velocity_ = 0.0f;
 }
 
-// The body kept out of the wall the simulation object stands against: the capsule keeps the
-// root a radius away, but an arm swinging forward or an idle hand reaches past it. Everything
-// above the root is moved back along the wall's normal by as far as the deepest joint higher
-// than a step is past the wall's plane, at once (a hand must not go in), and eases back on a
-// spring once nothing is (the legs' IK keeps planted feet where they are).
+// The body kept out of walls: the capsule keeps the root a radius away, but an arm swinging
+// forward or an idle hand reaches past it. Everything above the root is moved back by as far as
+// the deepest joint higher than a step is past the wall the simulation object stands against,
+// or a hand, elbow or the head past the wall found toward it (find_walls), at once (a hand must
+// not go in), at most kMaxWallPush, and eases back on a spring once nothing is. The feet stay
+// where the animation has them: the foot lock takes the shift (body_shift_) off their targets,
+// so the body leans over them rather than sliding them.
 void Controller::keep_body_off_walls(float dt) {
   float depth = 0.0f;
   glm::vec3 wall, n;
