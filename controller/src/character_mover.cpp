@@ -117,23 +117,44 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
       out[static_cast<size_t>(slid_[k])].position += slide * travelled;
     }
   }
-  // 3. The ground where each move ended, reached from the start's height.
+  // 3. The ground where each move ended, reached from the start's height, and ahead of it.
+  size_t probes = 0;
   for (size_t i = 0; i < n; ++i) {
-    probes_[i] = GroundProbe{
-        glm::vec3(out[i].position.x, starts[i].y + shape.step_height, out[i].position.z),
-        shape.step_height + shape.max_step_down, shape.min_walkable_normal_y};
-    ground_hits_[i] = GroundHit{};
+    const glm::vec3 top(out[i].position.x, starts[i].y + shape.step_height, out[i].position.z);
+    const float reach = shape.step_height + shape.max_step_down;
+    probes_[probes++] = GroundProbe{top, reach, shape.min_walkable_normal_y};
+    glm::vec3 d = goals[i] - starts[i];
+    d.y = 0.0f;
+    const float length = glm::length(d);
+    // Only a step within the capsule's own size (the simulation's and the root's per update):
+    // the ground ahead of a trajectory sample a metre away, up or down stairs, says nothing.
+    lead_[i] = length >= 1e-6f && length <= shape.radius ? static_cast<int>(probes) : -1;
+    if (lead_[i] >= 0) {
+      probes_[probes++] = GroundProbe{top + d * (kLedgeLead * shape.radius / length), reach, 0.0f};
+    }
   }
-  if (n > 0)
-    world.probe_ground(origin, std::span(probes_).first(n), std::span(ground_hits_).first(n));
-  for (size_t i = 0; i < n; ++i) {
-    GroundHit& hit = ground_hits_[i];
-    if (accept(probes_[i], hit) && hit.hit && hit.walkable) {
-      out[i].position.y = hit.point.y;
-      out[i].ground_normal = hit.normal;
-    } else {
+  std::fill_n(ground_hits_.begin(), probes, GroundHit{});
+  if (probes > 0) {
+    world.probe_ground(origin, std::span(probes_).first(probes),
+                       std::span(ground_hits_).first(probes));
+  }
+  for (size_t i = 0, k = 0; i < n; ++i, ++k) {
+    GroundHit& hit = ground_hits_[k];
+    const bool ground = accept(probes_[k], hit) && hit.hit && hit.walkable;
+    // Measured from the end's own ground, not the start's: a trajectory sample a metre down a
+    // stair is far below the start and on no ledge.
+    const float floor = hit.point.y - shape.step_height;
+    bool ledge = !ground;
+    if (lead_[i] >= 0) {
+      GroundHit& ahead = ground_hits_[++k];
+      ledge = ledge || !accept(probes_[k], ahead) || !ahead.hit || ahead.point.y < floor;
+    }
+    if (ledge) {
       out[i].position = starts[i];
       out[i].no_ground = true;
+    } else {
+      out[i].position.y = hit.point.y;
+      out[i].ground_normal = hit.normal;
     }
   }
 }

@@ -364,7 +364,8 @@ void Controller::place_feet(float dt) {
     p.toe += moved;
     p.ankle += moved;
     p.length = leg_length(side);
-    p.planted = feet_[side].locked || debug_.contact[side];
+    // A foot stepping while its frame says contact is in the air: it looks ahead like any other.
+    p.planted = f.locked || (debug_.contact[side] && !f.stepping);
     p.near_ground =
         p.planted || p.toe.y - ground_height_ - shared_->lowest_foot_end(side) < kNearGroundHeight;
   }

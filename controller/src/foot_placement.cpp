@@ -25,6 +25,8 @@ constexpr float kFallHalflife = 0.06f;  // s
 constexpr float kProbeMargin = 0.02f;
 // Ground ahead this much higher than the plane of the ground under the foot (m) is a step.
 constexpr float kStepRise = 0.02f;
+// Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
+constexpr float kEdgeRise = 0.01f;
 
 // Probe slots: per side, heel now, toe now, heel ahead, toe ahead.
 constexpr int kHeel = 0, kToe = 1, kHeelAhead = 2, kToeAhead = 3;
@@ -116,10 +118,41 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   for (int i = 0; i < kProbes; ++i) {
     probes_[i] = GroundProbe{glm::vec3(probe_points_[i].x, top, probe_points_[i].z), reach, 0.0f};
   }
+  constexpr float kAround[kFootprint][2] = {
+      {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
+  for (int side = 0; side < 2; ++side) {
+    for (int k = 0; k < kFootprint; ++k) {
+      const glm::vec3 toe = probe_points_[slot(side, kToe)];
+      const glm::vec3 at(toe.x + kFootprintRadius * kAround[k][0], top,
+                         toe.z + kFootprintRadius * kAround[k][1]);
+      probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach, 0.0f};
+    }
+  }
   mover.probe(world, origin, probes_, hits_);
+  // Ground deeper below the body than a step is over a ledge the body cannot step down
+  // (character_mover.hpp): a foot out over it stays level with the body, so that swinging back
+  // it passes over the edge instead of through the ledge's side.
+  const float ledge = body_ground - settings.step_height;
+  const auto found = [&](int i) {
+    return hits_[i].hit && hits_[i].point.y >= ledge ? hits_[i].point.y : body_ground;
+  };
   for (int i = 0; i < kProbes; ++i) {
-    const float y = hits_[i].hit ? hits_[i].point.y : body_ground;
-    probe_grounds_[i] = glm::vec3(probe_points_[i].x, y, probe_points_[i].z);
+    probe_grounds_[i] = glm::vec3(probe_points_[i].x, found(i), probe_points_[i].z);
+  }
+  // Around the toe, only an edge counts: ground above the plane of the surface under the toe
+  // (on a slope the footprint's uphill side is only the slope, and would lift the toe off it).
+  for (int side = 0; side < 2; ++side) {
+    const GroundHit& under = hits_[slot(side, kToe)];
+    const glm::vec3 n = under.hit ? under.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+    float& toe = probe_grounds_[slot(side, kToe)].y;
+    const float plane_rise =
+        kFootprintRadius * std::sqrt(std::max(0.0f, 1.0f - n.y * n.y)) / std::max(n.y, 0.1f);
+    float edge = toe;
+    for (int k = 0; k < kFootprint; ++k) {
+      const float y = found(kProbes + side * kFootprint + k);
+      if (y > toe + plane_rise + kEdgeRise) edge = std::max(edge, y);
+    }
+    toe = edge;
   }
   // Ahead counts only where the ground steps up: up a slope it is only the slope, which the
   // foot will meet as it gets there (counted now, a landing foot would lock in the air).

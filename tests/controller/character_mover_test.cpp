@@ -110,6 +110,38 @@ TEST(CharacterMover, StepsDownUpToMaxStepDownAndStopsAtALedge) {
   EXPECT_EQ(ledge.position, glm::vec3(0, -0.3f, 1.9f));  // stays where it was
 }
 
+TEST(CharacterMover, AtALedgeDeeperThanAStepItStopsBackFromTheEdge) {
+  // A 0.45 m drop at z = 1: within max_step_down (0.5) but deeper than step_height (0.35).
+  // Stepped off, the lifted capsule would overlap the edge and walk back through its side.
+  AnalyticWorld world;
+  world.height = [](double, double z) { return z < 1.0 ? 0.0 : -0.45; };
+  CharacterMover mover;
+  glm::vec3 p(0.0f, 0.0f, 0.0f);
+  bool stopped = false;
+  for (int step = 0; step < 100; ++step) {
+    const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0, 0, 0.02f));
+    stopped = stopped || m.no_ground;
+    p = m.position;
+  }
+  EXPECT_TRUE(stopped);
+  EXPECT_EQ(p.y, 0.0f);
+  // Stopped once the ground half a radius ahead fell away: the centre, and with it the feet,
+  // stay back from the edge.
+  const float back = 1.0f - CharacterMover::kLedgeLead * shape().radius;
+  EXPECT_LE(p.z, back);
+  EXPECT_GT(p.z, back - 0.021f);
+  // A trajectory sample 0.8 m away, three 14 cm steps down (0.42 m, deeper than a step), is on
+  // no ledge: only the ground ahead of a move's end, against the end's own, makes one.
+  AnalyticWorld stairs;
+  stairs.height = [](double, double z) {
+    return z < 0.0 ? 0.0 : -0.14 * (1.0 + std::floor(z / 0.3));
+  };
+  const MoveResult far =
+      mover.move(stairs, glm::dvec3(0.0), shape(), glm::vec3(0, 0, -0.1f), glm::vec3(0, 0, 0.7f));
+  EXPECT_FALSE(far.no_ground);
+  EXPECT_NEAR(far.position.y, -0.42f, kTolerance);
+}
+
 TEST(CharacterMover, WalksUpAWalkableSlopeButNotASteepOne) {
   AnalyticWorld world;
   const double gentle = std::tan(glm::radians(20.0));

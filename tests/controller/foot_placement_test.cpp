@@ -95,6 +95,47 @@ TEST(FootPlacement, AFootOverAStairsEdgeRestsOnTheStepNeverInsideIt) {
   EXPECT_GT(p.ground(0).heel, 0.0f);
 }
 
+TEST(FootPlacement, AToeAtATreadsEdgeStandsOnTheTreadNotBelowItsEdge) {
+  // Toes 15 cm ahead of their heels at z = 0.15: the step's edge is 5 mm ahead of the left toe
+  // (a probe under the toe itself finds the lower tread) and 3 cm ahead of the right one.
+  for (const float edge : {0.155f, 0.18f}) {
+    AnalyticWorld world;
+    world.boxes.push_back(
+        AnalyticBox{glm::vec2(0.0f, edge + 1.0f), glm::vec2(5.0f, 1.0f), 0.0f, 0.17f});
+    CharacterMover mover;
+    FootPlacement p;
+    const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
+                                           standing_leg(0.1f, 0.0f, 0.0f)};
+    settle(p, world, mover, legs, 0.0f);
+    if (edge - legs[0].toe.z < FootPlacement::kFootprintRadius) {
+      EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f) << edge;
+    } else {
+      EXPECT_EQ(p.ground(0).toe, 0.0f) << edge;  // a toe off the edge stays on its own tread
+    }
+  }
+}
+
+TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
+  // The body stands on a block whose edge is at z = 0.1, the toes beyond it: a 0.45 m drop is a
+  // ledge (deeper than step_height, 0.35), a 0.2 m one a step the foot goes down to.
+  for (const float drop : {0.45f, 0.2f}) {
+    AnalyticWorld world;
+    world.boxes.push_back(
+        AnalyticBox{glm::vec2(0.0f, 0.1f - 1.0f), glm::vec2(5.0f, 1.0f), 0.0f, drop});
+    CharacterMover mover;
+    FootPlacement p;
+    const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, drop),
+                                           standing_leg(0.1f, 0.0f, drop)};
+    settle(p, world, mover, legs, drop);
+    const FootPlacementSettings settings;
+    // Down the step, the toe goes as far as the foot may tilt from its heel on the block.
+    const float rise = glm::length(legs[0].toe - legs[0].ankle) * std::tan(settings.max_foot_tilt);
+    const float expected = drop > settings.step_height ? drop : std::max(0.0f, drop - rise);
+    EXPECT_NEAR(p.ground(0).toe, expected, 2e-3f) << drop;
+    EXPECT_NEAR(p.ground(0).heel, drop, 1e-3f) << drop;  // the heel is on the block
+  }
+}
+
 TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   AnalyticWorld world;
   // The riser at z = 0.3, ahead of a toe at z = 0.15 moving forward with the body.
@@ -137,7 +178,7 @@ TEST(FootPlacement, GarbageAnswersAreIgnoredAndCounted) {
   const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.2f),
                                          standing_leg(0.1f, 0.0f, 0.2f)};
   settle(p, world, mover, legs, 0.2f);
-  EXPECT_EQ(mover.rejected(), 180 * FootPlacement::kProbes);
+  EXPECT_EQ(mover.rejected(), 180 * FootPlacement::kQueries);
   for (int side = 0; side < 2; ++side) {
     EXPECT_EQ(p.ground(side).heel, 0.2f);
     EXPECT_EQ(p.ground(side).toe, 0.2f);
@@ -161,8 +202,9 @@ TEST(FootPlacement, ThePelvisComesDownSoThatTheLowerFootReachesWithinItsLimit) {
   EXPECT_GT(p.pelvis_drop(), 0.05f);
   EXPECT_NEAR(reach, std::max(glm::length(low.hip - low.ankle), 0.97f * low.length), 2e-3f);
 
-  // Far deeper than the limit: the drop stops at it.
-  world.height = [](double x, double) { return x > 0.0 ? -0.45 : 0.0; };
+  // Far deeper than the limit (yet within a step: deeper is a ledge the foot stays above), the
+  // drop stops at the limit.
+  world.height = [](double x, double) { return x > 0.0 ? -0.33 : 0.0; };
   FootPlacementSettings settings;
   settings.max_pelvis_drop = 0.2f;
   settle(p, world, mover, legs, 0.0f, settings);

@@ -13,7 +13,12 @@
 //    max_step_down, at where the sweeps ended. Walkable ground there is the new height (up a
 //    step, down a step, along a slope). No ground within reach (a ledge) or ground too steep:
 //    the move does not happen, the character stays where it was (never launched into the air,
-//    never below the ground).
+//    never below the ground). A drop deeper than step_height, under the capsule's centre or
+//    kLedgeLead of its radius ahead of it, is a ledge too: lowered that far, the lifted capsule
+//    would overlap the edge it left, and a sweep that starts inside geometry sees nothing, so the
+//    next move would walk back through the ledge's side (found strafing off a ramp's side). The
+//    lead keeps the centre, and so the feet, back from the edge. max_step_down is how far the
+//    probe reaches: ground found below a drop it cannot take still tells a ledge from a hole.
 // Each phase is one batched call to the world (all trajectory samples at once). Answers that
 // fail the checks of world.hpp count as no hit and are counted in rejected().
 //
@@ -55,6 +60,9 @@ class CharacterMover {
   // How far short of a contact a sweep stops (m), so that the next sweep does not start
   // touching the obstacle.
   static constexpr float kSkin = 0.01f;
+  // Where ahead of the capsule's centre, in radii along the move, a drop makes a ledge: within
+  // one tread of steep stairs (a 0.26 m tread is more than half a 0.3 m radius).
+  static constexpr float kLedgeLead = 0.5f;
 
   // Moves each start[i] toward goal[i] (y ignored) and writes where it ended to out[i]: three
   // batched calls to the world (sweep, slide, ground), whatever the count (at most kMaxMoves).
@@ -89,8 +97,9 @@ class CharacterMover {
 
   std::array<ShapeSweep, kMaxMoves> sweeps_{};
   std::array<SweepHit, kMaxMoves> sweep_hits_{};
-  std::array<GroundProbe, kMaxMoves> probes_{};
-  std::array<GroundHit, kMaxMoves> ground_hits_{};
+  std::array<GroundProbe, 2 * kMaxMoves> probes_{};  // per move: its end, then ahead of it
+  std::array<GroundHit, 2 * kMaxMoves> ground_hits_{};
+  std::array<int, kMaxMoves> lead_{};  // the probe ahead of each move's end, or -1
   std::array<int, kMaxMoves> slid_{};  // the move each slide sweep belongs to
   int64_t rejected_ = 0;
 };

@@ -63,6 +63,13 @@ class FootPlacement {
  public:
   // Heel and toe of each foot, now and ahead.
   static constexpr int kProbes = 8;
+  // Around each toe, kFootprint probes kFootprintRadius out (m): a toe joint at a tread's or a
+  // ramp's edge is a point the ground under it changes at, and a probe a millimetre on the low
+  // side let a toe sink below the edge it was on. The toe stands on the highest of them.
+  static constexpr int kFootprint = 4;
+  static constexpr float kFootprintRadius = 0.015f;
+  // Ground probes per update, all in one call.
+  static constexpr int kQueries = kProbes + 2 * kFootprint;
   // How far ahead the probes look: the body's velocity times this (s), or the toe's own
   // (a step to the side or a turn's step goes where the body does not) times kToeLookahead,
   // whichever goes farther.
@@ -120,8 +127,8 @@ class FootPlacement {
   float pelvis_drop_velocity_ = 0.0f;
   float drop_goal_ = 0.0f;  // the drop's goal, smoothed
   float drop_goal_velocity_ = 0.0f;
-  std::array<GroundProbe, kProbes> probes_{};
-  std::array<GroundHit, kProbes> hits_{};
+  std::array<GroundProbe, kQueries> probes_{};
+  std::array<GroundHit, kQueries> hits_{};
   std::array<glm::vec3, kProbes> probe_points_{};
   std::array<glm::vec3, kProbes> probe_grounds_{};
 };
