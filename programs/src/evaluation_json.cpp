@@ -30,6 +30,8 @@ nlohmann::json evaluation_metrics_json(const EvaluationMetrics& m) {
           {"database_accel_p99_m_s2", m.database_accel_p99},
           {"transition_accel_ratio_same_sampling", m.transition_accel_ratio_same_sampling},
           {"database_accel_p99_same_sampling_m_s2", m.database_accel_p99_same_sampling},
+          {"transition_accel_ratio_played", m.transition_accel_ratio_played},
+          {"played_accel_p99_m_s2", m.played_accel_p99},
           {"search_us_mean", m.search_us_mean},
           {"update_us_mean", m.update_us_mean},
           {"body_turn_rate_deg_s_p99", m.body_turn_rate_deg_s_p99},

@@ -196,6 +196,10 @@ void print_metrics(const EvaluationMetrics& m) {
       "played with the controller's sampling, %.1f m/s^2)\n",
       m.transition_accel_ratio, m.transition_accel_p99, m.database_accel_p99,
       m.transition_accel_ratio_same_sampling, m.database_accel_p99_same_sampling);
+  std::printf(
+      "transition_accel_ratio_played %8.3f   (against the playing clips on their own at the "
+      "same moments, %.1f m/s^2)\n",
+      m.transition_accel_ratio_played, m.played_accel_p99);
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
   print_body_metrics(m);
