@@ -119,6 +119,7 @@ struct EvaluationAccumulator::State {
   int style_requests = 0;
   int style_request_start = -1;  // frame of the open request, -1 when none is open
   RunningMean style_times;
+  double style_time_max = 0.0;
   void measure_style(const EvaluationFrame& r);
   JointRoleIndices roles;
   size_t joint_count = 0;
@@ -229,7 +230,9 @@ void EvaluationAccumulator::State::measure_style(const EvaluationFrame& r) {
   }
   const bool match = requested && r.clip_style == r.requested_style;
   if (match && style_request_start >= 0) {
-    style_times.add(static_cast<double>(frames - style_request_start) * dt);
+    const double response = static_cast<double>(frames - style_request_start) * dt;
+    style_times.add(response);
+    style_time_max = std::max(style_time_max, response);
     style_request_start = -1;
   }
   if (requested && glm::length(r.desired_velocity) > kStyleMovingSpeed) {
@@ -456,6 +459,7 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.style_requests = s.style_requests;
   m.style_requests_reached = static_cast<int>(s.style_times.count);
   m.style_response_s = s.style_times.value();
+  m.style_response_s_max = s.style_time_max;
   m.search_us_mean = s.searches.value();
   m.update_us_mean = s.updates.value();
   m.transition_accel_p99 = s.accelerations.percentile(99.0);

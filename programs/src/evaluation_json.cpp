@@ -23,6 +23,7 @@ nlohmann::json evaluation_metrics_json(const EvaluationMetrics& m) {
           {"style_match", m.style_match},
           {"style_frames", m.style_frames},
           {"style_response_s", m.style_response_s},
+          {"style_response_s_max", m.style_response_s_max},
           {"style_requests", m.style_requests},
           {"style_requests_reached", m.style_requests_reached},
           {"transition_accel_ratio", m.transition_accel_ratio},

@@ -175,8 +175,9 @@ void print_metrics(const EvaluationMetrics& m) {
   if (m.style_requests > 0) {
     std::printf("style_match                 %10.3f   (%d moving frames with a style request)\n",
                 m.style_match, m.style_frames);
-    std::printf("style_response_s            %10.3f   (%d of %d requests reached)\n",
-                m.style_response_s, m.style_requests_reached, m.style_requests);
+    std::printf("style_response_s            %10.3f   (%d of %d requests reached; slowest %.3f)\n",
+                m.style_response_s, m.style_requests_reached, m.style_requests,
+                m.style_response_s_max);
   }
   std::printf("foot_skate_cm_s_mean        %10.3f\n", m.foot_skate_cm_s_mean);
   std::printf("foot_skate_cm_s_p95         %10.3f\n", m.foot_skate_cm_s_p95);

@@ -168,6 +168,7 @@ struct EvaluationMetrics {
   double style_match = -1.0;
   int style_frames = 0;
   double style_response_s = 0.0;
+  double style_response_s_max = 0.0;  // the slowest of those requests
   int style_requests = 0;
   int style_requests_reached = 0;
   double transition_accel_ratio = 0.0;
