@@ -3,6 +3,8 @@
 # all-styles database at 1/30, 1/60 and 1/144 s on the style scripts of scripts/input, one
 # markdown row per style and time step on stdout; the JSON of each run is kept in OUT_DIR.
 #   scripts/measure_styles.sh DB [OUT_DIR]      (mm from build/release, or $MM)
+# STYLE_DTS="0.033333 0.016667" measures only those time steps; REUSE=1 keeps the JSON files
+# already in OUT_DIR and only prints their rows (to gather runs made in parallel).
 # Build the database as docs/styles.md says. Each style's moves (mm info) decide which scripts
 # judge it: styles-side-moves.txt only for the styles with "backward, strafes".
 set -euo pipefail
@@ -18,17 +20,20 @@ styles=$("$mm" info "$db" | awk '/^styles:/{on=1; next} on && /^  [a-z]/ && $1 !
 
 printf '| style | dt | style_match moves / own / side | response max (s) | skating geom moves / own / side (data) | accel ratio moves / own / side / switch | accel ratio played moves / own / side / switch | root dist mean / max (cm) | stand turns err mean / max (deg), unsettled |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'
-for dt in 0.033333 0.016667 0.0069444; do
+for dt in ${STYLE_DTS:-0.033333 0.016667 0.0069444}; do
   case $dt in 0.033333) label=1/30 ;; 0.016667) label=1/60 ;; *) label=1/144 ;; esac
   while read -r style kind side; do
     json="$out/$style-${label/\//-}.json"
     scripts=(--script scripts/input/styles-moves.txt --script scripts/input/styles-own-moves.txt)
     [[ $side == side ]] && scripts+=(--script scripts/input/styles-side-moves.txt)
     scripts+=(--script scripts/input/styles-response.txt --script scripts/input/stand-turns.txt)
-    "$mm" eval --db "$db" --style "$style" --dt "$dt" "${scripts[@]}" --json "$json" >/dev/null
+    if [[ ${REUSE:-0} != 1 || ! -f $json ]]; then
+      "$mm" eval --db "$db" --style "$style" --dt "$dt" "${scripts[@]}" --json "$json" >/dev/null
+    fi
     jq -r --arg style "$style" --arg kind "$kind" --arg dt "$label" '
       def run(name): (.runs[] | select(.script | endswith(name))) // null;
-      def n2: if . == null then "-" else (. * 100 | round / 100 | tostring) end;
+      def n2: if . == null then "-" else (. * 100 | round) as $c |
+        "\($c / 100 | floor).\($c % 100 | tostring | if length < 2 then "0" + . else . end)" end;
       def f(x): x | n2;
       run("styles-moves.txt") as $m | run("styles-own-moves.txt") as $o |
       run("styles-side-moves.txt") as $s | run("styles-response.txt") as $r |
