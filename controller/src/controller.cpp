@@ -450,7 +450,7 @@ void Controller::desired_motion(const ControllerInput& input) {
   desired_velocity_ = desired_rotation_ * scaled;
   if (world_ && !input.strafe && !facing_given) face_along_obstacle();
 
-  tag_bits_ = resolve_tag(input.tag);
+  tag_bits_ = input.tag_bits ? *input.tag_bits : shared_->tag_bits(input.tag);
   style_ = input.style >= 0 && input.style < shared_->style_count() ? input.style : -1;
   debug_.requested_style = style_;
   const bool released = glm::length(move) == 0.0f;
@@ -470,18 +470,6 @@ void Controller::desired_motion(const ControllerInput& input) {
     warp_facing_reached_ = true;
   }
   simulation_goal_rotation_ = warped_facing();
-}
-
-uint64_t Controller::resolve_tag(std::string_view tag) const {
-  if (tag.empty()) return 0;
-  uint64_t bits = 0;
-  for (size_t i = 0; i < db_->tag_names().size(); ++i) {
-    const std::string& name = db_->tag_names()[i];
-    const bool word = name.size() > tag.size() && name.compare(0, tag.size(), tag) == 0 &&
-                      name[tag.size()] == '-';
-    if (name == tag || word) bits |= uint64_t{1} << i;
-  }
-  return bits;
 }
 
 bool Controller::should_search() const {

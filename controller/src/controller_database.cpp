@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "mm/controller/controller.hpp"
@@ -163,6 +166,19 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
     out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
   }
   return std::shared_ptr<const ControllerDatabase>(std::move(out));
+}
+
+uint64_t ControllerDatabase::tag_bits(std::string_view tag) const {
+  if (tag.empty()) return 0;
+  uint64_t bits = 0;
+  const std::span<const std::string> names = database_->tag_names();
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string& name = names[i];
+    const bool word = name.size() > tag.size() && name.compare(0, tag.size(), tag) == 0 &&
+                      name[tag.size()] == '-';
+    if (name == tag || word) bits |= uint64_t{1} << i;
+  }
+  return bits;
 }
 
 Result<const Searcher*> ControllerDatabase::searcher(std::string_view method) const {

@@ -159,6 +159,7 @@ InputScript::InputScript(std::vector<ScriptEvent> events) : events_(std::move(ev
 Status InputScript::resolve_styles(const ControllerDatabase& database,
                                    std::string_view name_for_messages, int default_style) {
   for (ScriptEvent& event : events_) {
+    event.input.tag_bits = database.tag_bits(event.tag);
     if (event.style.empty()) {
       event.input.style = default_style;
       continue;

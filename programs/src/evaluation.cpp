@@ -119,6 +119,7 @@ struct EvaluationAccumulator::State {
   int style_requests = 0;
   int style_request_start = -1;  // frame of the open request, -1 when none is open
   RunningMean style_times;
+  double style_time_max = 0.0;
   void measure_style(const EvaluationFrame& r);
   JointRoleIndices roles;
   size_t joint_count = 0;
@@ -229,7 +230,9 @@ void EvaluationAccumulator::State::measure_style(const EvaluationFrame& r) {
   }
   const bool match = requested && r.clip_style == r.requested_style;
   if (match && style_request_start >= 0) {
-    style_times.add(static_cast<double>(frames - style_request_start) * dt);
+    const double response = static_cast<double>(frames - style_request_start) * dt;
+    style_times.add(response);
+    style_time_max = std::max(style_time_max, response);
     style_request_start = -1;
   }
   if (requested && glm::length(r.desired_velocity) > kStyleMovingSpeed) {
@@ -456,6 +459,7 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.style_requests = s.style_requests;
   m.style_requests_reached = static_cast<int>(s.style_times.count);
   m.style_response_s = s.style_times.value();
+  m.style_response_s_max = s.style_time_max;
   m.search_us_mean = s.searches.value();
   m.update_us_mean = s.updates.value();
   m.transition_accel_p99 = s.accelerations.percentile(99.0);
@@ -630,6 +634,62 @@ class WorldReadings {
   glm::vec3 previous_sim_{0.0f};
 };
 
+// The acceleration the playing clips have on their own at the moments transition_accel_p99
+// samples (the 10 frames from each transition, counted once per transition among them): the
+// clip played straight through those moments, with the controller's sampling. What a blend
+// adds to a jump shows against this; against the whole database it would also show how much
+// more the script runs than the data does.
+class PlayedAcceleration {
+ public:
+  PlayedAcceleration(const Database& db, float dt, bool cubic)
+      : db_(db),
+        dt_(dt),
+        cubic_(cubic),
+        local_(static_cast<size_t>(db.joint_count())),
+        global_(local_.size()) {
+    for (std::vector<glm::vec3>& step : steps_) step.assign(local_.size(), glm::vec3(0.0f));
+  }
+
+  void add(const ControllerDebug& d) {
+    transition_bits_ = (transition_bits_ << 1) | (d.transitioned ? 1u : 0u);
+    const int count = std::popcount(transition_bits_ & 0x3ffu);
+    if (count == 0 || d.clip < 0) return;
+    for (int k = 0; k < 3; ++k) {
+      pose_at(d.clip, d.clip_time + static_cast<float>(k - 1) * dt_,
+              steps_[static_cast<size_t>(k)]);
+    }
+    for (int i = 0; i < count; ++i) {
+      joint_accelerations(steps_[0], steps_[1], steps_[2], dt_, accelerations_);
+    }
+  }
+  double p99() const { return accelerations_.percentile(99.0); }
+
+ private:
+  // The clip's global joint positions at `time`, held within the clip.
+  void pose_at(int clip_index, float time, std::vector<glm::vec3>& out) {
+    const ClipRange& clip = db_.clips()[static_cast<size_t>(clip_index)];
+    const float last = static_cast<float>(clip.frame_count() - 1);
+    const float x = std::clamp(time / db_.frame_time(), 0.0f, last);
+    const int i0 = std::min(clamped_integer<int>(std::floor(x)), clip.frame_count() - 1);
+    const int i1 = std::min(i0 + 1, clip.frame_count() - 1);
+    for (size_t j = 0; j < local_.size(); ++j) {
+      local_[j] =
+          sample_database_joint(db_, clip.start + i0, clip.start + i1, x - static_cast<float>(i0),
+                                j, cubic_, InterpolationMethod::Nlerp);
+    }
+    forward_kinematics(db_.skeleton().parents(), local_, global_);
+    for (size_t j = 0; j < local_.size(); ++j) out[j] = global_[j].translation;
+  }
+
+  const Database& db_;
+  float dt_;
+  bool cubic_;
+  std::vector<Transform> local_, global_;
+  std::vector<glm::vec3> steps_[3];
+  uint32_t transition_bits_ = 0;
+  PercentileHistogram accelerations_;
+};
+
 // The transition figures against the database's own acceleration at the same dt.
 void compare_with_database(const ControllerDatabase& database, const EvaluationOptions& options,
                            EvaluationMetrics& m) {
@@ -720,6 +780,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   EvaluationAccumulator accumulator(db.roles(), joints, dt);
   std::vector<glm::vec3> positions(joints);
   WorldReadings world(options.world, db.roles(), joints);
+  PlayedAcceleration played(db, dt, options.settings.cubic_playback);
   using Clock = std::chrono::steady_clock;
   for (int f = 0; f < *frame_count; ++f) {
     const float t = static_cast<float>(f + 1) * dt;
@@ -730,6 +791,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
     world.read(controller, dt, frame);
     accumulator.add(frame);
+    played.add(controller.debug());
     if (options.dump) *options.dump << csv_row(frame) << "\n";
     if (options.on_frame) options.on_frame(frame);
   }
@@ -737,6 +799,10 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   result.metrics = accumulator.metrics();
   compare_with_database(*database, options, result.metrics);
   compare_skating_with_database(*database, dt, result.metrics);
+  EvaluationMetrics& m = result.metrics;
+  m.played_accel_p99 = played.p99();
+  m.transition_accel_ratio_played =
+      m.played_accel_p99 > 0.0 ? m.transition_accel_p99 / m.played_accel_p99 : 0.0;
   return result;
 }
 

@@ -42,6 +42,7 @@ class PyController {
     input.camera_yaw = camera_yaw;
     if (facing_yaw) input.facing_yaw = *facing_yaw;
     input.tag = tag;
+    input.tag_bits = controller_->controller_database().tag_bits(tag);
     controller_->update(dt, input);
   }
 

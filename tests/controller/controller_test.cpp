@@ -474,6 +474,38 @@ TEST(ControllerTest, TagRequestPlaysTaggedClipsThenLocomotionResumes) {
       << db.clips()[static_cast<size_t>(c.debug().clip)].name;
 }
 
+// A tag request resolved outside update(): the database names the tags a request covers, and
+// update() follows the resolved bits, not the text, once they are given.
+TEST(ControllerTest, ResolvedTagBitsDecideTheRequest) {
+  const auto shared = normal_controller_database();
+  const Database& db = shared->database();
+  uint64_t wave = 0;
+  for (size_t i = 0; i < db.tag_names().size(); ++i) {
+    if (db.tag_names()[i].rfind("wave-", 0) == 0) wave |= uint64_t{1} << i;
+  }
+  ASSERT_NE(wave, 0u);
+  EXPECT_EQ(shared->tag_bits("wave"), wave);  // the first word names every wave-* tag
+  EXPECT_EQ(shared->tag_bits("wav"), 0u);     // a prefix that is not a whole word names none
+  EXPECT_EQ(shared->tag_bits("no-such-tag"), 0u);
+  EXPECT_EQ(shared->tag_bits(""), 0u);
+
+  auto clip_tags = [&](const Controller& c) {
+    return db.clips()[static_cast<size_t>(c.debug().clip)].tags;
+  };
+  // Bits without text play the tagged clips...
+  Controller bits_only = make();
+  ControllerInput input;
+  input.tag_bits = wave;
+  for (int i = 0; i < 60; ++i) bits_only.update(kDt, input);
+  EXPECT_TRUE(clip_tags(bits_only) & wave);
+  // ...and resolved bits of 0 win over the text: locomotion, no wave.
+  Controller zero_bits = make();
+  input.tag = "wave";
+  input.tag_bits = uint64_t{0};
+  for (int i = 0; i < 60; ++i) zero_bits.update(kDt, input);
+  EXPECT_FALSE(clip_tags(zero_bits) & wave);
+}
+
 TEST(ControllerTest, DifferentFrameRatesTrackTheSameTrajectory) {
   // The game's rate is not the database's: at 30, 60 and 144 Hz the character ends up near the
   // same place after the same script.
@@ -645,6 +677,17 @@ TEST(ControllerStyles, AScriptStyleResolvesAndAnUnknownOneNamesTheLine) {
   ASSERT_TRUE(script->resolve_styles(*shared, "styles.txt", -1).ok());
   EXPECT_EQ(script->at(0.5f).style, *shared->style_id("normal"));
   EXPECT_EQ(script->at(1.5f).style, -1);  // no style on the line, no default: any
+
+  // The same step resolves each line's tag, so that update() compares no strings.
+  Result<InputScript> tagged =
+      parse_input_script("0 0 0 0 0 tag=wave\n1 0 1 0 0\n2 0 0 0 0 tag=nothing\n", "tags.txt");
+  ASSERT_TRUE(tagged) << tagged.message();
+  EXPECT_FALSE(tagged->at(0.5f).tag_bits.has_value());  // parsed, not resolved yet
+  ASSERT_TRUE(tagged->resolve_styles(*shared, "tags.txt", -1).ok());
+  EXPECT_EQ(tagged->at(0.5f).tag_bits, shared->tag_bits("wave"));
+  EXPECT_NE(shared->tag_bits("wave"), 0u);
+  EXPECT_EQ(tagged->at(1.5f).tag_bits, uint64_t{0});
+  EXPECT_EQ(tagged->at(2.5f).tag_bits, uint64_t{0});  // an unknown tag: locomotion
 
   Result<InputScript> bad = parse_input_script("0 0 1 0 0\n\n2 0 1 0 0 style=proud\n", "bad.txt");
   ASSERT_TRUE(bad) << bad.message();

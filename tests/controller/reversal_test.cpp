@@ -107,5 +107,28 @@ TEST(ReversalTest, DeadBlendingTransitionsAreSmootherThanInertialization) {
   }
 }
 
+// transition_accel_ratio_played judges a transition against the clips it plays, at the same
+// moments: a cut (no cross-fade) jumps far harder than the clips move there, the default blend
+// does not. Against the whole database the same runs would also be judged by how much they run.
+TEST(ReversalTest, ACutShowsAgainstTheClipsItPlaysAndTheBlendDoesNot) {
+  Result<InputScript> script =
+      load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input/reversals.txt");
+  ASSERT_TRUE(script.ok()) << script.message();
+  double ratio[2] = {0.0, 0.0};
+  for (const bool cut : {false, true}) {
+    EvaluationOptions options;
+    options.dt = 1.0f / 30.0f;
+    if (cut) options.settings.dead_blend_time = 0.0f;
+    Result<EvaluationResult> run =
+        evaluate_script(test::normal_controller_database(), *script, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    EXPECT_GT(run->metrics.played_accel_p99, 0.0);
+    ratio[cut ? 1 : 0] = run->metrics.transition_accel_ratio_played;
+  }
+  EXPECT_LT(ratio[0], 1.0);
+  EXPECT_GT(ratio[1], 2.0);
+  EXPECT_GT(ratio[1], 2.0 * ratio[0]);
+}
+
 }  // namespace
 }  // namespace mm

@@ -408,6 +408,30 @@ TEST(Evaluation, StandingKeysWaitASecondAfterTheFacingChanges) {
   }
 }
 
+// Two style requests while walking: the first style plays from the request's 4th frame on, the
+// second from its 9th; the style response is their mean and the slowest, and style_match the
+// share of moving frames whose clip has the requested style.
+TEST(Evaluation, StyleResponseIsTheMeanAndTheSlowestOfTheRequests) {
+  EvaluationAccumulator accumulator(synthetic_roles(), kJointCount, kDt);
+  const std::vector<glm::vec3> joints = joints_of(Pose{});
+  for (int i = 0; i < 20; ++i) {
+    EvaluationFrame f;
+    f.t = static_cast<float>(i + 1) * kDt;
+    f.desired_velocity = glm::vec3(0.0f, 0.0f, 1.4f);
+    f.joints = joints;
+    f.requested_style = i < 10 ? 1 : 2;
+    f.clip_style = i < 3 ? 0 : (i < 10 ? 1 : (i < 18 ? 1 : 2));
+    accumulator.add(f);
+  }
+  const EvaluationMetrics m = accumulator.metrics();
+  EXPECT_EQ(m.style_requests, 2);
+  EXPECT_EQ(m.style_requests_reached, 2);
+  EXPECT_NEAR(m.style_response_s, 0.5 * (3.0 + 8.0) * kDt, 1e-6);
+  EXPECT_NEAR(m.style_response_s_max, 8.0 * kDt, 1e-6);
+  EXPECT_EQ(m.style_frames, 20);
+  EXPECT_NEAR(m.style_match, (7.0 + 2.0) / 20.0, 1e-9);
+}
+
 TEST(Evaluation, NothingMeasuredGivesZeroesAndZeroCounts) {
   EvaluationAccumulator empty(synthetic_roles(), kJointCount, kDt);
   const EvaluationMetrics m = empty.metrics();

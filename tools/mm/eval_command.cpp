@@ -175,8 +175,9 @@ void print_metrics(const EvaluationMetrics& m) {
   if (m.style_requests > 0) {
     std::printf("style_match                 %10.3f   (%d moving frames with a style request)\n",
                 m.style_match, m.style_frames);
-    std::printf("style_response_s            %10.3f   (%d of %d requests reached)\n",
-                m.style_response_s, m.style_requests_reached, m.style_requests);
+    std::printf("style_response_s            %10.3f   (%d of %d requests reached; slowest %.3f)\n",
+                m.style_response_s, m.style_requests_reached, m.style_requests,
+                m.style_response_s_max);
   }
   std::printf("foot_skate_cm_s_mean        %10.3f\n", m.foot_skate_cm_s_mean);
   std::printf("foot_skate_cm_s_p95         %10.3f\n", m.foot_skate_cm_s_p95);
@@ -196,6 +197,10 @@ void print_metrics(const EvaluationMetrics& m) {
       "played with the controller's sampling, %.1f m/s^2)\n",
       m.transition_accel_ratio, m.transition_accel_p99, m.database_accel_p99,
       m.transition_accel_ratio_same_sampling, m.database_accel_p99_same_sampling);
+  std::printf(
+      "transition_accel_ratio_played %8.3f   (against the playing clips on their own at the "
+      "same moments, %.1f m/s^2)\n",
+      m.transition_accel_ratio_played, m.played_accel_p99);
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
   print_body_metrics(m);

@@ -313,6 +313,7 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
     } else {
       styles.poll(window, db, !ui_keyboard);
       styles.apply(input);
+      input.tag_bits = db.tag_bits(input.tag);  // resolved here, not in the update
     }
     const float dt = stage.panel.paused
                          ? 0.0f

@@ -121,6 +121,11 @@ class ControllerDatabase {
   // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
   uint64_t action_tags() const { return action_tags_; }
   uint64_t idle_tags() const { return idle_tags_; }
+  // The bits of the tags a tag request names (ControllerInput::tag): a tag equal to `tag`, or
+  // whose first word is it ("wave" names "wave-both-hands" and "wave-left-hand"); 0 for an
+  // empty or unknown name. Compares strings: call it outside update() and pass the bits in
+  // ControllerInput::tag_bits.
+  uint64_t tag_bits(std::string_view tag) const;
   // Styles (controller_style.cpp). The id of a style name of the database, or an error naming
   // the style and the styles there are; call it outside update() and pass the id in
   // ControllerInput::style.
@@ -575,7 +580,6 @@ class Controller {
   float foot_length(int side) const;  // ankle to toe in the played pose (m; 0 without a toe)
   void finish_pose();
   void refresh_outputs(float dt);
-  uint64_t resolve_tag(std::string_view tag) const;
 
   std::shared_ptr<const ControllerDatabase> shared_;
   const Database* db_ = nullptr;

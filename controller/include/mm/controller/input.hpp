@@ -6,7 +6,9 @@
 // is read in the camera's frame: +y pushes away from the camera (forward), +x to the camera's
 // right. Sticks outside the unit disc are scaled back onto it; non-finite values count as 0.
 
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <string_view>
 
 #include <glm/glm.hpp>
@@ -25,12 +27,19 @@ struct ControllerInput {
   float facing_yaw = std::numeric_limits<float>::quiet_NaN();
   // Play clips carrying this tag (e.g. "wave"): a database tag equal to it, or whose first word
   // is it ("wave" matches "wave-both-hands" and "wave-left-hand"). Empty: locomotion. The view
-  // is read during update() only; it need not outlive the call.
+  // is read during update() only; it need not outlive the call. Matching it against the
+  // database's tag names is string work, so resolve it outside update() into tag_bits below.
   std::string_view tag;
   // The requested style, an id from ControllerDatabase::style_id() (resolved once, outside
   // update()); -1 (or an id the database does not have): any style. Frames of other styles pay
   // ControllerSettings::style_cost in the search (docs/controller.md, Styles).
   int style = -1;
+  // `tag` resolved against the database, ControllerDatabase::tag_bits(tag), outside update()
+  // (InputScript::resolve_styles() does it for a script's lines, the viewer and the Python
+  // binding when they set a tag): update() then reads only these bits (0: locomotion) and
+  // never looks at `tag`. Empty: update() resolves `tag` itself, comparing it with every tag
+  // name of the database on every call.
+  std::optional<uint64_t> tag_bits;
 };
 
 }  // namespace mm

@@ -83,8 +83,9 @@ class InputScript {
   // Index of the line in effect at t, or -1 before the first line.
   int index_at(float t) const;
   // Sets every line's input.style from its style name (a line without one gets
-  // `default_style`, -1: any). An unknown name fails with "<name_for_messages>:<line>: " and
-  // ControllerDatabase::style_id()'s message.
+  // `default_style`, -1: any), and its input.tag_bits from its tag (an unknown tag: 0, plain
+  // locomotion, as update() would resolve it), so that update() does no string work. An unknown
+  // name fails with "<name_for_messages>:<line>: " and ControllerDatabase::style_id()'s message.
   Status resolve_styles(const ControllerDatabase& database, std::string_view name_for_messages,
                         int default_style = -1);
 

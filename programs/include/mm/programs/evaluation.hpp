@@ -38,7 +38,11 @@
 //   through at the same dt with linear interpolation between frames; the controller plays with
 //   cubic Hermite sampling by default, which is smoother than that, so the same ratio against
 //   the data played with the controller's own sampling is reported beside it
-//   (transition_accel_ratio_same_sampling);
+//   (transition_accel_ratio_same_sampling). The database's mix of moves is not the script's (a
+//   script that runs half the time meets running's larger accelerations in half its
+//   transitions, while the data mostly walks), so transition_accel_ratio_played divides the
+//   same percentile by the one of the playing clips themselves at the same moments, played
+//   straight through with the controller's sampling (played_accel_p99): what the blends add;
 // - search_us_mean: wall time per search; update_us_mean: wall time per update() (the only
 //   figures that vary from run to run).
 //
@@ -164,6 +168,7 @@ struct EvaluationMetrics {
   double style_match = -1.0;
   int style_frames = 0;
   double style_response_s = 0.0;
+  double style_response_s_max = 0.0;  // the slowest of those requests
   int style_requests = 0;
   int style_requests_reached = 0;
   double transition_accel_ratio = 0.0;
@@ -171,6 +176,8 @@ struct EvaluationMetrics {
   double database_accel_p99 = 0.0;                // m/s^2, linear interpolation
   double database_accel_p99_same_sampling = 0.0;  // m/s^2, the controller's sampling
   double transition_accel_ratio_same_sampling = 0.0;
+  double transition_accel_ratio_played = 0.0;
+  double played_accel_p99 = 0.0;  // m/s^2, the playing clips on their own
   double search_us_mean = 0.0;
   double update_us_mean = 0.0;
   // The body metrics (definitions at the top of this file).
