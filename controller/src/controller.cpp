@@ -735,7 +735,8 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t k0 = static_cast<size_t>(at.frame0) * joints;
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
-  for (size_t j = 0; j < joints; ++j) local[j] = sample_joint(at, j);
+  sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
+                       settings_.interpolation, local);
   velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
   angular_velocities[0] =
       glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
