@@ -415,9 +415,15 @@ void Controller::refresh_outputs(float dt) {
   }
   foot_lock(dt);
   publish_world_transforms();
-  if (settings_.compute_skinning) {
+  skinning_stale_ = settings_.compute_skinning;
+}
+
+std::span<const glm::mat4> Controller::skinning_matrices() const {
+  if (skinning_stale_) {
     mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
+    skinning_stale_ = false;
   }
+  return skinning_;
 }
 
 // The stick, relative to the camera, becomes a desired velocity (with separate forward,
