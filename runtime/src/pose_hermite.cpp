@@ -6,9 +6,7 @@
 #include "mm/runtime/assert.hpp"
 #include "mm/runtime/interpolation.hpp"
 
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
+#include "quat_lanes.hpp"
 
 namespace mm {
 
@@ -28,65 +26,7 @@ Transform joint_hermite(const PoseFrameView& a, const PoseFrameView& b, float du
 
 #if defined(__SSE2__)
 
-// Four quaternions (GLM's memory order x, y, z, w) as one register per component.
-struct Quat4 {
-  __m128 w, x, y, z;
-};
-
-// Four vec3 as one register per component.
-struct Vec4x3 {
-  __m128 x, y, z;
-};
-
-static_assert(sizeof(glm::quat) == 16 && sizeof(glm::vec3) == 12);
-static_assert(offsetof(glm::quat, x) == 0 && offsetof(glm::quat, w) == 12);
-
-Quat4 load_quats(const glm::quat* q) {
-  __m128 r0 = _mm_loadu_ps(&q[0].x), r1 = _mm_loadu_ps(&q[1].x);
-  __m128 r2 = _mm_loadu_ps(&q[2].x), r3 = _mm_loadu_ps(&q[3].x);
-  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-  return {r3, r0, r1, r2};
-}
-
-// Twelve consecutive floats x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3 to x, y and z registers.
-Vec4x3 load_vec3s(const glm::vec3* v) {
-  const float* f = &v[0].x;
-  const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
-  const __m128 x01 = _mm_shuffle_ps(a, a, _MM_SHUFFLE(3, 3, 3, 0));  // x0 x1 x1 x1
-  const __m128 x23 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2));  // x2 x2 x3 x3
-  const __m128 y01 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1));  // y0 y0 y1 y1
-  const __m128 y23 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3));  // y2 y2 y3 y3
-  const __m128 z01 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2));  // z0 z0 z1 z1
-  const __m128 z23 = _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0));  // z2 z2 z3 z3
-  return {_mm_shuffle_ps(x01, x23, _MM_SHUFFLE(2, 0, 3, 0)),
-          _mm_shuffle_ps(y01, y23, _MM_SHUFFLE(2, 0, 2, 0)),
-          _mm_shuffle_ps(z01, z23, _MM_SHUFFLE(2, 0, 2, 0))};
-}
-
-// GLM's quaternion product p * q, component for component in its order.
-Quat4 multiply(const Quat4& p, const Quat4& q) {
-  const auto mul = _mm_mul_ps;
-  const auto add = _mm_add_ps;
-  const auto sub = _mm_sub_ps;
-  return {sub(sub(sub(mul(p.w, q.w), mul(p.x, q.x)), mul(p.y, q.y)), mul(p.z, q.z)),
-          sub(add(add(mul(p.w, q.x), mul(p.x, q.w)), mul(p.y, q.z)), mul(p.z, q.y)),
-          sub(add(add(mul(p.w, q.y), mul(p.y, q.w)), mul(p.z, q.x)), mul(p.x, q.z)),
-          sub(add(add(mul(p.w, q.z), mul(p.z, q.w)), mul(p.x, q.y)), mul(p.y, q.x))};
-}
-
-Quat4 scale(const Quat4& q, __m128 s) {
-  return {_mm_mul_ps(q.w, s), _mm_mul_ps(q.x, s), _mm_mul_ps(q.y, s), _mm_mul_ps(q.z, s)};
-}
-
-Quat4 add(const Quat4& p, const Quat4& q) {
-  return {_mm_add_ps(p.w, q.w), _mm_add_ps(p.x, q.x), _mm_add_ps(p.y, q.y), _mm_add_ps(p.z, q.z)};
-}
-
-// GLM's quaternion dot: (w w + x x) + (y y + z z).
-__m128 dot(const Quat4& a, const Quat4& b) {
-  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a.w, b.w), _mm_mul_ps(a.x, b.x)),
-                    _mm_add_ps(_mm_mul_ps(a.y, b.y), _mm_mul_ps(a.z, b.z)));
-}
+using namespace lanes;
 
 // Joints first .. first + 3 into out.
 void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, float t,
@@ -94,13 +34,13 @@ void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, 
   // transform_hermite's basis and tangent scales, in its order of operations.
   const float t2 = t * t;
   const float t3 = t2 * t;
-  const __m128 h00 = _mm_set1_ps(2.0f * t3 - 3.0f * t2 + 1.0f);
-  const __m128 h10 = _mm_set1_ps(t3 - 2.0f * t2 + t);
-  const __m128 h01 = _mm_set1_ps(-2.0f * t3 + 3.0f * t2);
-  const __m128 h11 = _mm_set1_ps(t3 - t2);
-  const __m128 h10d = _mm_set1_ps((t3 - 2.0f * t2 + t) * duration);
-  const __m128 h11d = _mm_set1_ps((t3 - t2) * duration);
-  const __m128 half_duration = _mm_set1_ps(0.5f * duration);
+  const __m128 h00 = c(2.0f * t3 - 3.0f * t2 + 1.0f);
+  const __m128 h10 = c(t3 - 2.0f * t2 + t);
+  const __m128 h01 = c(-2.0f * t3 + 3.0f * t2);
+  const __m128 h11 = c(t3 - t2);
+  const __m128 h10d = c((t3 - 2.0f * t2 + t) * duration);
+  const __m128 h11d = c((t3 - t2) * duration);
+  const __m128 half_duration = c(0.5f * duration);
 
   // Translation: h00 a + (h10 d) va + h01 b + (h11 d) vb, summed left to right.
   const Vec4x3 pa = load_vec3s(&a.positions[first]);
@@ -119,7 +59,7 @@ void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, 
   // Rotation: b on a's side, the tangents 0.5 d (0, w) q, the curve, normalized.
   const Quat4 qa = load_quats(&a.rotations[first]);
   Quat4 qb = load_quats(&b.rotations[first]);
-  const __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot(qa, qb), _mm_setzero_ps()), _mm_set1_ps(-0.0f));
+  const __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot(qa, qb), _mm_setzero_ps()), c(-0.0f));
   qb = {_mm_xor_ps(qb.w, flip), _mm_xor_ps(qb.x, flip), _mm_xor_ps(qb.y, flip),
         _mm_xor_ps(qb.z, flip)};
   const Vec4x3 wa = load_vec3s(&a.angular_velocities[first]);
@@ -134,11 +74,11 @@ void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, 
   // Back to one Transform per joint: the rotation's four floats, then the translation's three
   // with the scale's first (1) in the fourth, then the scale's other two.
   _MM_TRANSPOSE4_PS(rx, ry, rz, rw);
-  __m128 ones = _mm_set1_ps(1.0f);
+  __m128 ones = c(1.0f);
   _MM_TRANSPOSE4_PS(x, y, z, ones);
   const __m128 rotations[4] = {rx, ry, rz, rw};
   const __m128 translations[4] = {x, y, z, ones};
-  const int usable = _mm_movemask_ps(_mm_cmpgt_ps(length, _mm_set1_ps(1e-6f)));
+  const int usable = _mm_movemask_ps(_mm_cmpgt_ps(length, c(1e-6f)));
   for (size_t i = 0; i < 4; ++i) {
     Transform& o = out[first + i];
     _mm_storeu_ps(&o.rotation.x, rotations[i]);
