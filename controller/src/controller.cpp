@@ -282,6 +282,7 @@ void Controller::size_buffers() {
     v->assign(n, glm::vec3(0.0f));
   }
   skinning_.assign(n, glm::mat4(1.0f));
+  fk_plan_ = ForwardKinematicsPlan(db.skeleton().parents());
   query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
   std::vector<Transform> bind(n), inverse_bind(n);
   forward_kinematics(db.skeleton().parents(), db.skeleton().rest(), bind);
@@ -1108,7 +1109,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
 }
 
 void Controller::finish_pose() {
-  forward_kinematics(db_->skeleton().parents(), locals_, globals_);
+  fk_plan_.run(locals_, globals_);
   const Database& db = *db_;
   const ClipRange& clip = db.clips()[static_cast<size_t>(clip_)];
   const int frame =

@@ -47,6 +47,7 @@
 #include "mm/controller/world.hpp"
 #include "mm/database/database.hpp"
 #include "mm/runtime/dead_blending.hpp"
+#include "mm/runtime/fk_plan.hpp"
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/result.hpp"
@@ -651,6 +652,7 @@ class Controller {
   std::vector<Transform> globals_;        // relative to origin_
   std::vector<Transform> world_globals_;  // globals_ in the world, while origin_ is not zero
   std::vector<glm::mat4> inverse_bind_;
+  ForwardKinematicsPlan fk_plan_;  // the database skeleton's
   // Computed by skinning_matrices() from the transforms when stale.
   mutable std::vector<glm::mat4> skinning_;
   mutable bool skinning_stale_ = false;
