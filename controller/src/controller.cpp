@@ -282,6 +282,7 @@ void Controller::size_buffers() {
     v->assign(n, glm::vec3(0.0f));
   }
   skinning_.assign(n, glm::mat4(1.0f));
+  fk_plan_ = ForwardKinematicsPlan(db.skeleton().parents());
   query_.assign(static_cast<size_t>(db.feature_dims()), 0.0f);
   std::vector<Transform> bind(n), inverse_bind(n);
   forward_kinematics(db.skeleton().parents(), db.skeleton().rest(), bind);
@@ -415,9 +416,15 @@ void Controller::refresh_outputs(float dt) {
   }
   foot_lock(dt);
   publish_world_transforms();
-  if (settings_.compute_skinning) {
+  skinning_stale_ = settings_.compute_skinning;
+}
+
+std::span<const glm::mat4> Controller::skinning_matrices() const {
+  if (skinning_stale_) {
     mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
+    skinning_stale_ = false;
   }
+  return skinning_;
 }
 
 // The stick, relative to the camera, becomes a desired velocity (with separate forward,
@@ -723,7 +730,8 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const size_t joints = static_cast<size_t>(db.joint_count());
   const size_t k0 = static_cast<size_t>(at.frame0) * joints;
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
-  for (size_t j = 0; j < joints; ++j) local[j] = sample_joint(at, j);
+  sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
+                       settings_.interpolation, local);
   velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
   angular_velocities[0] =
       glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
@@ -1089,7 +1097,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
 }
 
 void Controller::finish_pose() {
-  forward_kinematics(db_->skeleton().parents(), locals_, globals_);
+  fk_plan_.run(locals_, globals_);
   const Database& db = *db_;
   const ClipRange& clip = db.clips()[static_cast<size_t>(clip_)];
   const int frame =

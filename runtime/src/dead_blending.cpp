@@ -6,6 +6,7 @@
 
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/spring.hpp"
+#include "quat_lanes.hpp"
 
 namespace mm {
 
@@ -37,20 +38,99 @@ float usable_length(float blend_time) {
   return std::isfinite(blend_time) ? std::max(blend_time, 0.0f) : 0.0f;
 }
 
+// One joint of extrapolate() below.
+void extrapolate_joint(DeadBlend& blend, size_t i, float keep, float travel) {
+  Transform& s = blend.source[i];
+  s.translation += blend.source_velocities[i] * travel;
+  s.rotation = glm::normalize(
+      quat_from_scaled_angle_axis(blend.source_angular_velocities[i] * travel) * s.rotation);
+  blend.source_velocities[i] = negligible_to_zero(blend.source_velocities[i] * keep);
+  blend.source_angular_velocities[i] =
+      negligible_to_zero(blend.source_angular_velocities[i] * keep);
+}
+
+#if defined(__SSE2__)
+using namespace lanes;
+
+// quat_exp's series branch (interpolation.cpp), lane by lane; `ok` marks the lanes inside it.
+Quat4 exp_series(const Vec4x3& h, __m128& ok) {
+  const __m128 a2 = dot(h, h);
+  ok = _mm_cmplt_ps(a2, c(0.25f));
+  // k + a2 * rest, nested as the scalar series nests it.
+  const auto term = [&](float k, __m128 rest) { return add(c(k), mul(a2, rest)); };
+  const __m128 cosine =
+      term(1.0f, term(-1.0f / 2.0f, term(1.0f / 24.0f, term(-1.0f / 720.0f, c(1.0f / 40320.0f)))));
+  const __m128 sine_over_a = term(
+      1.0f, term(-1.0f / 6.0f, term(1.0f / 120.0f, term(-1.0f / 5040.0f, c(1.0f / 362880.0f)))));
+  return {cosine, mul(h.x, sine_over_a), mul(h.y, sine_over_a), mul(h.z, sine_over_a)};
+}
+
+// quat_to_scaled_angle_axis of quaternions through quat_log's series branch, lane by lane; `ok`
+// marks the lanes inside it.
+Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
+  const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
+  const Vec4x3 v{a.x, a.y, a.z};
+  const __m128 s2 = dot(v, v);
+  const __m128 w2 = mul(a.w, a.w);
+  ok = _mm_and_ps(_mm_cmpgt_ps(a.w, _mm_setzero_ps()),
+                  _mm_cmplt_ps(s2, mul(mul(c(0.0625f), a.w), a.w)));
+  const __m128 x2 = _mm_div_ps(s2, w2);
+  // k + x2 * rest, nested as the scalar series nests it.
+  const auto term = [&](float k, __m128 rest) { return add(c(k), mul(x2, rest)); };
+  const __m128 atan_x_over_x = term(
+      1.0f, term(-1.0f / 3.0f,
+                 term(1.0f / 5.0f, term(-1.0f / 7.0f,
+                                        term(1.0f / 9.0f, term(-1.0f / 11.0f, c(1.0f / 13.0f)))))));
+  return scale(scale(v, _mm_div_ps(atan_x_over_x, a.w)), c(2.0f));
+}
+
+// Joints first .. first + 3 of extrapolate_joint; false (nothing written) when a lane leaves the
+// exponential's series or its rotation has no length: the caller then steps them one by one.
+bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
+  Transform* s = &blend.source[first];
+  glm::vec3* velocities = &blend.source_velocities[first];
+  glm::vec3* angular_velocities = &blend.source_angular_velocities[first];
+  const __m128 travel4 = c(travel), keep4 = c(keep);
+  const Vec4x3 v = load_vec3s(velocities);
+  const Vec4x3 w = load_vec3s(angular_velocities);
+  __m128 ok;
+  const Quat4 step = exp_series(scale(scale(w, travel4), c(0.5f)), ok);
+  __m128 length;
+  const Quat4 rotation = normalize(multiply(step, transform_rotations(s)), length);
+  ok = _mm_and_ps(ok, _mm_cmpgt_ps(length, _mm_setzero_ps()));
+  if (_mm_movemask_ps(ok) != 0xF) return false;
+  const Translations4 t = load_translations(s);
+  store_translations(add(t.t, scale(v, travel4)), t.scale_x, s);
+  store_quats(rotation, &s[0].rotation, sizeof(Transform));
+  // negligible_to_zero of the decayed velocities.
+  const __m128 negligible = c(kSpringNegligible * kSpringNegligible);
+  const auto decayed = [&](const Vec4x3& u) {
+    const Vec4x3 k = scale(u, keep4);
+    const __m128 zero = _mm_cmplt_ps(dot(k, k), negligible);
+    return Vec4x3{_mm_andnot_ps(zero, k.x), _mm_andnot_ps(zero, k.y), _mm_andnot_ps(zero, k.z)};
+  };
+  store_vec3s(decayed(v), velocities);
+  store_vec3s(decayed(w), angular_velocities);
+  return true;
+}
+#endif
+
 // Moves the source on by dt with velocities decaying at rate `decay` (1/s), exactly, so the
-// result does not depend on how a span of time is cut into updates.
+// result does not depend on how a span of time is cut into updates. Four joints at a time where
+// their steps are small (every lane equal to extrapolate_joint's result to the bit).
 void extrapolate(DeadBlend& blend, float decay, float dt) {
   const float keep = std::exp(-decay * dt);
   const float travel = decay > 0.0f ? (1.0f - keep) / decay : dt;
-  for (size_t i = 0; i < blend.source.size(); ++i) {
-    Transform& s = blend.source[i];
-    s.translation += blend.source_velocities[i] * travel;
-    s.rotation = glm::normalize(
-        quat_from_scaled_angle_axis(blend.source_angular_velocities[i] * travel) * s.rotation);
-    blend.source_velocities[i] = negligible_to_zero(blend.source_velocities[i] * keep);
-    blend.source_angular_velocities[i] =
-        negligible_to_zero(blend.source_angular_velocities[i] * keep);
+  const size_t n = blend.source.size();
+  size_t i = 0;
+#if defined(__SSE2__)
+  for (; i + 4 <= n; i += 4) {
+    if (!extrapolate_x4(blend, i, keep, travel)) {
+      for (size_t j = i; j < i + 4; ++j) extrapolate_joint(blend, j, keep, travel);
+    }
   }
+#endif
+  for (; i < n; ++i) extrapolate_joint(blend, i, keep, travel);
 }
 
 // One joint of the blend: rotation exp(w * d) * source with d = log(incoming * source^-1), and
@@ -86,6 +166,36 @@ JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incom
       partial * ws;
   return out;
 }
+
+#if defined(__SSE2__)
+// Joints first .. first + 3 of blend_joint without velocities, into out; a lane outside the
+// logarithm's or the exponential's series (joints far apart) is done by blend_joint itself.
+void blend_x4(const DeadBlend& blend, size_t first, const PoseMotion& incoming, Weight w,
+              std::span<Transform> out) {
+  const Transform* s = &blend.source[first];
+  const Transform* in = &incoming.local[first];
+  const Quat4 source = transform_rotations(s);
+  __m128 log_ok, exp_ok, length;
+  const Vec4x3 d =
+      scaled_angle_axis_series(multiply(transform_rotations(in), conjugate(source)), log_ok);
+  const Quat4 partial = exp_series(scale(scale(d, c(w.value)), c(0.5f)), exp_ok);
+  const Quat4 rotation = normalize(multiply(partial, source), length);
+  const int ok = _mm_movemask_ps(
+      _mm_and_ps(_mm_and_ps(log_ok, exp_ok), _mm_cmpgt_ps(length, _mm_setzero_ps())));
+  // glm::mix: source (1 - w) + incoming w; the scale is the incoming one.
+  const Translations4 ts = load_translations(s);
+  const Translations4 ti = load_translations(in);
+  const Vec4x3 translation = add(scale(ts.t, c(1.0f - w.value)), scale(ti.t, c(w.value)));
+  Transform* o = &out[first];
+  store_quats(rotation, &o[0].rotation, sizeof(Transform));
+  store_translations(translation, ti.scale_x, o);
+  for (size_t l = 0; l < 4; ++l) {
+    o[l].scale.y = in[l].scale.y;
+    o[l].scale.z = in[l].scale.z;
+    if (!(ok & (1 << l))) o[l] = blend_joint(blend, first + l, incoming, w, false).pose;
+  }
+}
+#endif
 
 }  // namespace
 
@@ -147,7 +257,14 @@ void dead_blend_update(DeadBlend& blend, const PoseMotion& incoming, float blend
     extrapolate(blend, std::isfinite(halflife) ? std::log(2.0f) / halflife : 0.0f, dt);
   }
   const bool with_velocities = !out_velocities.empty() || !out_angular_velocities.empty();
-  for (size_t i = 0; i < n; ++i) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  // The pose alone: four joints at a time, each lane equal to blend_joint's to the bit.
+  if (blend.active && !with_velocities) {
+    for (; i + 4 <= n; i += 4) blend_x4(blend, i, incoming, w, out_local);
+  }
+#endif
+  for (; i < n; ++i) {
     JointBlend out;
     if (blend.active) {
       out = blend_joint(blend, i, incoming, w, with_velocities);

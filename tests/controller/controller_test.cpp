@@ -218,6 +218,31 @@ TEST(ControllerTest, SameInputSameOutputBitForBit) {
   EXPECT_GT(a.debug().transitions, 3);
 }
 
+// The skinning matrices are computed when read, from the last update's pose: each maps the
+// bind pose onto that pose (the rest pose's joint origins land on the joints' positions), however
+// many updates went by unread. With compute_skinning off they are never filled.
+TEST(ControllerTest, SkinningMatricesShowTheLastUpdatesPose) {
+  Controller c = make();
+  ControllerSettings off;
+  off.compute_skinning = false;
+  Controller unskinned = make(off);
+  for (int read = 0; read < 3; ++read) {
+    for (int i = 0; i < 50 + 40 * read; ++i) {
+      c.update(kDt, push_toward(static_cast<float>(read * 90)));
+      unskinned.update(kDt, push_toward(0.0f));
+    }
+    const std::span<const glm::mat4> skin = c.skinning_matrices();
+    for (size_t j = 0; j < skin.size(); ++j) {
+      const glm::vec4 bind_origin =
+          glm::inverse(c.inverse_bind_matrices()[j]) * glm::vec4(0, 0, 0, 1);
+      const glm::vec3 shown = glm::vec3(skin[j] * bind_origin);
+      EXPECT_LT(glm::length(shown - c.global_transforms()[j].translation), 1e-4f)
+          << "read " << read << ", joint " << j;
+    }
+  }
+  for (const glm::mat4& m : unskinned.skinning_matrices()) EXPECT_EQ(m, glm::mat4(1.0f));
+}
+
 // Largest per-joint displacement between two frames of global transforms.
 float largest_step(std::span<const Transform> a, std::span<const Transform> b) {
   float step = 0.0f;

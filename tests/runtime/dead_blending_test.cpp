@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "mm/runtime/dead_blending.hpp"
 #include "mm/runtime/spring.hpp"
@@ -226,6 +227,45 @@ TEST(DeadBlending, TheSameSpanOfTimeGivesTheSamePoseHoweverItIsCut) {
     EXPECT_TRUE(near_vec3(one.local[j].translation, many.local[j].translation, 1e-5f));
     EXPECT_TRUE(same_rotation(one.local[j].rotation, many.local[j].rotation, 1e-5f));
   }
+}
+
+// Without velocities asked for, the pose is computed four joints at a time; each joint equals the
+// one computed with velocities (joint by joint) to the bit, through a whole blend, for joints near
+// their incoming pose (the logarithm's and exponential's series) and far from it (their
+// trigonometric forms), with a joint count that leaves a remainder after the blocks of four.
+TEST(DeadBlending, ThePoseAloneEqualsThePoseWithItsVelocitiesToTheBit) {
+  constexpr size_t n = 22;
+  std::vector<Transform> outgoing(n), incoming(n), pose_alone(n), pose(n);
+  std::vector<glm::vec3> out_v(n), out_w(n), in_v(n), in_w(n), v(n), w(n);
+  for (size_t j = 0; j < n; ++j) {
+    outgoing[j] = test::random_transform(0.5f);
+    out_v[j] = test::random_vec3(-2.0f, 2.0f);
+    out_w[j] = test::random_vec3(-6.0f, 6.0f);
+    incoming[j].rotation = j % 3 == 0 ? test::random_rotation()
+                                      : turn(test::random_vec3(-0.2f, 0.2f)) * outgoing[j].rotation;
+    incoming[j].translation = test::random_vec3(-0.5f, 0.5f);
+    in_v[j] = test::random_vec3(-2.0f, 2.0f);
+    in_w[j] = test::random_vec3(-6.0f, 6.0f);
+  }
+  DeadBlend alone;
+  alone.resize(static_cast<int>(n));
+  dead_blend_transition(alone, {outgoing, out_v, out_w}, kBlendTime);
+  DeadBlend with_velocities = alone;
+  int blended = 0;
+  for (int step = 0; step < 40; ++step) {
+    dead_blend_update(alone, {incoming, in_v, in_w}, kBlendTime, kDecay, 1.0f / 60.0f, pose_alone,
+                      {}, {});
+    dead_blend_update(with_velocities, {incoming, in_v, in_w}, kBlendTime, kDecay, 1.0f / 60.0f,
+                      pose, v, w);
+    blended += alone.active ? 1 : 0;
+    for (size_t j = 0; j < n; ++j) {
+      EXPECT_EQ(pose_alone[j].rotation, pose[j].rotation) << "step " << step << ", joint " << j;
+      EXPECT_EQ(pose_alone[j].translation, pose[j].translation)
+          << "step " << step << ", joint " << j;
+      EXPECT_EQ(pose_alone[j].scale, pose[j].scale);
+    }
+  }
+  EXPECT_GT(blended, 20);
 }
 
 TEST(DeadBlending, BadTimesNeverPoisonTheState) {

@@ -47,6 +47,7 @@
 #include "mm/controller/world.hpp"
 #include "mm/database/database.hpp"
 #include "mm/runtime/dead_blending.hpp"
+#include "mm/runtime/fk_plan.hpp"
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/result.hpp"
@@ -318,7 +319,8 @@ struct ControllerSettings {
 
   // ---- Robustness. A dt larger than this is clamped to it (s).
   float max_dt = 0.1f;
-  // Fills skinning_matrices() on every update.
+  // skinning_matrices() gives the pose of the last update (computed on their first read after
+  // it, so a game that skins from the transforms pays nothing for them).
   bool compute_skinning = true;
 
   // Checks every field (finite, in range, a known search method).
@@ -453,8 +455,9 @@ class Controller {
   // Local transforms after inertialization and IK; the root's (joint 0) is relative to origin().
   std::span<const Transform> local_transforms() const { return locals_; }
   // global * inverse(bind global), with the database skeleton's rest pose as the bind pose
-  // (from global_transforms(), so in world space).
-  std::span<const glm::mat4> skinning_matrices() const { return skinning_; }
+  // (from global_transforms(), so in world space). The first read after an update computes
+  // them: like the update itself, not to be called from two threads at once.
+  std::span<const glm::mat4> skinning_matrices() const;
   // The character's root (joint 0): its ground position and facing (world, as
   // global_transforms()).
   const Transform& root_transform() const { return global_transforms()[0]; }
@@ -653,7 +656,10 @@ class Controller {
   std::vector<Transform> globals_;        // relative to origin_
   std::vector<Transform> world_globals_;  // globals_ in the world, while origin_ is not zero
   std::vector<glm::mat4> inverse_bind_;
-  std::vector<glm::mat4> skinning_;
+  ForwardKinematicsPlan fk_plan_;  // the database skeleton's
+  // Computed by skinning_matrices() from the transforms when stale.
+  mutable std::vector<glm::mat4> skinning_;
+  mutable bool skinning_stale_ = false;
   std::vector<float> query_;
 
   // Foot locks: 0 left, 1 right.
