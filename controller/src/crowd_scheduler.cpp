@@ -129,6 +129,14 @@ void CrowdScheduler::plan_all(CrowdTier tier) {
       static_cast<double>(tier_.size()) * settings_.cost_us[static_cast<size_t>(tier)];
 }
 
+Status CrowdScheduler::set_budget_ms(float budget_ms) {
+  CrowdSchedulerSettings changed = settings_;
+  changed.budget_ms = budget_ms;
+  if (Status valid = changed.validate(); !valid) return valid;
+  settings_ = changed;
+  return Status::success();
+}
+
 // order_ by key (significance plus the hysteresis of the tier held), most significant first and
 // the lower index first among equals: a strict order, so any sort gives the same permutation.
 void CrowdScheduler::rank(std::span<const float> significance) {

@@ -90,6 +90,9 @@ class CrowdScheduler {
   void plan(std::span<const float> significance);
   // Every character at one tier this frame, budget ignored (tests, calibration).
   void plan_all(CrowdTier tier);
+  // A new frame budget for the next plan() (ms; 0: none), e.g. from a game's settings or its
+  // measured frame time. Fails, changing nothing, when the budget is not a number >= 0.
+  Status set_budget_ms(float budget_ms);
 
   // Character i's work of this frame (after plan()): updates, moves or holds `controller`
   // (always the same one for i) by its tier and phase, and sets pose(i). Reduced-rate
