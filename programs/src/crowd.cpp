@@ -316,10 +316,12 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
     planned += plans.planned_us[f];
   }
   result.planned_cost_us_mean = planned / static_cast<double>(frames - warm);
+  const size_t joints = crowd->scheduler.joints();
+  result.final_poses.resize(n * joints);
   for (size_t i = 0; i < n; ++i) {
     result.final_positions.push_back(crowd->controllers[i].root_transform().translation);
-    const std::span<const Transform> pose = crowd->scheduler.pose(i);
-    result.final_poses.insert(result.final_poses.end(), pose.begin(), pose.end());
+    crowd->scheduler.displayed_pose(
+        i, std::span<Transform>(result.final_poses.data() + i * joints, joints));
   }
   return result;
 }
@@ -490,8 +492,9 @@ namespace {
 // One character's ground metrics, fed its displayed pose every frame.
 struct QualityProbe {
   QualityProbe(const JointRoleIndices& roles, float dt, size_t joints)
-      : ground(roles, dt), positions(joints) {}
+      : ground(roles, dt), pose(joints), positions(joints) {}
   GroundAccumulator ground;
+  std::vector<Transform> pose;
   std::vector<glm::vec3> positions;
 };
 
@@ -523,8 +526,11 @@ Result<std::array<CrowdTierQuality, kCrowdTierCount>> crowd_tier_quality(
       crowd->scheduler.plan_all(static_cast<CrowdTier>(tier));
       for (size_t i = 0; i < n; ++i) {
         step_character(*crowd, i, t, options.dt, search);
-        const std::span<const Transform> pose = crowd->scheduler.pose(i);
-        for (size_t j = 0; j < pose.size(); ++j) probes[i]->positions[j] = pose[j].translation;
+        QualityProbe& probe = *probes[i];
+        crowd->scheduler.displayed_pose(i, probe.pose);
+        for (size_t j = 0; j < probe.pose.size(); ++j) {
+          probe.positions[j] = probe.pose[j].translation;
+        }
         GroundFrame frame;
         frame.joints = probes[i]->positions;
         probes[i]->ground.add(frame);

@@ -189,7 +189,7 @@ void CrowdView::pack(bool tier_colours, std::vector<BoneInstance>& out) const {
   for (size_t i = 0; i < controllers_.size(); ++i) {
     const glm::vec4 colour =
         tier_colours ? glm::vec4(crowd_tier_colour(scheduler_->tier(i)), 1.0f) : plain;
-    pack_bone_instances(scheduler_->pose(i), Transform::identity(), parents_, head_, colour,
+    pack_bone_instances(scheduler_->pose(i), scheduler_->carry(i), parents_, head_, colour,
                         std::span<BoneInstance>(out.data() + i * per, per));
   }
 }
