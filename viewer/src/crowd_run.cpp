@@ -5,6 +5,7 @@
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -75,7 +76,8 @@ Status prepare(CrowdStage& stage, const ViewerOptions& options,
   stage.view = std::move(*view);
   // Above the middle of the crowd, far enough out to see most of it.
   stage.camera.target = glm::vec3(0.0f, 0.9f, 0.0f);
-  stage.camera.distance = OrbitCamera::kMaxDistance;
+  stage.camera.distance = std::clamp(1.2f * stage.view->radius() + 4.0f, OrbitCamera::kMinDistance,
+                                     OrbitCamera::kMaxDistance);
   stage.camera.pitch = 0.5f;
   stage.tier_colours = options.tier_colours;
   stage.panel = options.panel;
