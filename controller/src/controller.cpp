@@ -376,6 +376,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
 
 void Controller::update(float dt, const ControllerInput& input) {
   if (!(dt > 0.0f) || !std::isfinite(dt)) return;
+  settle_carried_pose();  // after update_move_only(): the pose the update goes on from
   dt = std::min(dt, settings_.max_dt);
   follow_character();
   debug_.searched = debug_.transitioned = false;
@@ -409,6 +410,7 @@ void Controller::update(float dt, const ControllerInput& input) {
 // Forward kinematics, the feet, the skinning matrices: everything read back after an update
 // (or a teleport or adjustment) from the local pose.
 void Controller::refresh_outputs(float dt) {
+  pose_carried_ = false;  // forward kinematics places every joint
   finish_pose();
   if (world_) {
     place_feet(dt);

@@ -26,20 +26,49 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
       glm::angleAxis(wrap_angle(quat_yaw(sim_rotation_) - yaw_before), glm::vec3(0.0f, 1.0f, 0.0f));
   const glm::vec3 root = sim_position_ + turn * (locals_[0].translation - before);
   move_root(root, glm::normalize(turn * locals_[0].rotation));
-  for (Transform& global : globals_) {
-    global.translation = sim_position_ + turn * (global.translation - before);
-    global.rotation = glm::normalize(turn * global.rotation);
+  if (!pose_carried_) {
+    // The first move after a posed frame: the other joints stay behind, hanging from the root
+    // as it is now. Held toes would pull the legs back to where the character was; the body's
+    // facing jumps; the first full update after this searches for the input of that moment.
+    pose_carried_ = true;
+    carried_from_ = globals_[0];
+    for (FootLock& foot : feet_) foot = FootLock{};
+    body_yaw_known_ = false;
+    force_search_ = true;
   }
+  Transform& moved = globals_[0];
+  moved.translation = sim_position_ + turn * (moved.translation - before);
+  moved.rotation = glm::normalize(turn * moved.rotation);
   last_root_ = sim_position_ + turn * (last_root_ - before);
-  // Held toes would pull the legs back to where the character was; the body's facing jumped.
-  for (FootLock& foot : feet_) foot = FootLock{};
-  body_yaw_known_ = false;
-  // The first full update after this searches for the input of that moment.
-  force_search_ = true;
-  publish_world_transforms();
+  if (origin_ != glm::dvec3(0.0)) {
+    world_globals_[0] = moved;
+    world_globals_[0].translation = glm::vec3(to_world(origin_, moved.translation));
+  }
   if (settings_.compute_skinning) {
+    settle_carried_pose();
     mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
   }
+}
+
+Transform Controller::carried_from() const {
+  Transform from = carried_from_;
+  if (origin_ != glm::dvec3(0.0)) from.translation = glm::vec3(to_world(origin_, from.translation));
+  return from;
+}
+
+void Controller::settle_carried_pose() {
+  if (!pose_carried_) return;
+  pose_carried_ = false;
+  // The rigid motion from where the held joints hang to where the root is: a turn about +Y
+  // (each move turned the root about the vertical) and a translation.
+  const Transform& root = globals_[0];
+  const glm::quat turn = glm::normalize(root.rotation * glm::conjugate(carried_from_.rotation));
+  for (size_t j = 1; j < globals_.size(); ++j) {
+    Transform& global = globals_[j];
+    global.translation = root.translation + turn * (global.translation - carried_from_.translation);
+    global.rotation = glm::normalize(turn * global.rotation);
+  }
+  publish_world_transforms();
 }
 
 namespace {
@@ -51,11 +80,6 @@ void prefetch_lines(const void* begin, size_t bytes) {
   for (size_t offset = 0; offset < bytes; offset += kLine) {
     __builtin_prefetch(first + offset, 1);
   }
-}
-
-template <typename T>
-void prefetch_vector(const std::vector<T>& values) {
-  prefetch_lines(values.data(), values.size() * sizeof(T));
 }
 
 }  // namespace
@@ -75,10 +99,12 @@ void Controller::prefetch_move_only() const {
   prefetch_lines(&debug_.searched, sizeof(debug_.searched));
   prefetch_lines(&debug_.transitioned, sizeof(debug_.transitioned));
   prefetch_lines(&debug_.search_seconds, sizeof(debug_.search_seconds));
+  prefetch_lines(&pose_carried_, sizeof(pose_carried_));
   prefetch_lines(sampled_.data(), sizeof(Transform));
   prefetch_lines(locals_.data(), sizeof(Transform));
-  prefetch_vector(globals_);
-  if (origin_ != glm::dvec3(0.0)) prefetch_vector(world_globals_);
+  // Only the root moves (the rest of the pose is carried, not rewritten).
+  prefetch_lines(globals_.data(), sizeof(Transform));
+  if (origin_ != glm::dvec3(0.0)) prefetch_lines(world_globals_.data(), sizeof(Transform));
 }
 
 }  // namespace mm

@@ -48,6 +48,7 @@ void Controller::shift_origin(const glm::vec3& shift) {
     (*pose)[0].translation -= shift;  // only the root is in the world; the rest hang from it
   }
   for (Transform& global : globals_) global.translation -= shift;
+  carried_from_.translation -= shift;
   for (FootLock& foot : feet_) {
     foot.position -= shift;
     foot.target -= shift;

@@ -81,6 +81,8 @@ Result<CrowdScheduler> CrowdScheduler::create(size_t characters, size_t joints,
   s.update_period_.assign(characters, 1);
   s.blend_weight_.assign(characters, 0.0f);
   s.shows_last_.assign(characters, 0);
+  s.carried_.assign(characters, 0);
+  s.carry_.assign(characters, Transform{});
   s.keys_.assign(characters, 0.0f);
   s.order_.resize(characters);
   for (size_t i = 0; i < characters; ++i) s.order_[i] = static_cast<uint32_t>(i);
@@ -127,6 +129,14 @@ void CrowdScheduler::plan_all(CrowdTier tier) {
   counts_[static_cast<size_t>(tier)] = static_cast<int>(tier_.size());
   planned_cost_us_ =
       static_cast<double>(tier_.size()) * settings_.cost_us[static_cast<size_t>(tier)];
+}
+
+Status CrowdScheduler::set_budget_ms(float budget_ms) {
+  CrowdSchedulerSettings changed = settings_;
+  changed.budget_ms = budget_ms;
+  if (Status valid = changed.validate(); !valid) return valid;
+  settings_ = changed;
+  return Status::success();
 }
 
 // order_ by key (significance plus the hysteresis of the tier held), most significant first and
@@ -200,11 +210,27 @@ void CrowdScheduler::prefetch(size_t i, const Controller& controller) const {
     const char* first = static_cast<const char*>(begin);
     for (size_t offset = 0; offset < bytes; offset += kLine) __builtin_prefetch(first + offset, 1);
   };
+  // A full update's own memory traffic dwarfs the latency this hides; a move is all latency,
+  // and touches only the held pose's root and the carry (after its first step).
+  if (tier(i) == CrowdTier::MoveOnly) {
+    lines(last_.data() + i * joints_, sizeof(Transform));
+    lines(carry_.data() + i, sizeof(Transform));
+    controller.prefetch_move_only();
+    return;
+  }
   const size_t bytes = joints_ * sizeof(Transform);
   lines(last_.data() + i * joints_, bytes);
   lines(shown_.data() + i * joints_, bytes);
-  // A full update's own memory traffic dwarfs the latency this hides; a move is all latency.
-  if (tier(i) == CrowdTier::MoveOnly) controller.prefetch_move_only();
+}
+
+void CrowdScheduler::displayed_pose(size_t i, std::span<Transform> out) const {
+  MM_ASSERT(out.size() == joints_);
+  const std::span<const Transform> shown = pose(i);
+  if (!(shows_last_[i] != 0 && carried_[i] != 0)) {
+    std::copy(shown.begin(), shown.end(), out.begin());
+    return;
+  }
+  for (size_t j = 0; j < joints_; ++j) out[j] = compose(carry_[i], shown[j]);
 }
 
 void CrowdScheduler::step(size_t i, Controller& controller, float dt,
@@ -216,6 +242,7 @@ void CrowdScheduler::step(size_t i, Controller& controller, float dt,
     return poses.begin() + static_cast<std::ptrdiff_t>(base);
   };
   if (last_step_[i] == Step::None) {
+    controller.settle_carried_pose();
     for (std::vector<Transform>* pose : {&from_, &last_, &shown_}) {
       std::copy(globals.begin(), globals.end(), pose_begin(*pose));
     }
@@ -242,16 +269,14 @@ void CrowdScheduler::step(size_t i, Controller& controller, float dt,
   const bool blends = at_once && !continues && last_step != Step::None;
   // What is shown now: where a chase starts, or what a blend eases from.
   if (blends || !at_once) {
-    const std::span<const Transform> shown = pose(i);
-    std::copy(shown.begin(), shown.end(), pose_begin(from_));
+    displayed_pose(i, std::span<Transform>(&*pose_begin(from_), joints_));
   }
   if (now == Step::Move) {
     controller.update_move_only(pending_dt_[i], input);
   } else {
     controller.update(pending_dt_[i], input);
   }
-  const std::span<const Transform> updated = controller.global_transforms();
-  std::copy(updated.begin(), updated.end(), pose_begin(last_));
+  keep_update(i, controller, now, last_step);
   update_period_[i] = static_cast<uint8_t>(at_once ? 1 : crowd_tier_period(t));
   pending_dt_[i] = 0.0f;
   held_frames_[i] = 0;
@@ -260,11 +285,37 @@ void CrowdScheduler::step(size_t i, Controller& controller, float dt,
   show(i);
 }
 
+// last_ and the carry after character i's step: the controller's pose, or, when the step only
+// moved it, the held pose (copied once, when the holding starts) and the rigid motion from
+// where it hangs to the controller's root.
+void CrowdScheduler::keep_update(size_t i, const Controller& controller, Step now, Step last_step) {
+  const std::span<const Transform> globals = controller.global_transforms();
+  Transform& held_root = last_[i * joints_];
+  if (now != Step::Move || !controller.pose_carried()) {
+    std::copy(globals.begin(), globals.end(), &held_root);
+    carried_[i] = 0;
+    return;
+  }
+  const Transform from = controller.carried_from();
+  const bool same_hold = last_step == Step::Move && carried_[i] != 0 &&
+                         held_root.translation == from.translation &&
+                         held_root.rotation == from.rotation;
+  if (!same_hold) {
+    std::copy(globals.begin(), globals.end(), &held_root);
+    held_root = from;
+  }
+  const Transform& root = globals[0];
+  Transform& carry = carry_[i];
+  carry.rotation = glm::normalize(root.rotation * glm::conjugate(from.rotation));
+  carry.translation = root.translation - carry.rotation * from.translation;
+  carried_[i] = 1;
+}
+
 // Offsets from the new pose (last_) to `predicted`, per joint in world space, at full weight.
 void CrowdScheduler::start_blend(size_t i, std::span<const Transform> predicted) {
   const size_t base = i * joints_;
   for (size_t j = 0; j < joints_; ++j) {
-    const Transform& now = last_[base + j];
+    const Transform now = updated_joint(i, j);
     offset_translations_[base + j] = predicted[j].translation - now.translation;
     offset_rotations_[base + j] =
         aligned(predicted[j].rotation * glm::conjugate(now.rotation), glm::quat(1, 0, 0, 0));
@@ -285,12 +336,11 @@ void CrowdScheduler::show(size_t i) {
   shows_last_[i] = s == 1.0f && w == 0.0f;
   if (shows_last_[i]) return;
   if (s == 1.0f) {
-    std::copy(last_.begin() + static_cast<std::ptrdiff_t>(base),
-              last_.begin() + static_cast<std::ptrdiff_t>(base + joints_), out.begin());
+    for (size_t j = 0; j < joints_; ++j) out[j] = updated_joint(i, j);
   } else {
     for (size_t j = 0; j < joints_; ++j) {
       const Transform& a = from_[base + j];
-      const Transform& b = last_[base + j];
+      const Transform b = updated_joint(i, j);
       out[j].translation = a.translation + (b.translation - a.translation) * s;
       const glm::quat from = aligned(a.rotation, b.rotation);
       out[j].rotation = glm::normalize(from + (b.rotation - from) * s);

@@ -15,6 +15,8 @@
 #include <span>
 #include <thread>
 
+#include <time.h>
+
 namespace mm {
 
 namespace {
@@ -100,6 +102,9 @@ struct CrowdTimes {
   std::vector<double> frame_seconds;   // barrier to barrier
   std::vector<double> search_seconds;  // per character, over the frames before the replay
   std::vector<double> replay_seconds;  // per character, the replay's updates
+  // Budgeted runs: the CPU time each thread spent stepping characters, per frame (frame-major,
+  // threads per frame), which a thread descheduled by other processes is not charged for.
+  std::vector<double> step_cpu_seconds;
 };
 
 // The mean update time (microseconds) over frames [first, last).
@@ -156,6 +161,14 @@ Status check_options(const CrowdOptions& options) {
 }
 
 // ---- Budgeted runs (crowd_scheduler.hpp) ----------------------------------------------------
+
+// The CPU time the calling thread has run (s): what a calibration charges, since on a machine
+// other processes share the wall clock of a thread's work overstates its cost.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
 
 // The characters a worker takes off the shared counter at a time: few enough that the threads
 // end a frame together, many enough that the counter is not contended.
@@ -230,6 +243,7 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
   std::atomic<size_t> next{0};
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
+  times.step_cpu_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
   auto worker = [&](int index) {
     Clock::time_point frame_start = Clock::now();
     for (size_t f = 0; f < frames; ++f) {
@@ -245,6 +259,7 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
         next.store(0, std::memory_order_relaxed);
       }
       sync.arrive_and_wait();
+      const double cpu_start = thread_cpu_seconds();
       for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
         for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
           if (i + 1 < n) crowd.scheduler.prefetch(i + 1, crowd.controllers[i + 1]);
@@ -252,6 +267,8 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
               step_character(crowd, i, t, options.dt, times.search_seconds[i]) * 1e6);
         }
       }
+      times.step_cpu_seconds[f * static_cast<size_t>(threads) + static_cast<size_t>(index)] =
+          thread_cpu_seconds() - cpu_start;
       sync.arrive_and_wait();
       if (index == 0) {
         const Clock::time_point now = Clock::now();
@@ -275,8 +292,11 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
   Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, options, n, *options.lod);
   if (!crowd) return Error{crowd.message()};
   const int threads = std::min<int>(options.threads, options.characters);
-  CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
-                   std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+  CrowdTimes times{std::vector<float>(frames * n),
+                   std::vector<double>(frames, 0.0),
+                   std::vector<double>(n, 0.0),
+                   std::vector<double>(n, 0.0),
+                   {}};
   PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                    std::vector<double>(frames, 0.0)};
   const auto start = std::chrono::steady_clock::now();
@@ -296,10 +316,12 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
     planned += plans.planned_us[f];
   }
   result.planned_cost_us_mean = planned / static_cast<double>(frames - warm);
+  const size_t joints = crowd->scheduler.joints();
+  result.final_poses.resize(n * joints);
   for (size_t i = 0; i < n; ++i) {
     result.final_positions.push_back(crowd->controllers[i].root_transform().translation);
-    const std::span<const Transform> pose = crowd->scheduler.pose(i);
-    result.final_poses.insert(result.final_poses.end(), pose.begin(), pose.end());
+    crowd->scheduler.displayed_pose(
+        i, std::span<Transform>(result.final_poses.data() + i * joints, joints));
   }
   return result;
 }
@@ -332,8 +354,11 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   }
 
   const int threads = std::min<int>(options.threads, options.characters);
-  CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
-                   std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+  CrowdTimes times{std::vector<float>(frames * n),
+                   std::vector<double>(frames, 0.0),
+                   std::vector<double>(n, 0.0),
+                   std::vector<double>(n, 0.0),
+                   {}};
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
   // Every update's time, replays included, summed per thread: what the world's share is of.
@@ -438,16 +463,24 @@ Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
   for (int tier = 0; tier < kCrowdTierCount; ++tier) {
     Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, calibration, n, settings);
     if (!crowd) return Error{crowd.message()};
-    CrowdTimes times{std::vector<float>(frames * n), std::vector<double>(frames, 0.0),
-                     std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+    CrowdTimes times{std::vector<float>(frames * n),
+                     std::vector<double>(frames, 0.0),
+                     std::vector<double>(n, 0.0),
+                     std::vector<double>(n, 0.0),
+                     {}};
     PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                      std::vector<double>(frames, 0.0)};
     run_scheduled_frames(*crowd, calibration, threads, times, plans, static_cast<CrowdTier>(tier));
-    // The second half's frames: thread time per character.
+    // The second half's frames: the CPU time the threads spent stepping, per character. Not
+    // the frame's wall time times the threads: on a shared machine a thread waits for a core
+    // (and the other waits at the barrier), which is not work the budget can plan away.
     double seconds = 0.0;
-    for (size_t f = frames / 2; f < frames; ++f) seconds += times.frame_seconds[f];
-    costs[static_cast<size_t>(tier)] = static_cast<float>(
-        seconds * 1e6 * threads / static_cast<double>(n * (frames - frames / 2)));
+    for (size_t k = frames / 2 * static_cast<size_t>(threads); k < times.step_cpu_seconds.size();
+         ++k) {
+      seconds += times.step_cpu_seconds[k];
+    }
+    costs[static_cast<size_t>(tier)] =
+        static_cast<float>(seconds * 1e6 / static_cast<double>(n * (frames - frames / 2)));
   }
   // Timing noise must not make a slower tier look dearer than a faster one.
   for (size_t t = 1; t < costs.size(); ++t) costs[t] = std::min(costs[t], costs[t - 1]);
@@ -459,8 +492,9 @@ namespace {
 // One character's ground metrics, fed its displayed pose every frame.
 struct QualityProbe {
   QualityProbe(const JointRoleIndices& roles, float dt, size_t joints)
-      : ground(roles, dt), positions(joints) {}
+      : ground(roles, dt), pose(joints), positions(joints) {}
   GroundAccumulator ground;
+  std::vector<Transform> pose;
   std::vector<glm::vec3> positions;
 };
 
@@ -492,8 +526,11 @@ Result<std::array<CrowdTierQuality, kCrowdTierCount>> crowd_tier_quality(
       crowd->scheduler.plan_all(static_cast<CrowdTier>(tier));
       for (size_t i = 0; i < n; ++i) {
         step_character(*crowd, i, t, options.dt, search);
-        const std::span<const Transform> pose = crowd->scheduler.pose(i);
-        for (size_t j = 0; j < pose.size(); ++j) probes[i]->positions[j] = pose[j].translation;
+        QualityProbe& probe = *probes[i];
+        crowd->scheduler.displayed_pose(i, probe.pose);
+        for (size_t j = 0; j < probe.pose.size(); ++j) {
+          probe.positions[j] = probe.pose[j].translation;
+        }
         GroundFrame frame;
         frame.joints = probes[i]->positions;
         probes[i]->ground.add(frame);

@@ -198,6 +198,44 @@ TEST(ViewerCli, EveryWritesNumberedScreenshotsAndThePlot) {
   EXPECT_GT(load_png(dir / "plot.png").width, 0);
 }
 
+// The crowd headless: numbered screenshots without --script, every tier the budget plans, and
+// the tiers' colours on the screen when asked for.
+TEST(ViewerCli, HeadlessCrowdDrawsEveryCharacterInItsTiersColour) {
+  const fs::path dir = test::scratch_dir();
+  const ProgramRun r =
+      run(viewer() + " --db '" + database_file().string() +
+          "' --headless --crowd 60 --budget-ms 0.2 --tier-colours --frames 40 --every 20" +
+          " --size 480x270 --no-panel --screenshot '" + (dir / "crowd.png").string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "crowd-000020.png"));
+  EXPECT_FALSE(fs::exists(dir / "crowd-000040.png")) << "the last frame is crowd.png itself";
+  int full = -1, half = -1, quarter = -1, move_only = -1;
+  const size_t at = r.output.find("tiers:");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  ASSERT_EQ(std::sscanf(r.output.c_str() + at, "tiers: full %d, half %d, quarter %d, move_only %d",
+                        &full, &half, &quarter, &move_only),
+            4)
+      << r.output;
+  EXPECT_EQ(full + half + quarter + move_only, 60) << r.output;
+  // 0.2 ms holds neither every character at full rate nor at half: some at full, the rest lower.
+  EXPECT_GT(full, 0) << r.output;
+  EXPECT_GT(quarter + move_only, 0) << r.output;
+  const Image image = load_png(dir / "crowd.png");
+  ASSERT_EQ(image.width, 480);
+  int green = 0, warm = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const glm::ivec3 c = image.at(x, y);
+      green += c.y > c.x + 40 && c.y > c.z + 40;  // full rate
+      warm += c.x > c.z + 60 && c.y > c.z + 20;   // quarter rate (yellow)
+    }
+  }
+  EXPECT_GT(green, 50) << "characters at full rate drawn green";
+  if (quarter > 0) {
+    EXPECT_GT(warm, 50) << "characters at quarter rate drawn yellow";
+  }
+}
+
 TEST(ViewerCli, RecordsLiveInputAsAScriptThatParses) {
   const fs::path dir = test::scratch_dir();
   const fs::path recorded = dir / "recorded.txt";
@@ -271,9 +309,10 @@ TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
   ProgramRun r = run(viewer() + " --help");
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.output.rfind("usage: mm-viewer", 0), 0u) << r.output;
-  for (const char* option : {"--db", "--data", "--body", "--weights", "--skinning", "--script",
-                             "--record", "--set", "--debug", "--no-panel", "--headless", "--frames",
-                             "--screenshot", "--every", "--plot", "--size", "--dt"}) {
+  for (const char* option :
+       {"--db",   "--data",  "--body",     "--weights",  "--skinning",  "--script",      "--record",
+        "--set",  "--debug", "--no-panel", "--headless", "--frames",    "--screenshot",  "--every",
+        "--plot", "--size",  "--dt",       "--crowd",    "--budget-ms", "--tier-colours"}) {
     EXPECT_NE(r.output.find(std::string("  ") + option + " "), std::string::npos) << option << "\n"
                                                                                   << r.output;
   }
@@ -293,6 +332,9 @@ TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
       {" --set nonsense=1", "--set: unknown setting 'nonsense'"},
       {" --every 10", "--every needs --screenshot"},
       {" --script a.txt --record b.txt", "--record records live input"},
+      {" --crowd 10 --script a.txt", "--crowd runs its own input"},
+      {" --crowd 0", "--crowd: 0 is outside [1, 1000000]"},
+      {" --budget-ms 3", "--budget-ms and --tier-colours need --crowd"},
       {" stray", "not expected: stray"},
   };
   for (const auto& [arguments, message] : cases) {

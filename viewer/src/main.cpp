@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "body_source.hpp"
+#include "crowd_run.hpp"
 #include "database_source.hpp"
 #include "mm/programs/number_parsing.hpp"
 #include "mm/world/bullet_world.hpp"
@@ -49,9 +50,11 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (const int code = parse_viewer_options(args, options); code >= 0) return code;
   if (!options.headless && !has_display()) {
-    std::fprintf(stderr,
-                 "mm-viewer: no display (DISPLAY is not set): run with --headless --script FILE, "
-                 "or under xvfb-run\n");
+    std::fprintf(
+        stderr,
+        "mm-viewer: no display (DISPLAY is not set): run with --headless (--script FILE or "
+        "--crowd N), "
+        "or under xvfb-run\n");
     return 1;
   }
 
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mm-viewer: %s\n", database.message().c_str());
     return 1;
   }
+  if (options.crowd > 0) return run_crowd(options, *database);
   mm::Result<BodySource> body = make_body(**database, options);
   if (!body) {
     std::fprintf(stderr, "mm-viewer: %s\n", body.message().c_str());

@@ -112,7 +112,7 @@ void add_character_options(CLI::App& app, ViewerOptions& out) {
 // How the run goes and what it leaves behind.
 void add_run_options(CLI::App& app, ViewerOptions& out) {
   app.add_flag("--headless", out.headless,
-               "no window: render offscreen (EGL surfaceless); needs --script");
+               "no window: render offscreen (EGL surfaceless); needs --script or --crowd");
   app.add_option("--frames", out.frames,
                  "stop after N frames (headless default: the script's length and 2 s)")
       ->check(cli::integer_in(1, kMaxRunFrames))
@@ -140,18 +140,44 @@ void add_run_options(CLI::App& app, ViewerOptions& out) {
   cli::add_dt_option(app, out.dt, "default: the wall clock in a window, 1/60 headless");
 }
 
+// The crowd (crowd_run.hpp).
+void add_crowd_options(CLI::App& app, ViewerOptions& out) {
+  app.add_option("--crowd", out.crowd,
+                 "a crowd of N characters on varied scripted input around the camera, under a "
+                 "frame budget (level of detail), drawn with instancing; headless it needs no "
+                 "--script and writes mm-viewer-crowd.png unless --screenshot says otherwise")
+      ->check(cli::integer_in(1, 1'000'000))
+      ->type_name("N");
+  app.add_option("--budget-ms", out.budget_ms,
+                 "the crowd's frame budget in ms, also a slider in the panel (default 4; 0: every "
+                 "character at full rate)")
+      ->check(CLI::Range(0.0f, 1000.0f))
+      ->type_name("MS");
+  app.add_flag("--tier-colours", out.tier_colours,
+               "colour the crowd by level-of-detail tier from the start (key T, a panel checkbox)");
+}
+
 // The options that only make sense together; -1 when they are fine, else 2 (printed).
 int check_combinations(const CLI::App& app, const ViewerOptions& out) {
   if (!out.db_path.empty() && !out.data_path.empty()) {
     return cli::usage_error(app, "give --db or --data, not both");
   }
-  if (out.headless && out.script_path.empty()) {
-    return cli::usage_error(app, "--headless needs --script");
+  if (out.crowd > 0 && (!out.script_path.empty() || !out.record_path.empty() ||
+                        !out.world_path.empty() || !out.body_path.empty())) {
+    return cli::usage_error(app,
+                            "--crowd runs its own input on flat ground: it cannot be used "
+                            "with --script, --record, --world or --body");
+  }
+  if (out.crowd == 0 && (app.count("--budget-ms") > 0 || out.tier_colours)) {
+    return cli::usage_error(app, "--budget-ms and --tier-colours need --crowd");
+  }
+  if (out.headless && out.script_path.empty() && out.crowd == 0) {
+    return cli::usage_error(app, "--headless needs --script or --crowd");
   }
   if (!out.script_path.empty() && !out.record_path.empty()) {
     return cli::usage_error(app, "--record records live input; it cannot be used with --script");
   }
-  if (out.every > 0 && out.screenshot_path.empty()) {
+  if (out.every > 0 && out.screenshot_path.empty() && out.crowd == 0) {
     return cli::usage_error(app, "--every needs --screenshot");
   }
   return cli::check_settings(app, out.settings);
@@ -166,6 +192,7 @@ int parse_viewer_options(const std::vector<std::string>& args, ViewerOptions& ou
   add_file_options(app, out);
   add_character_options(app, out);
   add_run_options(app, out);
+  add_crowd_options(app, out);
   if (const int code = cli::parse_command_line(app, args); code >= 0) return code;
   return check_combinations(app, out);
 }

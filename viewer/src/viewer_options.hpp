@@ -31,6 +31,9 @@ struct ViewerOptions {
   float dt = 0.0f;  // seconds per update; 0: the wall clock (windowed), 1/60 (headless)
   bool panel = true;
   DebugToggles toggles;
+  int crowd = 0;           // --crowd N: a crowd of N characters instead of one (crowd_run.hpp)
+  float budget_ms = 4.0f;  // --budget-ms: the crowd's frame budget (0: none)
+  bool tier_colours = false;
 };
 
 // Parses the arguments (without the program name). Returns the exit code to stop with (0 after

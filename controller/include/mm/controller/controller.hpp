@@ -420,11 +420,26 @@ class Controller {
   // its offset to the simulation object; the pose, playback and transitions are held (no
   // search, sampling, IK or forward kinematics), foot locks are released. A later update()
   // goes on from there. dt as in update().
+  //
+  // Only the root (joint 0 of global_transforms()) moves: the other joints stay where the last
+  // update left them, hanging from carried_from() rather than from the root, until
+  // settle_carried_pose() carries them with it (update() and any other step that poses the
+  // character do that themselves). A crowd draws the carried pose as the held pose moved by the
+  // rigid motion from carried_from() to root_transform(), touching a few cache lines per
+  // character instead of every joint. With settings.compute_skinning the pose is settled at
+  // once (the skinning matrices need every joint).
   void update_move_only(float dt, const ControllerInput& input);
   // Asks the cache for what the next update_move_only() reads and writes (the simulation
-  // object, the root, the displayed pose), so a crowd's loop can overlap one character's
-  // memory latency with the step before it. No effect on any result.
+  // object, the root), so a crowd's loop can overlap one character's memory latency with the
+  // step before it. No effect on any result.
   void prefetch_move_only() const;
+  // Whether joints 1.. of global_transforms() are still those of the last update, hanging from
+  // carried_from() (after update_move_only()).
+  bool pose_carried() const { return pose_carried_; }
+  // The root the held joints hang from while pose_carried() (world, as global_transforms()).
+  Transform carried_from() const;
+  // Carries the held joints rigidly with the root (no effect unless pose_carried()).
+  void settle_carried_pose();
 
   // Places the character and its simulation object (cold; clears any transition).
   void teleport(const glm::vec3& position, float yaw);
@@ -655,6 +670,10 @@ class Controller {
   glm::vec3 displayed_angular_velocity_{0.0f};
   std::vector<Transform> globals_;        // relative to origin_
   std::vector<Transform> world_globals_;  // globals_ in the world, while origin_ is not zero
+  // update_move_only(): joints 1.. of globals_ (and world_globals_) are held, relative to this
+  // root (relative to origin_ like globals_) rather than to globals_[0].
+  bool pose_carried_ = false;
+  Transform carried_from_;
   std::vector<glm::mat4> inverse_bind_;
   ForwardKinematicsPlan fk_plan_;  // the database skeleton's
   // Computed by skinning_matrices() from the transforms when stale.

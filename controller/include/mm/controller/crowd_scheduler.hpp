@@ -90,6 +90,9 @@ class CrowdScheduler {
   void plan(std::span<const float> significance);
   // Every character at one tier this frame, budget ignored (tests, calibration).
   void plan_all(CrowdTier tier);
+  // A new frame budget for the next plan() (ms; 0: none), e.g. from a game's settings or its
+  // measured frame time. Fails, changing nothing, when the budget is not a number >= 0.
+  Status set_budget_ms(float budget_ms);
 
   // Character i's work of this frame (after plan()): updates, moves or holds `controller`
   // (always the same one for i) by its tier and phase, and sets pose(i). Reduced-rate
@@ -103,11 +106,20 @@ class CrowdScheduler {
   // Whether step(i) calls the controller this frame (so needs an input).
   bool updates(size_t i) const;
 
-  // What to display for character i: global transforms (as Controller::global_transforms())
-  // after this frame's step.
+  // What to display for character i after this frame's step: global transforms (as
+  // Controller::global_transforms()) moved by the rigid motion carry(i). Only a character that
+  // only moves has a carry: its held pose stays as it was and carry(i) takes it along with the
+  // root (one transform per step, not every joint; a renderer applies it per instance).
   std::span<const Transform> pose(size_t i) const {
     return {(shows_last_[i] != 0 ? last_ : shown_).data() + i * joints_, joints_};
   }
+  // The rigid motion (a turn about +Y and a translation, unit scale) to apply to every joint of
+  // pose(i): compose(carry(i), pose(i)[j]). The identity for every tier but MoveOnly.
+  Transform carry(size_t i) const {
+    return shows_last_[i] != 0 && carried_[i] != 0 ? carry_[i] : Transform{};
+  }
+  // pose(i) with carry(i) applied, into `out` (joints() transforms): the displayed globals.
+  void displayed_pose(size_t i, std::span<Transform> out) const;
   CrowdTier tier(size_t i) const { return static_cast<CrowdTier>(tier_[i]); }
   // Characters per tier in this frame's plan, and the plan's work by the cost model (us).
   const std::array<int, kCrowdTierCount>& tier_counts() const { return counts_; }
@@ -122,6 +134,12 @@ class CrowdScheduler {
   void rank(std::span<const float> significance);
   void assign(CrowdTier floor, double capacity);
   void start_blend(size_t i, std::span<const Transform> predicted);
+  void keep_update(size_t i, const Controller& controller, Step now, Step last_step);
+  // Joint j of the last step's pose: last_, carried when the step only moved.
+  Transform updated_joint(size_t i, size_t j) const {
+    const Transform& held = last_[i * joints_ + j];
+    return carried_[i] != 0 ? compose(carry_[i], held) : held;
+  }
   void show(size_t i);
 
   CrowdSchedulerSettings settings_;
@@ -137,8 +155,12 @@ class CrowdScheduler {
   std::vector<uint8_t> update_period_;  // frames the last update's pose is chased over
   std::vector<float> blend_weight_;     // of the offsets: 1 at a blend's start, decaying to 0
   std::vector<uint8_t> shows_last_;     // pose() is the last update's pose as it is
-  std::vector<float> keys_;             // significance with hysteresis, this frame
-  std::vector<uint32_t> order_;         // characters by key, most significant first
+  // After a move: last_ is the pose held since the character started moving, its root where
+  // the held joints hang from, and carry_ the rigid motion from there to the controller's root.
+  std::vector<uint8_t> carried_;
+  std::vector<Transform> carry_;
+  std::vector<float> keys_;      // significance with hysteresis, this frame
+  std::vector<uint32_t> order_;  // characters by key, most significant first
   // Per character and joint (character-major): what was shown when the last update came, that
   // update's pose, the offsets a blend eases out, what is shown.
   std::vector<Transform> from_;

@@ -91,11 +91,13 @@ struct CrowdResult {
 Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database,
                               const CrowdOptions& options);
 
-// The scheduler's cost model measured on this machine: each tier's frame time over the last of
-// two seconds of `characters` of the options' crowd, every one at that tier, stepped on the
-// threads the budget is planned for (options.lod), as thread time per character (us). Measured
-// at the crowd's size and thread count, it holds the cache misses of a large crowd and the
-// threads' imperfect scaling.
+// The scheduler's cost model measured on this machine: `characters` of the options' crowd, every
+// one at a tier for two seconds, stepped on the threads the budget is planned for (options.lod);
+// the tier's cost is the CPU time the threads spent stepping over the last second, per character
+// and frame (us; clock_gettime(CLOCK_THREAD_CPUTIME_ID) around each thread's share of a frame).
+// Measured at the crowd's size, it holds the cache misses of a large crowd; measured as CPU time
+// rather than wall time times threads, it leaves out the time a thread waited for a core that
+// other processes held, or at the frame's barrier for the other thread.
 Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
     std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options,
     int characters);
