@@ -6,7 +6,6 @@
 
 #include "mm/controller/controller.hpp"
 #include "mm/runtime/interpolation.hpp"
-#include "mm/runtime/skinning.hpp"
 
 namespace mm {
 
@@ -46,7 +45,7 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
   }
   if (settings_.compute_skinning) {
     settle_carried_pose();
-    mm::skinning_matrices(global_transforms(), inverse_bind_, skinning_);
+    skinning_stale_ = true;  // computed when read (skinning_matrices())
   }
 }
 

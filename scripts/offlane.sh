@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# The course off its lanes (docs/world.md, "Measured on the course"): six shipped scripts started
+# at z = 3 in eight lanes of data/levels/course.glb, at each time step; one line per run with the
+# lowest toe clearance (cm), the deepest toe below its surface, the deepest joint in a wall, the
+# time stuck, the planted toes' float and the geometric skating against the data's own; BAD marks
+# a run that breaks a target (a toe below 1 cm, a toe in the ground, a joint 2 cm in a wall,
+# skating over the data's).
+#   scripts/offlane.sh DB OUT_DIR [DT...]        (mm from build/release, or $MM)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+db=${1:?usage: scripts/offlane.sh DB OUT_DIR [DT...]}
+out=${2:?usage: scripts/offlane.sh DB OUT_DIR [DT...]}
+shift 2
+mm=${MM:-build/release/tools/mm}
+mkdir -p "$out"
+[[ $# -gt 0 ]] || set -- 0.0333333 0.0166667 0.00694444
+for dt in "$@"; do
+  for script in stop-and-go walk-run strafe zigzag circle reversals; do
+    for x in 1 4 7 10 13.5 17.5 22 28; do
+      json="$out/$script-$x-$dt.json"
+      "$mm" eval --db "$db" --script "scripts/input/$script.txt" --dt "$dt" \
+        --world data/levels/course.glb --start "$x,3" --json "$json" >/dev/null
+      jq -r --arg s "$script" --arg x "$x" --arg dt "$dt" '
+        def f: . * 100 | round / 100;
+        (.toe_clearance_cm_min < 1 or .foot_penetration_cm_max > 0 or .wall_depth_cm_max > 2
+         or .foot_skate_geom_cm_s_mean > .foot_skate_geom_data_cm_s_mean) as $bad |
+        "\(if $bad then "BAD" else "ok " end) \($s) x=\($x) dt=\($dt) " +
+        "clearance=\(.toe_clearance_cm_min | f) penetration=\(.foot_penetration_cm_max | f) " +
+        "wall=\(.wall_depth_cm_max | f) stuck=\(.stuck_s | f) float=\(.foot_float_cm_mean | f) " +
+        "skate=\(.foot_skate_geom_cm_s_mean | f)/\(.foot_skate_geom_data_cm_s_mean | f)"' "$json"
+    done
+  done
+done
