@@ -103,8 +103,15 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
                           std::span<const PlacementLeg, 2> legs, float body_ground,
                           const glm::vec3& body_velocity) {
   const glm::vec3 ahead(body_velocity.x * kLookahead, 0.0f, body_velocity.z * kLookahead);
-  const float top = body_ground + settings.step_height + kProbeMargin;
-  const float reach = settings.step_height + settings.max_step_down + 2.0f * kProbeMargin;
+  // Each foot's probes start a step above the higher of the body's ground and the foot's own: a
+  // foot held up a slope the body runs down would otherwise be probed from inside the slope,
+  // find nothing, and its lock sink into the slope with the body's ground.
+  std::array<float, 2> top{}, reach{};
+  for (int side = 0; side < 2; ++side) {
+    const FootGround& g = feet_[side].ground;
+    top[side] = std::max({body_ground, g.heel, g.toe}) + settings.step_height + kProbeMargin;
+    reach[side] = top[side] - (body_ground - settings.max_step_down - kProbeMargin);
+  }
   for (int side = 0; side < 2; ++side) {
     const PlacementLeg& leg = legs[side];
     const glm::vec3 own = feet_[side].toe_velocity * kToeLookahead;
@@ -116,16 +123,18 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
     probe_points_[slot(side, kToeAhead)] = leg.toe + look;
   }
   for (int i = 0; i < kProbes; ++i) {
-    probes_[i] = GroundProbe{glm::vec3(probe_points_[i].x, top, probe_points_[i].z), reach, 0.0f};
+    const int side = i / 4;
+    probes_[i] = GroundProbe{glm::vec3(probe_points_[i].x, top[side], probe_points_[i].z),
+                             reach[side], 0.0f};
   }
   constexpr float kAround[kFootprint][2] = {
       {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
   for (int side = 0; side < 2; ++side) {
     for (int k = 0; k < kFootprint; ++k) {
       const glm::vec3 toe = probe_points_[slot(side, kToe)];
-      const glm::vec3 at(toe.x + kFootprintRadius * kAround[k][0], top,
+      const glm::vec3 at(toe.x + kFootprintRadius * kAround[k][0], top[side],
                          toe.z + kFootprintRadius * kAround[k][1]);
-      probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach, 0.0f};
+      probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach[side], 0.0f};
     }
   }
   mover.probe(world, origin, probes_, hits_);

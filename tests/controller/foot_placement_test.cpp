@@ -136,6 +136,28 @@ TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
   }
 }
 
+TEST(FootPlacement, AFootHeldUpASlopeTheBodyRunsDownKeepsItsGround) {
+  // Both feet planted on a 0.45 m block while the body's ground goes down to 0 (the body running
+  // down a slope away from a held foot): the probes, a step above the body's ground alone, would
+  // start inside the block and the feet sink with the body.
+  AnalyticWorld world;
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 0.0f), glm::vec2(5.0f, 1.0f), 0.0f, 0.45f});
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.45f),
+                                         standing_leg(0.1f, 0.0f, 0.45f)};
+  settle(p, world, mover, legs, 0.45f);
+  for (int f = 1; f <= 60; ++f) {
+    const float body = 0.45f * (1.0f - f / 60.0f);
+    p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, body, glm::vec3(0.0f),
+             kDt);
+  }
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_NEAR(p.ground(side).toe, 0.45f, 1e-3f) << side;
+    EXPECT_NEAR(p.ground(side).heel, 0.45f, 1e-3f) << side;
+  }
+}
+
 TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   AnalyticWorld world;
   // The riser at z = 0.3, ahead of a toe at z = 0.15 moving forward with the body.
