@@ -8,6 +8,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "gl.hpp"
+#include "gl_program.hpp"
 
 namespace mm::viewer {
 namespace {
@@ -62,19 +63,6 @@ void main() {
 }
 )";
 
-Result<GLuint> compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok) return shader;
-  char log[2048] = {};
-  glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-  glDeleteShader(shader);
-  return Error{std::string("crowd renderer: a shader does not compile: ") + log};
-}
-
 // The unit box: x and z in [-0.5, 0.5], y in [0, 1]; 12 triangles, a normal per face.
 std::vector<glm::vec3> unit_box() {
   std::vector<glm::vec3> out;  // position, normal, interleaved
@@ -97,14 +85,6 @@ std::vector<glm::vec3> unit_box() {
   return out;
 }
 
-// Flattens onto the plane y = height along the light: the planar shadow.
-glm::mat4 shadow_projection(const glm::vec3& light, float height) {
-  glm::mat4 m(1.0f);
-  m[1] = glm::vec4(-light.x / light.y, 0.0f, -light.z / light.y, 0.0f);
-  m[3] = glm::vec4(light.x / light.y * height, height, light.z / light.y * height, 1.0f);
-  return m;
-}
-
 }  // namespace
 
 Result<CrowdRenderer> CrowdRenderer::create() {
@@ -114,26 +94,9 @@ Result<CrowdRenderer> CrowdRenderer::create() {
 }
 
 Status CrowdRenderer::build() {
-  Result<GLuint> vs = compile(GL_VERTEX_SHADER, kVertex);
-  if (!vs) return Error{vs.message()};
-  Result<GLuint> fs = compile(GL_FRAGMENT_SHADER, kFragment);
-  if (!fs) {
-    glDeleteShader(*vs);
-    return Error{fs.message()};
-  }
-  program_ = glCreateProgram();
-  glAttachShader(program_, *vs);
-  glAttachShader(program_, *fs);
-  glLinkProgram(program_);
-  glDeleteShader(*vs);
-  glDeleteShader(*fs);
-  GLint linked = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &linked);
-  if (!linked) {
-    char log[2048] = {};
-    glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-    return Error{std::string("crowd renderer: the program does not link: ") + log};
-  }
+  Result<GLuint> program = link(kVertex, kFragment, "crowd");
+  if (!program) return Error{program.message()};
+  program_ = *program;
 
   const std::vector<glm::vec3> box = unit_box();
   vertex_count_ = static_cast<int>(box.size() / 2);

@@ -14,6 +14,7 @@
 
 #include "crowd_renderer.hpp"
 #include "crowd_view.hpp"
+#include "frame_output.hpp"
 #include "gl.hpp"
 #include "gl_context.hpp"
 #include "live_input.hpp"
@@ -131,25 +132,7 @@ void crowd_panel(CrowdStage& stage) {
 }
 
 void draw_panel_frame(CrowdStage& stage) {
-  // Headless runs may draw one frame only: ImGui measures an auto-sized window on its first
-  // frame and hides it, so they lay the panel out twice the first time.
-  const int passes = !stage.context->window() && !stage.imgui_laid_out ? 2 : 1;
-  stage.imgui_laid_out = true;
-  for (int pass = 0; pass < passes; ++pass) {
-    ImGui_ImplOpenGL3_NewFrame();
-    if (stage.context->window()) {
-      ImGui_ImplGlfw_NewFrame();
-    } else {
-      int width = 0, height = 0;
-      stage.context->framebuffer_size(width, height);
-      ImGui::GetIO().DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
-      ImGui::GetIO().DeltaTime = kDefaultRunDt;
-    }
-    ImGui::NewFrame();
-    crowd_panel(stage);
-    ImGui::Render();
-  }
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  draw_imgui_frame(*stage.context, stage.imgui_laid_out, [&] { crowd_panel(stage); });
 }
 
 void draw_frame(CrowdStage& stage) {
@@ -166,14 +149,6 @@ void draw_frame(CrowdStage& stage) {
   const float ms = std::chrono::duration<float, std::milli>(Clock::now() - start).count();
   stage.draw_ms = stage.draw_ms == 0.0f ? ms : stage.draw_ms + (ms - stage.draw_ms) / 30.0f;
   if (stage.imgui && stage.panel) draw_panel_frame(stage);
-}
-
-// OUT.png -> OUT-000120.png.
-std::filesystem::path numbered(const std::string& path, int frame) {
-  std::filesystem::path p(path);
-  char suffix[16];
-  std::snprintf(suffix, sizeof suffix, "-%06d", frame);
-  return p.parent_path() / (p.stem().string() + suffix + p.extension().string());
 }
 
 void print_summary(const CrowdStage& stage, int frames, double wall_seconds) {

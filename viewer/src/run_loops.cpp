@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "frame_output.hpp"
 #include "gl_context.hpp"
 #include "input_recorder.hpp"
 #include "live_input.hpp"
@@ -72,33 +73,9 @@ bool start_imgui(Stage& stage) {
 void draw_frame(Stage& stage, Scene& scene, bool show_panel) {
   scene.draw(*stage.renderer, *stage.context, stage.camera, stage.panel.show_body);
   if (!stage.imgui) return;
-  // A window that sizes itself is hidden on its first frame while ImGui measures it; headless
-  // runs may draw one frame only, so they lay the panel out once more before drawing it.
-  const int passes = !stage.context->window() && !stage.imgui_laid_out ? 2 : 1;
-  stage.imgui_laid_out = true;
-  for (int pass = 0; pass < passes; ++pass) {
-    ImGui_ImplOpenGL3_NewFrame();
-    if (stage.context->window()) {
-      ImGui_ImplGlfw_NewFrame();
-    } else {
-      int width = 0, height = 0;
-      stage.context->framebuffer_size(width, height);
-      ImGui::GetIO().DisplaySize = ImVec2(static_cast<float>(width), static_cast<float>(height));
-      ImGui::GetIO().DeltaTime = kDefaultRunDt;
-    }
-    ImGui::NewFrame();
+  draw_imgui_frame(*stage.context, stage.imgui_laid_out, [&] {
     if (show_panel) draw_panel(scene, stage.panel);
-    ImGui::Render();
-  }
-  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-}
-
-// OUT.png -> OUT-000120.png for the frame's own screenshot.
-std::filesystem::path numbered(const std::string& path, int frame) {
-  std::filesystem::path p(path);
-  char suffix[16];
-  std::snprintf(suffix, sizeof suffix, "-%06d", frame);
-  return p.parent_path() / (p.stem().string() + suffix + p.extension().string());
+  });
 }
 
 Status save_screenshot(const GlContext& context, const std::filesystem::path& path) {
