@@ -48,11 +48,7 @@ struct CrowdStage {
   std::string message;
 
   ~CrowdStage() {
-    if (imgui) {
-      ImGui_ImplOpenGL3_Shutdown();
-      if (context && context->window()) ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
+    if (imgui) stop_imgui(*context);
     bodies.reset();  // GL objects go before the context
     ground.reset();
   }
@@ -86,19 +82,8 @@ Status prepare(CrowdStage& stage, const ViewerOptions& options,
 }
 
 bool start_imgui(CrowdStage& stage) {
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;
-  ImGui::StyleColorsDark();
-  ImGui::GetStyle().Alpha = 0.92f;
-  if (stage.context->window()) ImGui_ImplGlfw_InitForOpenGL(stage.context->window(), true);
-  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
-    if (stage.context->window()) ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
-    return false;
-  }
-  stage.imgui = true;
-  return true;
+  stage.imgui = start_imgui(*stage.context);
+  return stage.imgui;
 }
 
 void tier_legend(const CrowdScheduler& scheduler) {

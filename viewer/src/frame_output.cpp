@@ -12,6 +12,27 @@
 
 namespace mm::viewer {
 
+bool start_imgui(const GlContext& context) {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  if (context.window()) ImGui_ImplGlfw_InitForOpenGL(context.window(), true);
+  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
+    if (context.window()) ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    return false;
+  }
+  return true;
+}
+
+void stop_imgui(const GlContext& context) {
+  ImGui_ImplOpenGL3_Shutdown();
+  if (context.window()) ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
 void draw_imgui_frame(const GlContext& context, bool& laid_out,
                       const std::function<void()>& panel) {
   const int passes = !context.window() && !laid_out ? 2 : 1;

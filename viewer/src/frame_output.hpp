@@ -1,6 +1,6 @@
 #pragma once
 // What both run loops (run_loops.hpp: one character; crowd_run.hpp: the crowd) do at the end of
-// a frame: draw the ImGui panel and name the frame's own screenshot.
+// a frame: start and stop ImGui, draw the panel, and name the frame's own screenshot.
 
 #include <filesystem>
 #include <functional>
@@ -9,6 +9,12 @@
 #include "gl_context.hpp"
 
 namespace mm::viewer {
+
+// ImGui on `context` (its GLFW window's input when it has one), dark, no imgui.ini left in the
+// working folder; false, with nothing left started, when its OpenGL backend cannot start.
+bool start_imgui(const GlContext& context);
+// Undoes start_imgui(), before the context goes.
+void stop_imgui(const GlContext& context);
 
 // One ImGui frame around `panel` (which makes the ImGui calls), drawn into the current
 // framebuffer. Headless runs may draw one frame only, and ImGui measures an auto-sized window on

@@ -33,11 +33,7 @@ struct Stage {
   bool imgui_laid_out = false;
 
   ~Stage() {
-    if (imgui) {
-      ImGui_ImplOpenGL3_Shutdown();
-      if (context && context->window()) ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
+    if (imgui) stop_imgui(*context);
     renderer.reset();  // its GL objects go before the context
   }
 };
@@ -55,19 +51,8 @@ Status prepare(Stage& stage, const ViewerOptions& options, Scene& scene) {
 
 // Dear ImGui on the context: with GLFW's input in a window; headless it only draws.
 bool start_imgui(Stage& stage) {
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the working folder
-  ImGui::StyleColorsDark();
-  ImGui::GetStyle().Alpha = 0.92f;
-  if (stage.context->window()) ImGui_ImplGlfw_InitForOpenGL(stage.context->window(), true);
-  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
-    if (stage.context->window()) ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
-    return false;
-  }
-  stage.imgui = true;
-  return true;
+  stage.imgui = start_imgui(*stage.context);
+  return stage.imgui;
 }
 
 void draw_frame(Stage& stage, Scene& scene, bool show_panel) {
