@@ -1369,7 +1369,9 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
                          kKneeForwardBias * (globals_[0].rotation * kForward);
-  apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
+  // The foot's subtree is refreshed once, below, after its rotation is set.
+  apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
+                              knee, foot, ankle_target, pole);
   const glm::quat raised_foot = glm::normalize(heel_rise * foot_rotation);
   locals_[static_cast<size_t>(foot)].rotation =
       glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * raised_foot);
