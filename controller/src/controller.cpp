@@ -1275,8 +1275,9 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
 // Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
 // displayed root.
 glm::vec3 Controller::playing_position(int joint) const {
-  const Transform played = forward_kinematics_joint(db_->skeleton().parents(), sampled_, joint);
-  return transform_point(compose(locals_[0], inverse(sampled_[0])), played.translation);
+  // Only the position: the chain's rotations and scales are not needed for it.
+  const glm::vec3 played = forward_kinematics_position(db_->skeleton().parents(), sampled_, joint);
+  return transform_point(compose(locals_[0], inverse(sampled_[0])), played);
 }
 
 // The end joint of a leg: its toe, or its foot when it has none.
