@@ -844,12 +844,14 @@ void Controller::predict() {
   const size_t n = trajectory_times_.size();
   std::span<glm::vec3> positions(debug_.predicted_positions, n);
   std::span<glm::quat> rotations(debug_.predicted_rotations, n);
+  // The coefficients depend only on the halflives and the times: computed again only when
+  // one of them changed (the tables check).
+  position_springs_.prepare_character(settings_.simulation_velocity_halflife, trajectory_times_);
+  rotation_springs_.prepare_critical(settings_.simulation_rotation_halflife, trajectory_times_);
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
-                           desired_velocity_, settings_.simulation_velocity_halflife,
-                           trajectory_times_);
+                           desired_velocity_, position_springs_);
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
-                          simulation_goal_rotation_, settings_.simulation_rotation_halflife,
-                          trajectory_times_);
+                          simulation_goal_rotation_, rotation_springs_);
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
