@@ -145,8 +145,10 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
     if (r > 0.0f) twist = rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction);
   }
 
-  const glm::quat hip_turn = twist * swing * hip_bend;
-  const glm::quat knee_turn = twist * swing * knee_bend * hip_bend;
+  // Products group from the left, so twist * swing is the same first factor of both.
+  const glm::quat turn = twist * swing;
+  const glm::quat hip_turn = turn * hip_bend;
+  const glm::quat knee_turn = turn * knee_bend * hip_bend;
   TwoBoneIkResult r;
   r.root_global = glm::normalize(hip_turn * in.root.rotation);
   r.mid_global = glm::normalize(knee_turn * in.mid.rotation);
