@@ -846,12 +846,14 @@ void Controller::predict() {
   const size_t n = trajectory_times_.size();
   std::span<glm::vec3> positions(debug_.predicted_positions, n);
   std::span<glm::quat> rotations(debug_.predicted_rotations, n);
+  // The coefficients depend only on the halflives and the times: computed again only when
+  // one of them changed (the tables check).
+  position_springs_.prepare_character(settings_.simulation_velocity_halflife, trajectory_times_);
+  rotation_springs_.prepare_critical(settings_.simulation_rotation_halflife, trajectory_times_);
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
-                           desired_velocity_, settings_.simulation_velocity_halflife,
-                           trajectory_times_);
+                           desired_velocity_, position_springs_);
   critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
-                          simulation_goal_rotation_, settings_.simulation_rotation_halflife,
-                          trajectory_times_);
+                          simulation_goal_rotation_, rotation_springs_);
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
@@ -1277,8 +1279,9 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
 // Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
 // displayed root.
 glm::vec3 Controller::playing_position(int joint) const {
-  const Transform played = forward_kinematics_joint(db_->skeleton().parents(), sampled_, joint);
-  return transform_point(compose(locals_[0], inverse(sampled_[0])), played.translation);
+  // Only the position: the chain's rotations and scales are not needed for it.
+  const glm::vec3 played = forward_kinematics_position(db_->skeleton().parents(), sampled_, joint);
+  return transform_point(compose(locals_[0], inverse(sampled_[0])), played);
 }
 
 // The end joint of a leg: its toe, or its foot when it has none.
@@ -1371,7 +1374,9 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
                          kKneeForwardBias * (globals_[0].rotation * kForward);
-  apply_two_bone_ik(parents, locals_, globals_, hip, knee, foot, ankle_target, pole);
+  // The foot's subtree is refreshed once, below, after its rotation is set.
+  apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
+                              knee, foot, ankle_target, pole);
   const glm::quat raised_foot = glm::normalize(heel_rise * foot_rotation);
   locals_[static_cast<size_t>(foot)].rotation =
       glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * raised_foot);

@@ -145,8 +145,10 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
     if (r > 0.0f) twist = rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction);
   }
 
-  const glm::quat hip_turn = twist * swing * hip_bend;
-  const glm::quat knee_turn = twist * swing * knee_bend * hip_bend;
+  // Products group from the left, so twist * swing is the same first factor of both.
+  const glm::quat turn = twist * swing;
+  const glm::quat hip_turn = turn * hip_bend;
+  const glm::quat knee_turn = turn * knee_bend * hip_bend;
   TwoBoneIkResult r;
   r.root_global = glm::normalize(hip_turn * in.root.rotation);
   r.mid_global = glm::normalize(knee_turn * in.mid.rotation);
@@ -158,10 +160,13 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   return r;
 }
 
-TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
-                                  std::span<Transform> global, int root, int mid, int end,
-                                  const glm::vec3& target, const glm::vec3& pole,
-                                  float extension_epsilon) {
+namespace {
+
+// The solve of a pose's chain, its local rotations written and the root's global refreshed.
+TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform> local,
+                               std::span<Transform> global, int root, int mid, int end,
+                               const glm::vec3& target, const glm::vec3& pole,
+                               float extension_epsilon) {
   MM_ASSERT(parents.size() == local.size() && parents.size() == global.size());
   MM_ASSERT(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
   MM_ASSERT(parents[mid] == root && parents[end] == mid);
@@ -178,13 +183,48 @@ TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transf
   const TwoBoneIkResult r = solve_two_bone_ik(in);
   local[root].rotation = r.root_local;
   local[mid].rotation = r.mid_local;
+  global[root] = parents[root] < 0 ? local[root] : compose(global[parents[root]], local[root]);
+  return r;
+}
+
+}  // namespace
+
+TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
+                                  std::span<Transform> global, int root, int mid, int end,
+                                  const glm::vec3& target, const glm::vec3& pole,
+                                  float extension_epsilon) {
+  const TwoBoneIkResult r =
+      solve_in_place(parents, local, global, root, mid, end, target, pole, extension_epsilon);
   // Parents come first, so one pass from the root on refreshes every descendant. Only the root's
   // descendants move: every other joint's global already is the FK of its unchanged local.
-  global[root] = parents[root] < 0 ? local[root] : compose(global[parents[root]], local[root]);
   for (size_t i = static_cast<size_t>(root) + 1; i < parents.size(); ++i) {
     int ancestor = parents[i];
     while (ancestor > root) ancestor = parents[ancestor];
     if (ancestor == root) global[i] = compose(global[parents[i]], local[i]);
+  }
+  return r;
+}
+
+TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
+                                            std::span<const int> subtree_sizes,
+                                            std::span<Transform> local, std::span<Transform> global,
+                                            int root, int mid, int end, const glm::vec3& target,
+                                            const glm::vec3& pole, float extension_epsilon) {
+  MM_ASSERT(subtree_sizes.size() == parents.size());
+  const TwoBoneIkResult r =
+      solve_in_place(parents, local, global, root, mid, end, target, pole, extension_epsilon);
+  // The root's descendants are the joints right after it; the end's subtree is left to the
+  // caller, which changes the end's local and refreshes it then (refreshed here too, it would
+  // be computed twice and the first thrown away).
+  const int end_last = end + subtree_sizes[static_cast<size_t>(end)];
+  const int root_last = root + subtree_sizes[static_cast<size_t>(root)];
+  for (int i = root + 1; i < root_last; ++i) {
+    if (i == end) {
+      i = end_last - 1;
+      continue;
+    }
+    const size_t j = static_cast<size_t>(i);
+    global[j] = compose(global[static_cast<size_t>(parents[j])], local[j]);
   }
   return r;
 }

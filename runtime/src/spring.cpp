@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include "mm/runtime/assert.hpp"
 
 #include "mm/runtime/finite.hpp"
@@ -189,6 +190,18 @@ void critical_spring_predict(std::span<glm::vec3> positions, std::span<glm::vec3
   }
 }
 
+namespace {
+
+// One predicted time of a rotation spring from its initial error (not frozen).
+void predict_rotation(glm::quat& rotation, glm::vec3& rate, const glm::vec3& error0,
+                      const glm::quat& goal, const SpringCoefficients& c) {
+  glm::vec3 error = error0;
+  apply_spring(error, rate, glm::vec3(0.0f), c);
+  rotation = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+}
+
+}  // namespace
+
 void critical_spring_predict(std::span<glm::quat> rotations,
                              std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
                              const glm::vec3& angular_velocity, const glm::quat& goal,
@@ -200,16 +213,34 @@ void critical_spring_predict(std::span<glm::quat> rotations,
   const glm::vec3 error0 =
       frozen ? glm::vec3(0.0f) : quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
   for (size_t i = 0; i < times.size(); ++i) {
-    if (frozen) {
-      if (!rotations.empty()) rotations[i] = rotation;
-      if (!angular_velocities.empty()) angular_velocities[i] = angular_velocity;
-      continue;
-    }
-    glm::vec3 error = error0;
+    glm::quat q = rotation;
     glm::vec3 rate = angular_velocity;
-    apply_spring(error, rate, glm::vec3(0.0f), spring_coefficients(w, prediction_time(times[i])));
-    if (!rotations.empty())
-      rotations[i] = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+    if (!frozen) {
+      predict_rotation(q, rate, error0, goal, spring_coefficients(w, prediction_time(times[i])));
+    }
+    if (!rotations.empty()) rotations[i] = q;
+    if (!angular_velocities.empty()) angular_velocities[i] = rate;
+  }
+}
+
+void critical_spring_predict(std::span<glm::quat> rotations,
+                             std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
+                             const glm::vec3& angular_velocity, const glm::quat& goal,
+                             const SpringPredictionTable& table) {
+  MM_ASSERT(table.prepared);
+  MM_ASSERT(rotations.empty() || rotations.size() == table.count);
+  MM_ASSERT(angular_velocities.empty() || angular_velocities.size() == table.count);
+  const bool frozen = !std::isfinite(table.halflife) || !finite(goal);
+  const glm::vec3 error0 =
+      frozen ? glm::vec3(0.0f) : quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
+  for (size_t i = 0; i < table.count; ++i) {
+    glm::quat q = rotation;
+    glm::vec3 rate = angular_velocity;
+    if (!frozen) {
+      const double* c = table.c[i];
+      predict_rotation(q, rate, error0, goal, SpringCoefficients{c[0], c[1], c[2], c[3]});
+    }
+    if (!rotations.empty()) rotations[i] = q;
     if (!angular_velocities.empty()) angular_velocities[i] = rate;
   }
 }
@@ -242,6 +273,79 @@ void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec
     if (!positions.empty()) positions[i] = x;
     if (!velocities.empty()) velocities[i] = v;
     if (!accelerations.empty()) accelerations[i] = a;
+  }
+}
+
+void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> accelerations, const glm::vec3& position,
+                              const glm::vec3& velocity, const glm::vec3& acceleration,
+                              const glm::vec3& desired_velocity,
+                              const SpringPredictionTable& table) {
+  MM_ASSERT(table.prepared);
+  MM_ASSERT(positions.empty() || positions.size() == table.count);
+  MM_ASSERT(velocities.empty() || velocities.size() == table.count);
+  MM_ASSERT(accelerations.empty() || accelerations.size() == table.count);
+  const bool frozen = !std::isfinite(table.halflife) || !finite(desired_velocity);
+  for (size_t i = 0; i < table.count; ++i) {
+    glm::vec3 x = position;
+    glm::vec3 v = velocity;
+    glm::vec3 a = acceleration;
+    if (!frozen) {
+      const double* c = table.c[i];
+      apply_character(x, v, a, desired_velocity,
+                      CharacterCoefficients{c[0], c[1], c[2], c[3], table.w});
+    }
+    if (!positions.empty()) positions[i] = x;
+    if (!velocities.empty()) velocities[i] = v;
+    if (!accelerations.empty()) accelerations[i] = a;
+  }
+}
+
+namespace {
+
+// Whether the table was prepared (by the same kind of prepare) for this halflife and times.
+bool same_key(const SpringPredictionTable& table, float halflife, std::span<const float> times) {
+  if (!table.prepared || table.count != times.size()) return false;
+  // Compared as bits: a NaN halflife or time is the same key as itself.
+  if (std::memcmp(&table.halflife, &halflife, sizeof(float)) != 0) return false;
+  return std::memcmp(table.times, times.data(), times.size() * sizeof(float)) == 0;
+}
+
+void set_key(SpringPredictionTable& table, float halflife, std::span<const float> times) {
+  MM_ASSERT(times.size() <= SpringPredictionTable::kMaxTimes);
+  table.prepared = true;
+  table.halflife = halflife;
+  table.count = times.size();
+  std::copy(times.begin(), times.end(), table.times);
+  table.w = angular_frequency(halflife);
+}
+
+}  // namespace
+
+void SpringPredictionTable::prepare_critical(float new_halflife, std::span<const float> new_times) {
+  if (same_key(*this, new_halflife, new_times) && kind == 1) return;
+  set_key(*this, new_halflife, new_times);
+  kind = 1;
+  for (size_t i = 0; i < count; ++i) {
+    const SpringCoefficients s = spring_coefficients(w, prediction_time(times[i]));
+    c[i][0] = s.xx;
+    c[i][1] = s.xv;
+    c[i][2] = s.vx;
+    c[i][3] = s.vv;
+  }
+}
+
+void SpringPredictionTable::prepare_character(float new_halflife,
+                                              std::span<const float> new_times) {
+  if (same_key(*this, new_halflife, new_times) && kind == 2) return;
+  set_key(*this, new_halflife, new_times);
+  kind = 2;
+  for (size_t i = 0; i < count; ++i) {
+    const CharacterCoefficients s = character_coefficients(w, prediction_time(times[i]));
+    c[i][0] = s.x_j0;
+    c[i][1] = s.x_j1;
+    c[i][2] = s.e;
+    c[i][3] = s.t;
   }
 }
 

@@ -263,5 +263,40 @@ TEST(TwoBoneIk, ApplyOnAPoseUpdatesLocalsAndGlobals) {
   EXPECT_EQ(local[Leg::kPelvis].rotation, leg.local[Leg::kPelvis].rotation);
 }
 
+// The same solve as apply_two_bone_ik; every global outside the end's subtree equals its result
+// to the bit, and the end's subtree keeps its globals for the caller to refresh. The knee has a
+// second child after the ankle's subtree (a knee cap), so the skip has a joint after it.
+TEST(TwoBoneIk, ApplyAboveEndRefreshesAllButTheEndsSubtree) {
+  const std::vector<int> parents{-1, 0, 1, 2, 3, 2};
+  const std::vector<int> subtree_sizes{6, 5, 4, 2, 1, 1};
+  Leg leg(0.42f, 0.4f, true);
+  std::vector<Transform> local = leg.local;
+  local.push_back(Transform{});
+  local[5].translation = {0.0f, 0.0f, 0.08f};
+  local[5].rotation = test::random_rotation(0.0f, 1.0f);
+  std::vector<Transform> before(local.size());
+  forward_kinematics(parents, local, before);
+  const glm::vec3 target = before[Leg::kHip].translation + glm::vec3(0.05f, -0.6f, 0.2f);
+  std::vector<Transform> all_local = local, all = before;
+  const TwoBoneIkResult expected = apply_two_bone_ik(parents, all_local, all, Leg::kHip, Leg::kKnee,
+                                                     Leg::kAnkle, target, glm::vec3(0, 0, 1));
+  std::vector<Transform> above = before;
+  const TwoBoneIkResult r =
+      apply_two_bone_ik_above_end(parents, subtree_sizes, local, above, Leg::kHip, Leg::kKnee,
+                                  Leg::kAnkle, target, glm::vec3(0, 0, 1));
+  EXPECT_EQ(r.root_local, expected.root_local);
+  EXPECT_EQ(r.mid_local, expected.mid_local);
+  for (int i : {Leg::kPelvis, Leg::kHip, Leg::kKnee, 5}) {
+    EXPECT_EQ(above[i].translation, all[i].translation) << i;
+    EXPECT_EQ(above[i].rotation, all[i].rotation) << i;
+  }
+  for (int i : {Leg::kAnkle, Leg::kToe}) {
+    EXPECT_EQ(above[i].translation, before[i].translation) << i;
+    EXPECT_EQ(above[i].rotation, before[i].rotation) << i;
+  }
+  // The end moved: a skip that refreshed it anyway would fail above.
+  EXPECT_NE(all[Leg::kAnkle].translation, before[Leg::kAnkle].translation);
+}
+
 }  // namespace
 }  // namespace mm

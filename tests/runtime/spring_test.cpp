@@ -499,5 +499,45 @@ TEST(RotationSpring, AngularVelocitySettlesWithoutSubnormals) {
   EXPECT_TRUE(same_rotation(q, goal, 1e-6f));
 }
 
+// A prepared table predicts the same numbers as the halflife and times do, to the bit, and a
+// table prepared again for another halflife or other times gives that one's (never the stale
+// coefficients).
+TEST(SpringPredictionTable, EqualsThePredictionFromTheHalflifeAndFollowsChanges) {
+  const std::array<float, 4> times{0.0f, 0.2f, 0.5f, 1.0f};
+  const std::array<float, 4> later{0.1f, 0.3f, 0.6f, 1.2f};
+  const glm::vec3 x(0.3f, 0.0f, -1.2f), v(1.1f, 0.0f, 0.4f), a(-2.0f, 0.0f, 0.7f);
+  const glm::vec3 desired(0.0f, 0.0f, 1.5f);
+  const glm::quat q = glm::angleAxis(0.4f, glm::vec3(0, 1, 0));
+  const glm::quat goal = glm::angleAxis(-1.3f, glm::vec3(0, 1, 0));
+  const glm::vec3 w(0.0f, 0.8f, 0.0f);
+  SpringPredictionTable positions_table, rotations_table;
+  // The same key twice in a row (kept), then another halflife, then other times.
+  for (const std::array<float, 4>& at : {times, later}) {
+    for (const float halflife : {0.3f, 0.3f, 0.12f}) {
+      std::array<glm::vec3, 4> p{}, vel{}, acc{}, p_table{}, vel_table{}, acc_table{};
+      spring_character_predict(p, vel, acc, x, v, a, desired, halflife, at);
+      positions_table.prepare_character(halflife, at);
+      spring_character_predict(p_table, vel_table, acc_table, x, v, a, desired, positions_table);
+      std::array<glm::quat, 4> r{}, r_table{};
+      std::array<glm::vec3, 4> rate{}, rate_table{};
+      critical_spring_predict(r, rate, q, w, goal, halflife, at);
+      rotations_table.prepare_critical(halflife, at);
+      critical_spring_predict(r_table, rate_table, q, w, goal, rotations_table);
+      for (size_t i = 0; i < at.size(); ++i) {
+        EXPECT_EQ(p_table[i], p[i]) << halflife << " " << i;
+        EXPECT_EQ(vel_table[i], vel[i]) << halflife << " " << i;
+        EXPECT_EQ(acc_table[i], acc[i]) << halflife << " " << i;
+        EXPECT_EQ(r_table[i], r[i]) << halflife << " " << i;
+        EXPECT_EQ(rate_table[i], rate[i]) << halflife << " " << i;
+      }
+    }
+  }
+  // The two halflives predict differently, so following the change is tested above.
+  std::array<glm::vec3, 4> slow{}, fast{};
+  spring_character_predict(slow, {}, {}, x, v, a, desired, 0.3f, times);
+  spring_character_predict(fast, {}, {}, x, v, a, desired, 0.12f, times);
+  EXPECT_NE(slow[3], fast[3]);
+}
+
 }  // namespace
 }  // namespace mm

@@ -51,6 +51,7 @@
 #include "mm/runtime/inertialization.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/result.hpp"
+#include "mm/runtime/spring.hpp"
 #include "mm/runtime/transform.hpp"
 #include "mm/search/search.hpp"
 
@@ -607,6 +608,9 @@ class Controller {
 
   // Schema facts resolved at create().
   std::vector<float> trajectory_times_;  // unique trajectory times of the schema (s)
+  // The prediction's spring coefficients at those times, kept while the halflives stay.
+  SpringPredictionTable position_springs_;
+  SpringPredictionTable rotation_springs_;
   struct TrajectoryColumn {
     int column = 0;      // first column in the feature row
     int time_index = 0;  // index into trajectory_times_

@@ -53,4 +53,15 @@ TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transf
                                   const glm::vec3& target, const glm::vec3& pole,
                                   float extension_epsilon = 1e-4f);
 
+// apply_two_bone_ik for a caller that sets the end joint's local rotation after the solve (a foot
+// turned to its own rotation) and refreshes the end's subtree itself: the globals of the root's
+// descendants are refreshed except the end and its descendants, which keep their old values.
+// Requires the joints in depth-first order (a joint's descendants are the next
+// subtree_sizes[joint] - 1 joints, as Skeleton keeps them).
+TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
+                                            std::span<const int> subtree_sizes,
+                                            std::span<Transform> local, std::span<Transform> global,
+                                            int root, int mid, int end, const glm::vec3& target,
+                                            const glm::vec3& pole, float extension_epsilon = 1e-4f);
+
 }  // namespace mm

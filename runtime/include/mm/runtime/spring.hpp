@@ -32,6 +32,7 @@
 //   with a non-finite goal or halflife give the current state at every time.
 // Nothing here allocates.
 
+#include <cstddef>
 #include <span>
 
 #include <glm/glm.hpp>
@@ -122,5 +123,43 @@ void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec
                               const glm::vec3& velocity, const glm::vec3& acceleration,
                               const glm::vec3& desired_velocity, float halflife,
                               std::span<const float> times);
+
+// The coefficients of a prediction at fixed times for one halflife: they depend only on those
+// (an exponential each), so a caller predicting every update at the same times (a trajectory)
+// keeps them and computes them again only when the halflife or a time changes. prepare() checks
+// that itself (exact comparison), so a stale table is never used, and the predictions from it
+// equal the ones computed from the halflife and times to the bit.
+struct SpringPredictionTable {
+  static constexpr size_t kMaxTimes = 16;
+  // Makes the table the one for halflife and times (times.size() <= kMaxTimes); recomputes only
+  // when either differs from the last call's.
+  void prepare_critical(float halflife, std::span<const float> times);
+  void prepare_character(float halflife, std::span<const float> times);
+
+  bool prepared = false;
+  int kind = 0;  // 1: prepare_critical's coefficients, 2: prepare_character's
+  float halflife = 0.0f;
+  size_t count = 0;
+  float times[kMaxTimes] = {};
+  // Per time: the critical spring's xx, xv, vx, vv, or the character's x_j0, x_j1, e, t, and
+  // the angular frequency w in w (spring.cpp).
+  double c[kMaxTimes][4] = {};
+  double w = 0.0;
+};
+
+// critical_spring_predict (rotations) with the table prepared (prepare_critical) for its
+// halflife and times.
+void critical_spring_predict(std::span<glm::quat> rotations,
+                             std::span<glm::vec3> angular_velocities, const glm::quat& rotation,
+                             const glm::vec3& angular_velocity, const glm::quat& goal,
+                             const SpringPredictionTable& table);
+
+// spring_character_predict with the table prepared (prepare_character) for its halflife and
+// times.
+void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
+                              std::span<glm::vec3> accelerations, const glm::vec3& position,
+                              const glm::vec3& velocity, const glm::vec3& acceleration,
+                              const glm::vec3& desired_velocity,
+                              const SpringPredictionTable& table);
 
 }  // namespace mm
