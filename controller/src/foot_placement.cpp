@@ -95,13 +95,27 @@ void FootPlacement::follow_toes(std::span<const PlacementLeg, 2> legs, float dt)
   }
 }
 
-// Heel and toe, where they are and (for a foot in the air) where its own or the body's velocity
-// takes them shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only
-// where it is: ahead, up a slope, it would rise off the surface it stands on.
 void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
                           CharacterMover& mover, const FootPlacementSettings& settings,
                           std::span<const PlacementLeg, 2> legs, float body_ground,
                           const glm::vec3& body_velocity) {
+  place_probes(settings, legs, body_ground, body_velocity);
+  mover.probe(world, origin, probes_, hits_);
+  for (int i = 0; i < kProbes; ++i) {
+    probe_grounds_[i] =
+        glm::vec3(probe_points_[i].x, found(i, body_ground, settings), probe_points_[i].z);
+  }
+  stand_on_edges(body_ground, settings);
+  keep_steps_ahead();
+}
+
+// Heel and toe, where they are and (for a foot in the air) where its own or the body's velocity
+// takes them shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only
+// where it is: ahead, up a slope, it would rise off the surface it stands on. Then the toe's
+// footprint around it.
+void FootPlacement::place_probes(const FootPlacementSettings& settings,
+                                 std::span<const PlacementLeg, 2> legs, float body_ground,
+                                 const glm::vec3& body_velocity) {
   const glm::vec3 ahead(body_velocity.x * kLookahead, 0.0f, body_velocity.z * kLookahead);
   // Each foot's probes start a step above the higher of the body's ground and the foot's own: a
   // foot held up a slope the body runs down would otherwise be probed from inside the slope,
@@ -121,35 +135,31 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
     probe_points_[slot(side, kToe)] = leg.toe;
     probe_points_[slot(side, kHeelAhead)] = leg.ankle + look;
     probe_points_[slot(side, kToeAhead)] = leg.toe + look;
-  }
-  for (int i = 0; i < kProbes; ++i) {
-    const int side = i / 4;
-    probes_[i] = GroundProbe{glm::vec3(probe_points_[i].x, top[side], probe_points_[i].z),
-                             reach[side], 0.0f};
-  }
-  constexpr float kAround[kFootprint][2] = {
-      {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
-  for (int side = 0; side < 2; ++side) {
+    for (const int which : {kHeel, kToe, kHeelAhead, kToeAhead}) {
+      const glm::vec3& p = probe_points_[slot(side, which)];
+      probes_[slot(side, which)] = GroundProbe{glm::vec3(p.x, top[side], p.z), reach[side], 0.0f};
+    }
+    constexpr float kAround[kFootprint][2] = {
+        {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
     for (int k = 0; k < kFootprint; ++k) {
-      const glm::vec3 toe = probe_points_[slot(side, kToe)];
-      const glm::vec3 at(toe.x + kFootprintRadius * kAround[k][0], top[side],
-                         toe.z + kFootprintRadius * kAround[k][1]);
+      const glm::vec3 at(leg.toe.x + kFootprintRadius * kAround[k][0], top[side],
+                         leg.toe.z + kFootprintRadius * kAround[k][1]);
       probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach[side], 0.0f};
     }
   }
-  mover.probe(world, origin, probes_, hits_);
-  // Ground deeper below the body than a step is over a ledge the body cannot step down
-  // (character_mover.hpp): a foot out over it stays level with the body, so that swinging back
-  // it passes over the edge instead of through the ledge's side.
-  const float ledge = body_ground - settings.step_height;
-  const auto found = [&](int i) {
-    return hits_[i].hit && hits_[i].point.y >= ledge ? hits_[i].point.y : body_ground;
-  };
-  for (int i = 0; i < kProbes; ++i) {
-    probe_grounds_[i] = glm::vec3(probe_points_[i].x, found(i), probe_points_[i].z);
-  }
-  // Around the toe, only an edge counts: ground above the plane of the surface under the toe
-  // (on a slope the footprint's uphill side is only the slope, and would lift the toe off it).
+}
+
+// The ground query `i` found. Deeper below the body than a step, it is over a ledge the body
+// cannot step down (character_mover.hpp): a foot out over it stays level with the body, so that
+// swinging back it passes over the edge instead of through the ledge's side.
+float FootPlacement::found(int i, float body_ground, const FootPlacementSettings& settings) const {
+  const GroundHit& hit = hits_[static_cast<size_t>(i)];
+  return hit.hit && hit.point.y >= body_ground - settings.step_height ? hit.point.y : body_ground;
+}
+
+// Around the toe, only an edge counts: ground above the plane of the surface under the toe (on a
+// slope the footprint's uphill side is only the slope, and would lift the toe off it).
+void FootPlacement::stand_on_edges(float body_ground, const FootPlacementSettings& settings) {
   for (int side = 0; side < 2; ++side) {
     const GroundHit& under = hits_[slot(side, kToe)];
     const glm::vec3 n = under.hit ? under.normal : glm::vec3(0.0f, 1.0f, 0.0f);
@@ -158,13 +168,16 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
         kFootprintRadius * std::sqrt(std::max(0.0f, 1.0f - n.y * n.y)) / std::max(n.y, 0.1f);
     float edge = toe;
     for (int k = 0; k < kFootprint; ++k) {
-      const float y = found(kProbes + side * kFootprint + k);
+      const float y = found(kProbes + side * kFootprint + k, body_ground, settings);
       if (y > toe + plane_rise + kEdgeRise) edge = std::max(edge, y);
     }
     toe = edge;
   }
-  // Ahead counts only where the ground steps up: up a slope it is only the slope, which the
-  // foot will meet as it gets there (counted now, a landing foot would lock in the air).
+}
+
+// Ahead counts only where the ground steps up: up a slope it is only the slope, which the foot
+// will meet as it gets there (counted now, a landing foot would lock in the air).
+void FootPlacement::keep_steps_ahead() {
   for (int side = 0; side < 2; ++side) {
     for (const int now : {kHeel, kToe}) {
       const int later = now + 2;  // kHeelAhead, kToeAhead

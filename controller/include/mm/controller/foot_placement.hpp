@@ -117,6 +117,11 @@ class FootPlacement {
   void probe(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
              const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
              float body_ground, const glm::vec3& body_velocity);
+  void place_probes(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
+                    float body_ground, const glm::vec3& body_velocity);
+  float found(int i, float body_ground, const FootPlacementSettings& settings) const;
+  void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
+  void keep_steps_ahead();
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
