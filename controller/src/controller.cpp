@@ -59,6 +59,18 @@ constexpr float kStepReach = 1.03f;
 // is planted, whatever its label says: the skating metric's rule (ground_metrics.hpp).
 constexpr float kPlantedHeight = 0.06f;
 constexpr float kPlantedSpeed = 0.35f;
+// A labelled contact whose animated toe moves horizontally faster than this (m/s) is not held:
+// planted toes in the data move under 0.3 m/s, and some clips label a toe sweeping in at a
+// run's landing or out at its push-off. Held there, the toe stops dead and the leg snaps after
+// the animation on release.
+constexpr float kLockSpeed = 0.6f;
+// A released toe leaves with this share of the animated toe's velocity held back (its offset
+// starts moving against it), so that it does not go from rest to the animation's speed in one
+// update: at a run's push-off that speed is metres per second.
+constexpr float kReleaseHold = 0.5f;
+// A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
+// follows the animation's own lift rather than stepping with a lift of its own.
+constexpr float kLiftOffSpeed = 0.2f;
 const glm::vec3 kForward(0.0f, 0.0f, 1.0f);
 
 // A rotation a game may hand in: finite and not far from unit length (it is normalized).
@@ -1151,14 +1163,17 @@ void Controller::foot_lock(float dt) {
     // The feet stay where the animation has them when the body is kept off a wall.
     const glm::vec3 unshifted = animated - body_shift_;
     const glm::vec3 on_ground = unshifted + glm::vec3(0.0f, ground_offset_[side], 0.0f);
-    const bool contact = debug_.contact[side] || low_and_slow(side, on_ground, dt);
+    const bool planted = low_and_slow(side, on_ground, dt);
+    const bool labelled = contact_label_holds(side);
+    const bool contact = labelled || planted;
     const glm::vec3 target = foot_target(side, unshifted, on_ground, contact, settling, dt);
     hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
     debug_.ik_target[side] = target;
-    // A stepping foot is in the air, whatever the playing frame says.
-    debug_.contact[side] = debug_.contact[side] && !feet_[side].stepping;
+    // A stepping foot is in the air, and a sweeping toe is not down, whatever the playing frame
+    // says.
+    debug_.contact[side] = labelled && !feet_[side].stepping;
     ease_heel_down(side, dt);
     if (glm::length(target - animated) >= 1e-5f || std::abs(feet_[side].heading_offset) > 1e-5f ||
         feet_[side].heel_rise > 0.0f || (world_ && foot_placement_.tilted(side))) {
@@ -1217,9 +1232,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
       // A foot that has to move while its frame says "contact" steps there rather than slides.
       released = true;
       f.locked = false;
-      f.stepping = contact && (settle || dragged);
+      f.stepping = contact && (settle || dragged) && f.velocity.y < kLiftOffSpeed;
       f.offset = f.target - on_ground;
-      f.offset_velocity = glm::vec3(0.0f);
+      f.offset_velocity = -kReleaseHold * f.velocity;
     }
   }
   f.previous_contact = contact;
@@ -1229,7 +1244,11 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
                            settings_.foot_lock_release_halflife, dt);
   }
-  glm::vec3 target = (f.locked ? f.position : on_ground) + f.offset;
+  glm::vec3 target = on_ground;
+  // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting
+  // off is no longer planted, and held down it would have that height to catch up on release.
+  if (f.locked) target = glm::vec3(f.position.x, std::max(f.position.y, on_ground.y), f.position.z);
+  target += f.offset;
   if (world_) keep_toe_off_wall(side, target);
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
@@ -1253,6 +1272,12 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   return target;
 }
 
+// Whether the playing frame's contact label holds the toe: not where the animated toe moves
+// faster than kLockSpeed (its speed as of the last foot lock).
+bool Controller::contact_label_holds(int side) const {
+  return debug_.contact[side] && feet_[side].speed < kLockSpeed;
+}
+
 // The height of the ground a toe stands on: in a world, the ground under it; on the game's
 // capsule, the capsule's height (ground_height_); else the plane y = 0.
 float Controller::toe_ground(int side) const {
@@ -1268,8 +1293,9 @@ float Controller::toe_ground(int side) const {
 bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
   FootLock& f = feet_[side];
   if (dt > 0.0f && f.has_animated) {
-    const float speed = std::hypot(on_ground.x - f.animated.x, on_ground.z - f.animated.z) / dt;
-    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
+    f.velocity = (on_ground - f.animated) / dt;
+    f.speed = std::hypot(f.velocity.x, f.velocity.z);
+    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && f.speed < kPlantedSpeed;
   }
   f.animated = on_ground;
   f.has_animated = true;
@@ -1303,8 +1329,11 @@ void Controller::hold_heading(int side, float dt) {
   const float animated = foot_heading(side);
   // A foot down in the pose a dead blend started from keeps its heading while the fade is
   // under half way, even when its toe is let go: the fade would swivel it on the ground. Not
-  // a stepping foot: it is in the air, and held it would never come round to land.
-  const bool hold = f.locked || (in_early_blend() && blend_source_contact_[side] && !f.stepping);
+  // a stepping foot: it is in the air, and held it would never come round to land; nor a toe
+  // the blend has lifted off the ground: a foot at push-off turns steep, its heading swings
+  // round, and held it would twist the foot about.
+  const bool hold = f.locked || (in_early_blend() && blend_source_contact_[side] && !f.stepping &&
+                                 f.low_and_slow);
   if (hold) {
     if (!f.heading_held) f.heading = wrap_angle(animated + f.heading_offset);
     f.heading_held = true;

@@ -364,8 +364,9 @@ void Controller::place_feet(float dt) {
     p.toe += moved;
     p.ankle += moved;
     p.length = leg_length(side);
-    // A foot stepping while its frame says contact is in the air: it looks ahead like any other.
-    p.planted = f.locked || (debug_.contact[side] && !f.stepping);
+    // A foot stepping while its frame says contact is in the air, and so is a toe sweeping
+    // along under its label: they look ahead like any other.
+    p.planted = f.locked || (contact_label_holds(side) && !f.stepping);
     p.near_ground =
         p.planted || p.toe.y - ground_height_ - shared_->lowest_foot_end(side) < kNearGroundHeight;
   }

@@ -585,6 +585,7 @@ class Controller {
                         bool contact, bool settling, float dt);
   float toe_ground(int side) const;
   bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
+  bool contact_label_holds(int side) const;
   void hold_heading(int side, float dt);
   glm::vec3 playing_position(int joint) const;
   int leg_end(int side) const;
@@ -709,8 +710,11 @@ class Controller {
     float heel_rise = 0.0f;
     float heel_rise_velocity = 0.0f;
     glm::vec3 heel_axis{1.0f, 0.0f, 0.0f};
-    // The animated toe on its ground last update, and whether it was low and slow then.
+    // The animated toe on its ground last update, its velocity and horizontal speed (m/s)
+    // then, and whether it was low and slow.
     glm::vec3 animated{0.0f};
+    glm::vec3 velocity{0.0f};
+    float speed = 0.0f;
     bool has_animated = false;
     bool low_and_slow = false;
   };
