@@ -64,6 +64,7 @@ constexpr float kPlantedSpeed = 0.35f;
 // run's landing or out at its push-off. Held there, the toe stops dead and the leg snaps after
 // the animation on release.
 constexpr float kLockSpeed = 0.6f;
+constexpr float kSweepHalflife = 0.015f;
 // A released toe leaves with this share of the animated toe's velocity held back (its offset
 // starts moving against it), so that it does not go from rest to the animation's speed in one
 // update: at a run's push-off that speed is metres per second.
@@ -1294,8 +1295,11 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
   FootLock& f = feet_[side];
   if (dt > 0.0f && f.has_animated) {
     f.velocity = (on_ground - f.animated) / dt;
-    f.speed = std::hypot(f.velocity.x, f.velocity.z);
-    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && f.speed < kPlantedSpeed;
+    const float speed = std::hypot(f.velocity.x, f.velocity.z);
+    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
+    // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
+    // jitter over a few milliseconds is no sweep.
+    f.speed += (speed - f.speed) * pull_fraction(kSweepHalflife, dt);
   }
   f.animated = on_ground;
   f.has_animated = true;
