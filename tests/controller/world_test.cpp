@@ -269,9 +269,9 @@ TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
 
 // stop-and-go beside a wall turned 60 degrees (the second course's wall_60, as in
 // data/levels/course2.glb), on a thinner capsule than the default: standing at the wall side on,
-// a swinging hand reaches farther past its face than the body is ever moved back (kMaxWallPush;
-// without the arm's swing, 1.9 and 6.6 cm at these rates). The arm is swung out about the upper
-// arm (arm_off_wall.hpp) instead, a centimetre clear of the face.
+// a swinging hand reaches farther past its face than the body is ever moved back (kMaxWallPush).
+// The arm is swung out about the upper arm (arm_off_wall.hpp) instead, a centimetre clear of the
+// face.
 TEST(ControllerWorldEvaluation, BesideATurnedWallTheHandsStayOutOfIt) {
   const auto shared = test::normal_controller_database();
   Result<InputScript> script =
