@@ -6,20 +6,29 @@
 # a run that breaks a target (a toe below 1 cm, a toe in the ground, a joint 2 cm in a wall,
 # skating over the data's).
 #   scripts/offlane.sh DB OUT_DIR [DT...]        (mm from build/release, or $MM)
+# Another course: COURSE (the .glb), LANES (the lanes' x, from the course's table in
+# docs/world-levels.md), START_Z (where the lanes start), SCRIPTS (names in scripts/input/), e.g.
+#   COURSE=data/levels/course2.glb START_Z=2 \
+#   LANES="0.8 3.4 6 8.7 11.5 14.3 17.45 21.2 25.8 31.3 33.75 36.45 39.05 42.15" \
+#   scripts/offlane.sh DB OUT_DIR
 set -euo pipefail
 cd "$(dirname "$0")/.."
 db=${1:?usage: scripts/offlane.sh DB OUT_DIR [DT...]}
 out=${2:?usage: scripts/offlane.sh DB OUT_DIR [DT...]}
 shift 2
 mm=${MM:-build/release/tools/mm}
+course=${COURSE:-data/levels/course.glb}
+lanes=${LANES:-1 4 7 10 13.5 17.5 22 28}
+start_z=${START_Z:-3}
+scripts=${SCRIPTS:-stop-and-go walk-run strafe zigzag circle reversals}
 mkdir -p "$out"
 [[ $# -gt 0 ]] || set -- 0.0333333 0.0166667 0.00694444
 for dt in "$@"; do
-  for script in stop-and-go walk-run strafe zigzag circle reversals; do
-    for x in 1 4 7 10 13.5 17.5 22 28; do
+  for script in $scripts; do
+    for x in $lanes; do
       json="$out/$script-$x-$dt.json"
       "$mm" eval --db "$db" --script "scripts/input/$script.txt" --dt "$dt" \
-        --world data/levels/course.glb --start "$x,3" --json "$json" >/dev/null
+        --world "$course" --start "$x,$start_z" --json "$json" >/dev/null
       jq -r --arg s "$script" --arg x "$x" --arg dt "$dt" '
         def f: . * 100 | round / 100;
         (.toe_clearance_cm_min < 1 or .foot_penetration_cm_max > 0 or .wall_depth_cm_max > 2

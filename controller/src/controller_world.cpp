@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 
+#include "mm/controller/arm_off_wall.hpp"
 #include "mm/controller/controller.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
@@ -32,6 +33,9 @@ constexpr float kMaxWallPush = 0.1f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
+// How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
+// the skin's thickness through it).
+constexpr float kArmMargin = 0.01f;
 
 }  // namespace
 
@@ -263,10 +267,34 @@ void Controller::keep_body_off_walls(float dt) {
   if (wall_push_ < 1e-5f) {
     wall_push_ = wall_push_velocity_ = 0.0f;
     body_shift_ = glm::vec3(0.0f);
-    return;
+  } else {
+    body_shift_ = wall_push_normal_ * wall_push_;
+    for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
   }
-  body_shift_ = wall_push_normal_ * wall_push_;
-  for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
+  keep_arms_off_walls();
+}
+
+// What the body's push leaves of an arm in a wall (the push stops at kMaxWallPush, and eases in
+// over a few updates while a swing is fast) is swung out about the upper arm (arm_off_wall.hpp):
+// against the wall the simulation object stands beside, and the walls found toward the arm's
+// hand and elbow, whichever side they face.
+void Controller::keep_arms_off_walls() {
+  const JointRoleIndices& roles = db_->roles();
+  const int upper_arms[2] = {roles.left_upper_arm, roles.right_upper_arm};
+  const std::span<const int> parents(db_->skeleton().parents());
+  glm::vec3 point, n;
+  const bool beside = wall_beside(point, n);
+  for (int side = 0; side < 2; ++side) {
+    if (upper_arms[side] < 0) continue;
+    if (beside) swing_arm_out_of_wall(globals_, parents, upper_arms[side], {point, n}, kArmMargin);
+    // find_walls' list: the hands first, then the lower arms, left before right.
+    for (const int k : {side, 2 + side}) {
+      const WallHit& hit = body_walls_[k];
+      if (!hit.found) continue;
+      swing_arm_out_of_wall(globals_, parents, upper_arms[side], {hit.point, hit.normal},
+                            kArmMargin);
+    }
+  }
 }
 
 // The wall the simulation object stands against, as a point on its face and its horizontal

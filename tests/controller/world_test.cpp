@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 #include "analytic_world.hpp"
 #include "controller_support.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/script.hpp"
 #include "mm/programs/evaluation.hpp"
 #include "mm/runtime/finite.hpp"
 
@@ -263,6 +265,36 @@ TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
   const Result<EvaluationResult> inside = evaluate_script(shared, script, options);
   ASSERT_TRUE(inside.ok()) << inside.message();
   EXPECT_GT(inside->metrics.ground.wall_depth_cm_max, 2.0);
+}
+
+// stop-and-go beside a wall turned 60 degrees (the second course's wall_60, as in
+// data/levels/course2.glb), on a thinner capsule than the default: standing at the wall side on,
+// a swinging hand reaches farther past its face than the body is ever moved back (kMaxWallPush).
+// The arm is swung out about the upper arm (arm_off_wall.hpp) instead, a centimetre clear of the
+// face.
+TEST(ControllerWorldEvaluation, BesideATurnedWallTheHandsStayOutOfIt) {
+  const auto shared = test::normal_controller_database();
+  Result<InputScript> script =
+      load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input/stop-and-go.txt");
+  ASSERT_TRUE(script.ok()) << script.message();
+  // Its face from (24.8, 4) to (28.26, 6), 0.3 m thick behind it.
+  const float yaw = glm::radians(60.0f);
+  const glm::vec2 along(std::sin(yaw), std::cos(yaw));
+  const glm::vec2 normal(std::cos(yaw), -std::sin(yaw));
+  AnalyticWorld world;
+  world.boxes.push_back(AnalyticBox{glm::vec2(24.8f, 4.0f) + 2.0f * along - 0.15f * normal,
+                                    glm::vec2(0.15f, 2.0f), yaw, 2.0f});
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f}) {
+    EvaluationOptions options;
+    options.dt = dt;
+    options.world = &world;
+    options.start = glm::dvec2(25.8, 2.0);
+    options.settings.character_radius = 0.15f;
+    const Result<EvaluationResult> run = evaluate_script(shared, *script, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    // The metric's sphere (1 cm) reads a joint on the face as 1 cm in.
+    EXPECT_LT(run->metrics.ground.wall_depth_cm_max, 1.0) << "dt " << dt;
+  }
 }
 
 }  // namespace

@@ -538,6 +538,7 @@ class Controller {
   void lift_to_ground(float dt);
   void settle_on_ground();
   void keep_body_off_walls(float dt);
+  void keep_arms_off_walls();
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;

@@ -39,4 +39,17 @@ std::vector<unsigned char> course_glb();
 // vertices, linear across each triangle). For scripts and tests that walk across the course.
 double course_height(double x, double z);
 
+// The second course (data/levels/course2.glb, world/src/course2.cpp, `mm-make-course --course 2`):
+// the same kinds of shapes with other numbers, and more (a ramp and stairs met from their top, a
+// wall at 45° and at 60°, a concave corner, a 1 m corridor, a kerb, a slope walked across), for
+// measuring what was tuned on the first. Its root node is "course2"; the functions are the
+// first course's.
+std::vector<CoursePart> course2_parts();
+std::string course2_table();
+std::vector<unsigned char> course2_glb();
+double course2_height(double x, double z);
+
+// Any course's parts as the markdown table above.
+std::string course_table_of(const std::vector<CoursePart>& parts);
+
 }  // namespace mm

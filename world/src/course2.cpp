@@ -1,0 +1,542 @@
+// The second test course (mm/world/course.hpp, course2_*): the shapes of the first with other
+// numbers everywhere, and shapes the first lacks (a ramp and stairs met from their top, a corner,
+// a corridor, a kerb, a slope walked across), so that what was tuned on one is measured on the
+// other. Its parts, their meshes, the .glb and the table.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "course_mesh.hpp"
+#include "mm/world/course.hpp"
+
+namespace mm {
+namespace {
+
+using course_mesh::Mesh;
+using course_mesh::metres;
+using course_mesh::Placed;
+using course_mesh::radians;
+
+// ---------------------------------------------------------------------------------------------
+// The layout (metres, degrees). Lanes run along +Z from kLaneStart, side by side along +X, each
+// part a metre or more from the next.
+
+constexpr double kLaneStart = 2.0;
+
+constexpr double kGroundLow[2] = {-2.0, -2.0};  // x, z
+constexpr double kGroundHigh[2] = {45.0, 16.0};
+
+constexpr double kLaneWidth = 1.6;  // ramps and the rough patch's neighbours
+constexpr double kStairsWidth = 1.8;
+
+// Ramps up, across a plateau, and down.
+struct Ramp {
+  const char* name;
+  double degrees;
+  double x;  // the lane's low x
+};
+constexpr Ramp kRamps[] = {{"ramp_15", 15.0, 0.0}, {"ramp_25", 25.0, 2.6}};
+constexpr double kRampRise = 0.8;
+constexpr double kRampPlateau = 1.5;
+
+// A platform the walk starts on, then a ramp or stairs down from its edge.
+constexpr double kPlatformStart = 0.5;  // z; the lane starts on it
+constexpr double kPlatformEdge = 4.0;   // z of its edge
+constexpr double kRampDownX = 5.2;
+constexpr double kRampDownDegrees = 20.0;
+constexpr double kRampDownTop = 0.7;
+constexpr double kStairsDownX = 13.4;
+constexpr int kStairsDownSteps = 4;
+constexpr double kStairsDownRiser = 0.16;
+constexpr double kStairsDownTread = 0.28;
+
+// Stairs up to a landing and down again.
+struct Stairs {
+  const char* name;
+  double x;
+  int steps;
+  double riser;
+  double tread;
+  double landing;
+};
+constexpr Stairs kStairs[] = {{"stairs_12_35", 7.8, 5, 0.12, 0.35, 1.2},
+                              {"stairs_20_25", 10.6, 4, 0.20, 0.25, 1.0}};
+
+// The rough patch: a smooth height field sampled every kRoughCell.
+constexpr double kRoughX = 16.2;
+constexpr double kRoughWidth = 2.5;
+constexpr double kRoughLength = 5.0;
+constexpr double kRoughCell = 0.125;
+constexpr int kRoughColumns = 20;  // kRoughWidth / kRoughCell
+constexpr int kRoughRows = 40;     // kRoughLength / kRoughCell
+
+// Walls turned from +Z toward +X, met by a walk along +Z.
+constexpr double kWallHeight = 2.0;
+constexpr double kTurnedThickness = 0.3;
+struct TurnedWall {
+  const char* name;
+  double start_x;  // one end of its face
+  double start_z;
+  double length;
+  double degrees;
+  double walk_x;  // a walk along +Z here meets its face
+};
+constexpr TurnedWall kTurnedWalls[] = {{"wall_45", 20.2, 4.0, 5.0, 45.0, 21.2},
+                                       {"wall_60", 24.8, 4.0, 4.0, 60.0, 25.8}};
+
+// The corner: a wall across the lane and one along its +X side, meeting at kCornerAt (concave,
+// seen from the lane). The corridor: two walls kCorridorWidth apart.
+constexpr double kCornerThickness = 0.25;
+constexpr double kCornerAt[2] = {31.8, 7.0};  // x of the side wall's face, z of the far wall's
+constexpr double kCornerFarLowX = 29.3;
+constexpr double kCornerSideStartZ = 3.0;
+constexpr double kCornerWalkX = 31.3;
+constexpr double kCorridorX = 33.25;  // its -X wall's face
+constexpr double kCorridorWidth = 1.0;
+constexpr double kCorridorThickness = 0.2;
+constexpr double kCorridorZ[2] = {3.0, 9.0};
+
+// Boxes across the lane.
+struct Box {
+  const char* name;
+  double x[2];
+  double z[2];
+  double top;
+  const char* what;
+};
+constexpr Box kBoxes[] = {{"kerb", {35.45, 37.45}, {5.0, 5.3}, 0.15, "kerb"},
+                          {"box_35", {38.45, 39.65}, {5.0, 6.2}, 0.35, "box"}};
+
+// A plane rising toward +X, walked along +Z (across its slope).
+constexpr double kSlopeX = 40.65;
+constexpr double kSlopeWidth = 3.0;
+constexpr double kSlopeZ[2] = {1.0, 9.0};
+constexpr double kSlopeDegrees = 12.0;
+
+// ---------------------------------------------------------------------------------------------
+// Profiles
+
+double ramp_run(const Ramp& ramp) {
+  return kRampRise / std::tan(radians(ramp.degrees));
+}
+
+double ramp_length(const Ramp& ramp) {
+  return 2.0 * ramp_run(ramp) + kRampPlateau;
+}
+
+double ramp_height(const Ramp& ramp, double along) {
+  const double run = ramp_run(ramp);
+  if (along <= 0.0 || along >= ramp_length(ramp)) return 0.0;
+  if (along < run) return kRampRise * along / run;
+  if (along <= run + kRampPlateau) return kRampRise;
+  return kRampRise * (ramp_length(ramp) - along) / run;
+}
+
+double ramp_down_run() {
+  return kRampDownTop / std::tan(radians(kRampDownDegrees));
+}
+
+double ramp_down_height(double z) {
+  if (z < kPlatformStart || z >= kPlatformEdge + ramp_down_run()) return 0.0;
+  if (z <= kPlatformEdge) return kRampDownTop;
+  return kRampDownTop * (1.0 - (z - kPlatformEdge) / ramp_down_run());
+}
+
+double stairs_down_top() {
+  return kStairsDownRiser * kStairsDownSteps;
+}
+
+double stairs_down_end() {
+  return kPlatformEdge + (kStairsDownSteps - 1) * kStairsDownTread;
+}
+
+double stairs_down_height(double z) {
+  if (z < kPlatformStart || z > stairs_down_end()) return 0.0;
+  if (z < kPlatformEdge) return stairs_down_top();
+  return kStairsDownRiser *
+         (kStairsDownSteps - 1 - std::floor((z - kPlatformEdge) / kStairsDownTread));
+}
+
+double stairs_length(const Stairs& stairs) {
+  return 2.0 * (stairs.steps - 1) * stairs.tread + stairs.landing;
+}
+
+double stairs_height(const Stairs& stairs, double along) {
+  if (along < 0.0 || along > stairs_length(stairs)) return 0.0;
+  const double up = (stairs.steps - 1) * stairs.tread;
+  if (along < up) return stairs.riser * (std::floor(along / stairs.tread) + 1.0);
+  if (along <= up + stairs.landing) return stairs.riser * stairs.steps;
+  return stairs.riser *
+         (stairs.steps - 1 - std::floor((along - up - stairs.landing) / stairs.tread));
+}
+
+// Bumps of other wavelengths and amplitude than the first course's, on a window that brings them
+// smoothly down to the ground within 0.4 m of the patch's edges.
+double rough_field(double u, double v) {
+  auto window = [](double s, double length) {
+    const double t = std::clamp(std::min(s, length - s) / 0.4, 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  const double bumps = 0.06 + 0.035 * std::sin(2.0 * std::numbers::pi * u / 1.1) +
+                       0.025 * std::sin(2.0 * std::numbers::pi * v / 0.7 + 1.3);
+  return window(u, kRoughWidth) * window(v, kRoughLength) * bumps;
+}
+
+double rough_vertex(int column, int row) {
+  return static_cast<float>(rough_field(column * kRoughCell, row * kRoughCell));
+}
+
+// The mesh's surface: every cell split from its (low u, low v) corner to its (high u, high v).
+double rough_height(double u, double v) {
+  const int column = std::clamp(static_cast<int>(std::floor(u / kRoughCell)), 0, kRoughColumns - 1);
+  const int row = std::clamp(static_cast<int>(std::floor(v / kRoughCell)), 0, kRoughRows - 1);
+  const double a = u / kRoughCell - column;
+  const double b = v / kRoughCell - row;
+  const double h00 = rough_vertex(column, row);
+  const double h10 = rough_vertex(column + 1, row);
+  const double h01 = rough_vertex(column, row + 1);
+  const double h11 = rough_vertex(column + 1, row + 1);
+  if (a >= b) return h00 + a * (h10 - h00) + b * (h11 - h10);
+  return h00 + b * (h01 - h00) + a * (h11 - h01);
+}
+
+double rough_top() {
+  double top = 0.0;
+  for (int column = 0; column <= kRoughColumns; ++column) {
+    for (int row = 0; row <= kRoughRows; ++row) top = std::max(top, rough_vertex(column, row));
+  }
+  return top;
+}
+
+double slope_top() {
+  return kSlopeWidth * std::tan(radians(kSlopeDegrees));
+}
+
+// A turned wall's face direction and its outward normal's opposite (its thickness), in (x, z).
+glm::dvec2 wall_along(const TurnedWall& wall) {
+  return {std::sin(radians(wall.degrees)), std::cos(radians(wall.degrees))};
+}
+glm::dvec2 wall_across(const TurnedWall& wall) {
+  return {std::cos(radians(wall.degrees)), -std::sin(radians(wall.degrees))};
+}
+
+// (x, z) in a turned wall's own frame: its face along +z from 0 to its length at x = 0, its
+// thickness x in [-kTurnedThickness, 0].
+glm::dvec2 wall_frame(const TurnedWall& wall, double x, double z) {
+  const glm::dvec2 d(x - wall.start_x, z - wall.start_z);
+  return {glm::dot(d, wall_across(wall)), glm::dot(d, wall_along(wall))};
+}
+
+struct Rect {
+  double x0, x1, z0, z1;
+};
+
+// The corner's and the corridor's walls, as boxes on the ground.
+std::vector<Rect> corner_walls() {
+  return {{kCornerFarLowX, kCornerAt[0] + kCornerThickness, kCornerAt[1],
+           kCornerAt[1] + kCornerThickness},
+          {kCornerAt[0], kCornerAt[0] + kCornerThickness, kCornerSideStartZ, kCornerAt[1]}};
+}
+std::vector<Rect> corridor_walls() {
+  return {{kCorridorX - kCorridorThickness, kCorridorX, kCorridorZ[0], kCorridorZ[1]},
+          {kCorridorX + kCorridorWidth, kCorridorX + kCorridorWidth + kCorridorThickness,
+           kCorridorZ[0], kCorridorZ[1]}};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes, in each part's own frame
+
+Placed flat_ground() {
+  Placed ground{"ground", {}, {0.0, 0.0, 0.0}, 0.0};
+  Mesh& m = ground.mesh;
+  const uint32_t a = m.vertex({kGroundLow[0], 0.0, kGroundLow[1]});
+  const uint32_t b = m.vertex({kGroundHigh[0], 0.0, kGroundLow[1]});
+  const uint32_t c = m.vertex({kGroundHigh[0], 0.0, kGroundHigh[1]});
+  const uint32_t d = m.vertex({kGroundLow[0], 0.0, kGroundHigh[1]});
+  m.triangle(a, b, c, {0.0, 1.0, 0.0});
+  m.triangle(a, c, d, {0.0, 1.0, 0.0});
+  return ground;
+}
+
+Placed rough_patch() {
+  Placed rough{"rough", {}, {kRoughX, 0.0, kLaneStart}, 0.0};
+  Mesh& m = rough.mesh;
+  for (int row = 0; row <= kRoughRows; ++row) {
+    for (int column = 0; column <= kRoughColumns; ++column) {
+      m.vertex({column * kRoughCell, rough_vertex(column, row), row * kRoughCell});
+    }
+  }
+  auto at = [](int column, int row) {
+    return static_cast<uint32_t>(row * (kRoughColumns + 1) + column);
+  };
+  for (int row = 0; row < kRoughRows; ++row) {
+    for (int column = 0; column < kRoughColumns; ++column) {
+      m.triangle(at(column, row), at(column + 1, row), at(column + 1, row + 1), {0, 1, 0});
+      m.triangle(at(column, row), at(column + 1, row + 1), at(column, row + 1), {0, 1, 0});
+    }
+  }
+  return rough;
+}
+
+Placed boxes(const char* name, const std::vector<Rect>& rects, double height) {
+  Placed placed{name, {}, {0.0, 0.0, 0.0}, 0.0};
+  for (const Rect& r : rects) placed.mesh.box({r.x0, 0.0, r.z0}, {r.x1, height, r.z1});
+  return placed;
+}
+
+void add_ramps_and_stairs(std::vector<Placed>& parts) {
+  for (const Ramp& ramp : kRamps) {
+    Placed placed{ramp.name, {}, {ramp.x, 0.0, kLaneStart}, 0.0};
+    const double run = ramp_run(ramp);
+    placed.mesh.prism(
+        {{0.0, 0.0}, {run, kRampRise}, {run + kRampPlateau, kRampRise}, {ramp_length(ramp), 0.0}},
+        0.0, kLaneWidth);
+    parts.push_back(std::move(placed));
+  }
+  {
+    Placed placed{"ramp_down_20", {}, {kRampDownX, 0.0, 0.0}, 0.0};
+    placed.mesh.prism({{kPlatformStart, 0.0},
+                       {kPlatformStart, kRampDownTop},
+                       {kPlatformEdge, kRampDownTop},
+                       {kPlatformEdge + ramp_down_run(), 0.0}},
+                      0.0, kLaneWidth);
+    parts.push_back(std::move(placed));
+  }
+  for (const Stairs& stairs : kStairs) {
+    // One box per tread (the landing is one): columns standing on the ground.
+    Placed placed{stairs.name, {}, {stairs.x, 0.0, kLaneStart}, 0.0};
+    double along = 0.0;
+    for (int step = 1; step <= 2 * stairs.steps - 1; ++step) {
+      const double length = step == stairs.steps ? stairs.landing : stairs.tread;
+      const double height = stairs_height(stairs, along + 0.5 * length);
+      placed.mesh.box({0.0, 0.0, along}, {kStairsWidth, height, along + length});
+      along += length;
+    }
+    parts.push_back(std::move(placed));
+  }
+  {
+    // The platform, then one box per tread down.
+    Placed placed{"stairs_down", {}, {kStairsDownX, 0.0, 0.0}, 0.0};
+    placed.mesh.box({0.0, 0.0, kPlatformStart}, {kStairsWidth, stairs_down_top(), kPlatformEdge});
+    for (int tread = 0; tread + 1 < kStairsDownSteps; ++tread) {
+      const double z = kPlatformEdge + tread * kStairsDownTread;
+      placed.mesh.box({0.0, 0.0, z}, {kStairsWidth, stairs_down_height(z + 0.5 * kStairsDownTread),
+                                      z + kStairsDownTread});
+    }
+    parts.push_back(std::move(placed));
+  }
+}
+
+std::vector<Placed> course2_meshes() {
+  std::vector<Placed> parts;
+  parts.push_back(flat_ground());
+  add_ramps_and_stairs(parts);
+  parts.push_back(rough_patch());
+  for (const TurnedWall& wall : kTurnedWalls) {
+    Placed placed{wall.name, {}, {wall.start_x, 0.0, wall.start_z}, wall.degrees};
+    placed.mesh.box({-kTurnedThickness, 0.0, 0.0}, {0.0, kWallHeight, wall.length});
+    parts.push_back(std::move(placed));
+  }
+  parts.push_back(boxes("corner", corner_walls(), kWallHeight));
+  parts.push_back(boxes("corridor", corridor_walls(), kWallHeight));
+  for (const Box& box : kBoxes) {
+    parts.push_back(boxes(box.name, {{box.x[0], box.x[1], box.z[0], box.z[1]}}, box.top));
+  }
+  {
+    // Its profile (x across the slope, y) extruded along its own x; the node's quarter turn about
+    // +Y takes its own z to world +x and its own x to world -z.
+    Placed placed{"slope_across", {}, {kSlopeX, 0.0, 0.0}, 90.0};
+    placed.mesh.prism({{0.0, 0.0}, {kSlopeWidth, 0.0}, {kSlopeWidth, slope_top()}}, -kSlopeZ[1],
+                      -kSlopeZ[0]);
+    parts.push_back(std::move(placed));
+  }
+  return parts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The table's rows
+
+std::string walk(double x) {
+  return "; walk +Z at x = " + metres(x);
+}
+
+void add_ramp_rows(std::vector<CoursePart>& parts) {
+  for (const Ramp& ramp : kRamps) {
+    const double run = ramp_run(ramp);
+    const double z = kLaneStart;
+    parts.push_back({ramp.name,
+                     {ramp.x, ramp.x + kLaneWidth},
+                     {z, z + ramp_length(ramp)},
+                     kRampRise,
+                     metres(ramp.degrees) + "° up (z " + metres(z) + " to " + metres(z + run) +
+                         "), plateau " + metres(kRampRise) + " m high (to " +
+                         metres(z + run + kRampPlateau) + "), " + metres(ramp.degrees) +
+                         "° down (to " + metres(z + ramp_length(ramp)) + ")" +
+                         walk(ramp.x + 0.5 * kLaneWidth)});
+  }
+  parts.push_back({"ramp_down_20",
+                   {kRampDownX, kRampDownX + kLaneWidth},
+                   {kPlatformStart, kPlatformEdge + ramp_down_run()},
+                   kRampDownTop,
+                   "platform " + metres(kRampDownTop) + " m high (z " + metres(kPlatformStart) +
+                       " to " + metres(kPlatformEdge) + "), " + metres(kRampDownDegrees) +
+                       "° down from its edge (to " + metres(kPlatformEdge + ramp_down_run()) + ")" +
+                       walk(kRampDownX + 0.5 * kLaneWidth) + " from its top"});
+}
+
+void add_stairs_rows(std::vector<CoursePart>& parts) {
+  for (const Stairs& s : kStairs) {
+    const double up = (s.steps - 1) * s.tread;
+    parts.push_back(
+        {s.name,
+         {s.x, s.x + kStairsWidth},
+         {kLaneStart, kLaneStart + stairs_length(s)},
+         s.riser * s.steps,
+         std::to_string(s.steps) + " risers of " + metres(s.riser) + " m up (treads " +
+             metres(s.tread) + " m, z " + metres(kLaneStart) + " to " + metres(kLaneStart + up) +
+             "), landing " + metres(s.riser * s.steps) + " m high (to " +
+             metres(kLaneStart + up + s.landing) + "), " + std::to_string(s.steps) + " down (to " +
+             metres(kLaneStart + stairs_length(s)) + ")" + walk(s.x + 0.5 * kStairsWidth)});
+  }
+  parts.push_back({"stairs_down",
+                   {kStairsDownX, kStairsDownX + kStairsWidth},
+                   {kPlatformStart, stairs_down_end()},
+                   stairs_down_top(),
+                   "platform " + metres(stairs_down_top()) + " m high (z " +
+                       metres(kPlatformStart) + " to " + metres(kPlatformEdge) + "), " +
+                       std::to_string(kStairsDownSteps) + " risers of " + metres(kStairsDownRiser) +
+                       " m down (treads " + metres(kStairsDownTread) + " m, to " +
+                       metres(stairs_down_end()) + ")" + walk(kStairsDownX + 0.5 * kStairsWidth) +
+                       " from its top"});
+}
+
+void add_wall_rows(std::vector<CoursePart>& parts) {
+  for (const TurnedWall& wall : kTurnedWalls) {
+    const glm::dvec2 start(wall.start_x, wall.start_z);
+    glm::dvec2 low(1e9), high(-1e9);
+    for (double a : {0.0, wall.length}) {
+      for (double t : {-kTurnedThickness, 0.0}) {
+        const glm::dvec2 corner = start + a * wall_along(wall) + t * wall_across(wall);
+        low = glm::min(low, corner);
+        high = glm::max(high, corner);
+      }
+    }
+    const glm::dvec2 end = start + wall.length * wall_along(wall);
+    const double meet_z =
+        start.y + (wall.walk_x - start.x) / wall_along(wall).x * wall_along(wall).y;
+    parts.push_back({wall.name,
+                     {low.x, high.x},
+                     {low.y, high.y},
+                     kWallHeight,
+                     "wall " + metres(wall.length) + " m long turned " + metres(wall.degrees) +
+                         "° from +Z, its face from (" + metres(start.x) + ", " + metres(start.y) +
+                         ") to (" + metres(end.x) + ", " + metres(end.y) + ")" + walk(wall.walk_x) +
+                         " to meet it at z = " + metres(meet_z)});
+  }
+  parts.push_back({"corner",
+                   {kCornerFarLowX, kCornerAt[0] + kCornerThickness},
+                   {kCornerSideStartZ, kCornerAt[1] + kCornerThickness},
+                   kWallHeight,
+                   "a wall across (face z = " + metres(kCornerAt[1]) +
+                       ") meeting one along the +X " + "side (face x = " + metres(kCornerAt[0]) +
+                       ", from z = " + metres(kCornerSideStartZ) + "), concave" +
+                       walk(kCornerWalkX) + " into the corner"});
+  parts.push_back(
+      {"corridor",
+       {kCorridorX - kCorridorThickness, kCorridorX + kCorridorWidth + kCorridorThickness},
+       {kCorridorZ[0], kCorridorZ[1]},
+       kWallHeight,
+       "two walls " + metres(kCorridorWidth) + " m apart (faces x = " + metres(kCorridorX) +
+           " and " + metres(kCorridorX + kCorridorWidth) + ")" +
+           walk(kCorridorX + 0.5 * kCorridorWidth) + " along it"});
+}
+
+}  // namespace
+
+std::vector<CoursePart> course2_parts() {
+  std::vector<CoursePart> parts;
+  parts.push_back({"ground",
+                   {kGroundLow[0], kGroundHigh[0]},
+                   {kGroundLow[1], kGroundHigh[1]},
+                   0.0,
+                   "flat ground (y = 0) under the whole course"});
+  add_ramp_rows(parts);
+  add_stairs_rows(parts);
+  parts.push_back({"rough",
+                   {kRoughX, kRoughX + kRoughWidth},
+                   {kLaneStart, kLaneStart + kRoughLength},
+                   rough_top(),
+                   "bumps of 0 to " + metres(100.0 * rough_top()) +
+                       " cm (a smooth height field on a " + metres(100.0 * kRoughCell) +
+                       " cm grid)" + walk(kRoughX + 0.5 * kRoughWidth)});
+  add_wall_rows(parts);
+  for (const Box& box : kBoxes) {
+    parts.push_back({box.name,
+                     {box.x[0], box.x[1]},
+                     {box.z[0], box.z[1]},
+                     box.top,
+                     std::string(box.what) + " " + metres(box.x[1] - box.x[0]) + " by " +
+                         metres(box.z[1] - box.z[0]) + " m, " + metres(box.top) + " m high" +
+                         walk(0.5 * (box.x[0] + box.x[1]))});
+  }
+  parts.push_back({"slope_across",
+                   {kSlopeX, kSlopeX + kSlopeWidth},
+                   {kSlopeZ[0], kSlopeZ[1]},
+                   slope_top(),
+                   "a plane rising " + metres(kSlopeDegrees) + "° toward +X" +
+                       walk(kSlopeX + 0.5 * kSlopeWidth) + " across its slope"});
+  return parts;
+}
+
+std::string course2_table() {
+  return course_table_of(course2_parts());
+}
+
+double course2_height(double x, double z) {
+  auto inside = [](double v, double low, double high) { return v >= low && v <= high; };
+  auto in_rect = [&](const Rect& r) { return inside(x, r.x0, r.x1) && inside(z, r.z0, r.z1); };
+  for (const Ramp& ramp : kRamps) {
+    if (inside(x, ramp.x, ramp.x + kLaneWidth) &&
+        inside(z, kLaneStart, kLaneStart + ramp_length(ramp))) {
+      return ramp_height(ramp, z - kLaneStart);
+    }
+  }
+  if (inside(x, kRampDownX, kRampDownX + kLaneWidth)) return ramp_down_height(z);
+  for (const Stairs& stairs : kStairs) {
+    if (inside(x, stairs.x, stairs.x + kStairsWidth)) return stairs_height(stairs, z - kLaneStart);
+  }
+  if (inside(x, kStairsDownX, kStairsDownX + kStairsWidth)) return stairs_down_height(z);
+  if (inside(x, kRoughX, kRoughX + kRoughWidth) &&
+      inside(z, kLaneStart, kLaneStart + kRoughLength)) {
+    return rough_height(x - kRoughX, z - kLaneStart);
+  }
+  for (const TurnedWall& wall : kTurnedWalls) {
+    const glm::dvec2 local = wall_frame(wall, x, z);
+    if (inside(local.x, -kTurnedThickness, 0.0) && inside(local.y, 0.0, wall.length)) {
+      return kWallHeight;
+    }
+  }
+  for (const Rect& r : corner_walls()) {
+    if (in_rect(r)) return kWallHeight;
+  }
+  for (const Rect& r : corridor_walls()) {
+    if (in_rect(r)) return kWallHeight;
+  }
+  for (const Box& box : kBoxes) {
+    if (in_rect({box.x[0], box.x[1], box.z[0], box.z[1]})) return box.top;
+  }
+  if (inside(x, kSlopeX, kSlopeX + kSlopeWidth) && inside(z, kSlopeZ[0], kSlopeZ[1])) {
+    return (x - kSlopeX) / kSlopeWidth * slope_top();
+  }
+  return 0.0;
+}
+
+std::vector<unsigned char> course2_glb() {
+  return course_mesh::write_glb(course2_meshes(), "course2",
+                                "mm-make-course --course 2 (world/src/course2.cpp)");
+}
+
+}  // namespace mm
