@@ -191,8 +191,8 @@ double thread_cpu_seconds() {
 constexpr size_t kChunk = 32;
 
 // A budgeted run times one step in this many (every character in turn, (i + frame) % this ==
-// 0): two clock reads around each of 10,000 steps were a tenth of a millisecond per thread
-// and frame that a game does not spend, and the sample's mean and p99 are the same figures.
+// 0): two clock reads around every step are the bench's bookkeeping, which a game's frame
+// does not pay, and a sample of every character in turn estimates the same mean and p99.
 constexpr size_t kTimedEvery = 8;
 
 // What a character that does not update this frame is handed (and does not read).
@@ -405,8 +405,8 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
   result.plan_ms_mean = plan * 1e3 / steady;
   result.steps_ms_mean = steps * 1e3 / steady;
   result.sync_ms_mean = result.frame_ms_mean - result.plan_ms_mean - result.steps_ms_mean;
-  // The work itself, as the threads' CPU time stepping (all threads), whose spread does not
-  // depend on whether the threads got their cores.
+  // The work itself, as the threads' CPU time stepping (all threads): its spread does not
+  // count the time a thread waited for a core.
   std::vector<double> work(frames - warm, 0.0);
   for (size_t f = warm; f < frames; ++f) {
     for (size_t k = 0; k < static_cast<size_t>(threads); ++k) {
