@@ -83,22 +83,33 @@ void prefetch_lines(const void* begin, size_t bytes) {
 
 }  // namespace
 
-void Controller::prefetch_move_only() const {
-  // The simulation object and the playback state it moves are members; the poses are heaps.
+void Controller::prefetch_move_only_members() const {
+  // Addresses within this object only: nothing here waits for memory. The heap arrays'
+  // pointers are among the lines asked for, so prefetch_move_only() finds them in the cache.
   prefetch_lines(&origin_, sizeof(origin_));
   prefetch_lines(&sim_position_,
                  static_cast<size_t>(reinterpret_cast<const char*>(&clip_time_) -
                                      reinterpret_cast<const char*>(&sim_position_)));
   prefetch_lines(&transition_src_position_, sizeof(transition_src_position_) * 4);
   prefetch_lines(&settings_.max_dt, sizeof(settings_.max_dt));
-  prefetch_lines(root_offsets_.rotations.data(), sizeof(glm::vec3));
-  prefetch_lines(root_offsets_.positions.data(), sizeof(glm::vec3));
+  prefetch_lines(&root_offsets_, sizeof(root_offsets_));
   prefetch_lines(&feet_, sizeof(feet_));
   prefetch_lines(&last_root_, sizeof(last_root_));
   prefetch_lines(&debug_.searched, sizeof(debug_.searched));
   prefetch_lines(&debug_.transitioned, sizeof(debug_.transitioned));
   prefetch_lines(&debug_.search_seconds, sizeof(debug_.search_seconds));
   prefetch_lines(&pose_carried_, sizeof(pose_carried_));
+  prefetch_lines(&sampled_, sizeof(sampled_));
+  prefetch_lines(&locals_, sizeof(locals_));
+  prefetch_lines(&globals_, sizeof(globals_));
+  prefetch_lines(&world_globals_, sizeof(world_globals_));
+}
+
+void Controller::prefetch_move_only() const {
+  // The poses and the root's offsets are heap arrays: their pointers are read here (from the
+  // lines prefetch_move_only_members() asked for a step earlier).
+  prefetch_lines(root_offsets_.rotations.data(), sizeof(glm::vec3));
+  prefetch_lines(root_offsets_.positions.data(), sizeof(glm::vec3));
   prefetch_lines(sampled_.data(), sizeof(Transform));
   prefetch_lines(locals_.data(), sizeof(Transform));
   // Only the root moves (the rest of the pose is carried, not rewritten).

@@ -204,6 +204,11 @@ bool CrowdScheduler::updates(size_t i) const {
   return (frame_ + static_cast<int64_t>(i)) % period == 0 || held_frames_[i] + 1 >= period;
 }
 
+void CrowdScheduler::prefetch_ahead(size_t i, const Controller& controller) const {
+  // A full update's own memory traffic dwarfs the latency this hides; a move is all latency.
+  if (tier(i) == CrowdTier::MoveOnly) controller.prefetch_move_only_members();
+}
+
 void CrowdScheduler::prefetch(size_t i, const Controller& controller) const {
   constexpr size_t kLine = 64;
   const auto lines = [](const void* begin, size_t bytes) {

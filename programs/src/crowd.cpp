@@ -10,6 +10,8 @@
 #include <barrier>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <span>
@@ -105,13 +107,23 @@ struct CrowdTimes {
   // Budgeted runs: the CPU time each thread spent stepping characters, per frame (frame-major,
   // threads per frame), which a thread descheduled by other processes is not charged for.
   std::vector<double> step_cpu_seconds;
+  // Budgeted runs: the plan's wall time (significances and CrowdScheduler::plan, on one thread)
+  // per frame, and each thread's wall time stepping characters (frame-major).
+  std::vector<double> plan_seconds;
+  std::vector<double> step_wall_seconds;
 };
 
-// The mean update time (microseconds) over frames [first, last).
+// The mean update time (microseconds) over frames [first, last), of the updates that were
+// timed (a budgeted run times a sample of them; the others are NaN).
 double mean_update_us(const CrowdTimes& times, size_t characters, size_t first, size_t last) {
   double sum = 0.0;
-  for (size_t k = first * characters; k < last * characters; ++k) sum += times.update_us[k];
-  return sum / static_cast<double>(characters * (last - first));
+  size_t timed = 0;
+  for (size_t k = first * characters; k < last * characters; ++k) {
+    if (std::isnan(times.update_us[k])) continue;
+    sum += times.update_us[k];
+    ++timed;
+  }
+  return timed > 0 ? sum / static_cast<double>(timed) : 0.0;
 }
 
 // The figures of a run whose frames [replay_start, end) also updated the replay (none when
@@ -142,8 +154,12 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
       p99(std::span<double>(times.frame_seconds.data() + warm, steady - warm)) * 1e3;
   result.max_characters_60hz =
       clamped_integer<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / frame_mean));
-  // The p99 of the steady frames, which come first in the frame-major times.
-  result.update_us_p99 = p99(std::span<float>(times.update_us.data(), steady * n));
+  // The p99 of the steady frames' timed updates, which come first in the frame-major times.
+  const auto untimed = std::partition(
+      times.update_us.begin(), times.update_us.begin() + static_cast<std::ptrdiff_t>(steady * n),
+      [](float us) { return !std::isnan(us); });
+  const size_t timed = static_cast<size_t>(untimed - times.update_us.begin());
+  result.update_us_p99 = timed > 0 ? p99(std::span<float>(times.update_us.data(), timed)) : 0.0;
   return result;
 }
 
@@ -174,13 +190,44 @@ double thread_cpu_seconds() {
 // end a frame together, many enough that the counter is not contended.
 constexpr size_t kChunk = 32;
 
+// A budgeted run times one step in this many (every character in turn, (i + frame) % this ==
+// 0): two clock reads around every step are the bench's bookkeeping, which a game's frame
+// does not pay, and a sample of every character in turn estimates the same mean and p99.
+constexpr size_t kTimedEvery = 8;
+
+// What a character that does not update this frame is handed (and does not read).
+const ControllerInput kNoInput{};
+
 // A crowd under its scheduler: the controllers, their scripts and what the run measures.
+// What a game keeps of its characters outside the animation is kept here the way a game
+// keeps it: each character's current input (its AI's output) and its position (for the
+// significance), in arrays walked in order, not looked up in each controller and script.
 struct ScheduledCrowd {
   std::vector<Controller> controllers;
   std::vector<InputScript> scripts;
   CrowdScheduler scheduler;
   std::vector<float> significance;
+  std::vector<glm::vec3> positions;     // each root after its last step
+  std::vector<ControllerInput> inputs;  // the script's line in effect
+  std::vector<uint32_t> next_line;      // the script's next line
+  std::vector<float> next_line_time;    // its time (infinite: none)
 };
+
+// Character i's input at game time t, which only grows from call to call: the line in effect
+// is kept and replaced when the next line's time comes (the same input as InputScript::at,
+// without its binary search over lines that lie far apart in memory).
+const ControllerInput& scripted_input(ScheduledCrowd& crowd, size_t i, float t) {
+  if (t >= crowd.next_line_time[i]) {
+    const std::vector<ScriptEvent>& lines = crowd.scripts[i].events();
+    size_t k = crowd.next_line[i];
+    while (k < lines.size() && lines[k].time <= t) ++k;
+    crowd.inputs[i] = lines[k - 1].input;
+    crowd.next_line[i] = static_cast<uint32_t>(k);
+    crowd.next_line_time[i] =
+        k < lines.size() ? lines[k].time : std::numeric_limits<float>::infinity();
+  }
+  return crowd.inputs[i];
+}
 
 Result<ScheduledCrowd> make_scheduled_crowd(
     const std::shared_ptr<const ControllerDatabase>& database, const CrowdOptions& options,
@@ -200,28 +247,47 @@ Result<ScheduledCrowd> make_scheduled_crowd(
   for (size_t i = 0; i < n; ++i) {
     scripts.push_back(varied_input_script(static_cast<uint32_t>(i), options.seconds));
   }
-  return ScheduledCrowd{std::move(controllers).value(), std::move(scripts),
-                        std::move(scheduler).value(), std::vector<float>(n, 0.0f)};
+  ScheduledCrowd crowd{std::move(controllers).value(),
+                       std::move(scripts),
+                       std::move(scheduler).value(),
+                       std::vector<float>(n, 0.0f),
+                       std::vector<glm::vec3>(n),
+                       std::vector<ControllerInput>(n),
+                       std::vector<uint32_t>(n, 0),
+                       std::vector<float>(n, std::numeric_limits<float>::infinity())};
+  for (size_t i = 0; i < n; ++i) {
+    crowd.positions[i] = crowd.controllers[i].root_transform().translation;
+    const std::vector<ScriptEvent>& lines = crowd.scripts[i].events();
+    if (!lines.empty()) crowd.next_line_time[i] = lines.front().time;
+  }
+  return crowd;
 }
 
-// Steps character i at game time t; returns the step's wall time (s) and adds what its update
-// spent searching to `search`.
-double step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double& search) {
+// Steps character i at game time t and keeps its position; returns the step's wall time (s)
+// when `timed`, else NaN, and adds what its update spent searching to `search`.
+float step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double& search,
+                     bool timed = false) {
   const bool updates = crowd.scheduler.updates(i);
-  const ControllerInput input = updates ? crowd.scripts[i].at(t) : ControllerInput{};
-  const auto start = std::chrono::steady_clock::now();
-  crowd.scheduler.step(i, crowd.controllers[i], dt, input);
-  const double elapsed =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (updates) search += crowd.controllers[i].debug().search_seconds;
+  const ControllerInput& input = updates ? scripted_input(crowd, i, t) : kNoInput;
+  Controller& controller = crowd.controllers[i];
+  float elapsed = std::numeric_limits<float>::quiet_NaN();
+  if (timed) {
+    const auto start = std::chrono::steady_clock::now();
+    crowd.scheduler.step(i, controller, dt, input);
+    elapsed = std::chrono::duration<float>(std::chrono::steady_clock::now() - start).count();
+  } else {
+    crowd.scheduler.step(i, controller, dt, input);
+  }
+  crowd.positions[i] = controller.root_transform().translation;
+  if (updates) search += controller.debug().search_seconds;
   return elapsed;
 }
 
 // This frame's plan: every character's significance from the camera at game time t.
 void plan_frame(ScheduledCrowd& crowd, const CrowdOptions& options, float t) {
   const glm::vec3 camera = crowd_camera(options, t);
-  for (size_t i = 0; i < crowd.controllers.size(); ++i) {
-    const glm::vec3 p = crowd.controllers[i].root_transform().translation;
+  for (size_t i = 0; i < crowd.positions.size(); ++i) {
+    const glm::vec3& p = crowd.positions[i];
     crowd.significance[i] = -glm::distance(glm::vec2(p.x, p.z), glm::vec2(camera.x, camera.z));
   }
   crowd.scheduler.plan(crowd.significance);
@@ -244,6 +310,8 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
   times.step_cpu_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
+  times.step_wall_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
+  times.plan_seconds.assign(frames, 0.0);
   auto worker = [&](int index) {
     Clock::time_point frame_start = Clock::now();
     for (size_t f = 0; f < frames; ++f) {
@@ -254,21 +322,27 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
         } else {
           plan_frame(crowd, options, t);
         }
+        times.plan_seconds[f] = std::chrono::duration<double>(Clock::now() - frame_start).count();
         plans.counts[f] = crowd.scheduler.tier_counts();
         plans.planned_us[f] = crowd.scheduler.planned_cost_us();
         next.store(0, std::memory_order_relaxed);
       }
       sync.arrive_and_wait();
+      const Clock::time_point steps_start = Clock::now();
       const double cpu_start = thread_cpu_seconds();
       for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
         for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
+          if (i + 2 < n) crowd.scheduler.prefetch_ahead(i + 2, crowd.controllers[i + 2]);
           if (i + 1 < n) crowd.scheduler.prefetch(i + 1, crowd.controllers[i + 1]);
-          times.update_us[f * n + i] = static_cast<float>(
-              step_character(crowd, i, t, options.dt, times.search_seconds[i]) * 1e6);
+          const bool timed = (i + f) % kTimedEvery == 0;
+          times.update_us[f * n + i] =
+              step_character(crowd, i, t, options.dt, times.search_seconds[i], timed) * 1e6f;
         }
       }
-      times.step_cpu_seconds[f * static_cast<size_t>(threads) + static_cast<size_t>(index)] =
-          thread_cpu_seconds() - cpu_start;
+      const size_t slot = f * static_cast<size_t>(threads) + static_cast<size_t>(index);
+      times.step_cpu_seconds[slot] = thread_cpu_seconds() - cpu_start;
+      times.step_wall_seconds[slot] =
+          std::chrono::duration<double>(Clock::now() - steps_start).count();
       sync.arrive_and_wait();
       if (index == 0) {
         const Clock::time_point now = Clock::now();
@@ -296,6 +370,8 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
                    std::vector<double>(frames, 0.0),
                    std::vector<double>(n, 0.0),
                    std::vector<double>(n, 0.0),
+                   {},
+                   {},
                    {}};
   PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                    std::vector<double>(frames, 0.0)};
@@ -316,6 +392,34 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
     planned += plans.planned_us[f];
   }
   result.planned_cost_us_mean = planned / static_cast<double>(frames - warm);
+  // Where the frame's wall time went: the plan, the longest thread's steps, and the rest (the
+  // hand-off between the threads at the frame's two barriers, and a thread's wait for a core).
+  double plan = 0.0, steps = 0.0;
+  for (size_t f = warm; f < frames; ++f) {
+    plan += times.plan_seconds[f];
+    const auto first = times.step_wall_seconds.begin() +
+                       static_cast<std::ptrdiff_t>(f * static_cast<size_t>(threads));
+    steps += *std::max_element(first, first + threads);
+  }
+  const double steady = static_cast<double>(frames - warm);
+  result.plan_ms_mean = plan * 1e3 / steady;
+  result.steps_ms_mean = steps * 1e3 / steady;
+  result.sync_ms_mean = result.frame_ms_mean - result.plan_ms_mean - result.steps_ms_mean;
+  // The work itself, as the threads' CPU time stepping (all threads): its spread does not
+  // count the time a thread waited for a core.
+  std::vector<double> work(frames - warm, 0.0);
+  for (size_t f = warm; f < frames; ++f) {
+    for (size_t k = 0; k < static_cast<size_t>(threads); ++k) {
+      work[f - warm] += times.step_cpu_seconds[f * static_cast<size_t>(threads) + k] * 1e3;
+    }
+  }
+  double work_sum = 0.0;
+  for (const double ms : work) work_sum += ms;
+  result.work_ms_mean = work_sum / steady;
+  result.work_ms_p99 = p99(std::span<double>(work));
+  result.frame_ms.assign(times.frame_seconds.begin() + static_cast<std::ptrdiff_t>(warm),
+                         times.frame_seconds.end());
+  for (double& ms : result.frame_ms) ms *= 1e3;
   const size_t joints = crowd->scheduler.joints();
   result.final_poses.resize(n * joints);
   for (size_t i = 0; i < n; ++i) {
@@ -358,6 +462,8 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
                    std::vector<double>(frames, 0.0),
                    std::vector<double>(n, 0.0),
                    std::vector<double>(n, 0.0),
+                   {},
+                   {},
                    {}};
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
@@ -448,6 +554,37 @@ glm::vec3 crowd_camera(const CrowdOptions& options, float t) {
                    centre.y + 0.5f * half.y * std::cos(angle));
 }
 
+namespace {
+
+// The samples a tier's calibration takes over its second second.
+constexpr size_t kCalibrationSamples = 5;
+
+// A tier's cost (us per character and frame) from a calibration run's CPU time per frame and
+// thread: the second half's frames cut into kCalibrationSamples samples, the median sample's
+// CPU time per character and frame. Not the frame's wall time times the threads: on a shared
+// machine a thread waits for a core (and the other waits at the barrier), which is not work
+// the budget can plan away. The median, not the mean: a burst of another process's work (its
+// cache traffic, a descheduled thread's lost cache) in one sample does not move it.
+float calibrated_cost_us(const std::vector<double>& step_cpu_seconds, size_t threads,
+                         size_t characters) {
+  const size_t frames = step_cpu_seconds.size() / threads;
+  const size_t first = frames / 2;
+  const size_t per_sample = std::max<size_t>(1, (frames - first) / kCalibrationSamples);
+  std::array<double, kCalibrationSamples> samples{};
+  size_t count = 0;
+  for (; count < kCalibrationSamples && first + (count + 1) * per_sample <= frames; ++count) {
+    const auto begin = step_cpu_seconds.begin() +
+                       static_cast<std::ptrdiff_t>((first + count * per_sample) * threads);
+    const double seconds =
+        std::accumulate(begin, begin + static_cast<std::ptrdiff_t>(per_sample * threads), 0.0);
+    samples[count] = seconds * 1e6 / static_cast<double>(characters * per_sample);
+  }
+  std::sort(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(count));
+  return static_cast<float>(samples[count / 2]);
+}
+
+}  // namespace
+
 Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
     std::shared_ptr<const ControllerDatabase> database, const CrowdOptions& options,
     int characters) {
@@ -467,20 +604,14 @@ Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
                      std::vector<double>(frames, 0.0),
                      std::vector<double>(n, 0.0),
                      std::vector<double>(n, 0.0),
+                     {},
+                     {},
                      {}};
     PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                      std::vector<double>(frames, 0.0)};
     run_scheduled_frames(*crowd, calibration, threads, times, plans, static_cast<CrowdTier>(tier));
-    // The second half's frames: the CPU time the threads spent stepping, per character. Not
-    // the frame's wall time times the threads: on a shared machine a thread waits for a core
-    // (and the other waits at the barrier), which is not work the budget can plan away.
-    double seconds = 0.0;
-    for (size_t k = frames / 2 * static_cast<size_t>(threads); k < times.step_cpu_seconds.size();
-         ++k) {
-      seconds += times.step_cpu_seconds[k];
-    }
     costs[static_cast<size_t>(tier)] =
-        static_cast<float>(seconds * 1e6 / static_cast<double>(n * (frames - frames / 2)));
+        calibrated_cost_us(times.step_cpu_seconds, static_cast<size_t>(threads), n);
   }
   // Timing noise must not make a slower tier look dearer than a faster one.
   for (size_t t = 1; t < costs.size(); ++t) costs[t] = std::min(costs[t], costs[t - 1]);

@@ -112,6 +112,7 @@ TEST(ControllerNoAllocationTest, TheCrowdSchedulerNeverAllocates) {
     for (size_t i = 0; i < kCharacters; ++i) {
       const ControllerInput input =
           test::push_toward(static_cast<float>(f / 90 * 60 + i), f % 400 > 300);
+      if (i + 2 < kCharacters) scheduler.prefetch_ahead(i + 2, crowd[i + 2]);
       if (i + 1 < kCharacters) scheduler.prefetch(i + 1, crowd[i + 1]);
       scheduler.step(i, crowd[i], 1.0f / 60.0f, input);
       const uint8_t t = static_cast<uint8_t>(scheduler.tier(i));

@@ -156,6 +156,43 @@ TEST(CrowdThreads, UnderABudgetTwoAndFourThreadsShowTheOneThreadPoses) {
   }
 }
 
+// A budget that holds every character at full rate steps each controller exactly as the plain
+// loop does: the budgeted run keeps each character's input line and position itself (as a game
+// would) instead of asking the script and the controller, and that must not change any input.
+// Its frame figures add up: the plan, the longest thread's steps and the rest make the frame.
+TEST(CrowdThreads, AnAmpleBudgetMovesTheCrowdAsTheLoopWithoutOne) {
+  const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
+  ASSERT_NE(shared, nullptr);
+  CrowdOptions options;
+  options.characters = 12;
+  options.seconds = 6.0f;  // several lines of every character's script
+  options.threads = 2;
+  Result<CrowdResult> plain = run_crowd(shared, options);
+  ASSERT_TRUE(plain.ok()) << plain.message();
+  CrowdSchedulerSettings lod;
+  lod.budget_ms = 100.0f;
+  options.lod = lod;
+  Result<CrowdResult> budgeted = run_crowd(shared, options);
+  ASSERT_TRUE(budgeted.ok()) << budgeted.message();
+  EXPECT_EQ(budgeted->tier_counts[0], 12);
+  ASSERT_EQ(budgeted->final_positions.size(), plain->final_positions.size());
+  for (size_t i = 0; i < plain->final_positions.size(); ++i) {
+    EXPECT_EQ(budgeted->final_positions[i], plain->final_positions[i]) << "character " << i;
+  }
+  ASSERT_EQ(budgeted->final_poses.size(), plain->final_poses.size());
+  for (size_t k = 0; k < plain->final_poses.size(); ++k) {
+    ASSERT_EQ(budgeted->final_poses[k].translation, plain->final_poses[k].translation) << k;
+  }
+  EXPECT_GT(budgeted->plan_ms_mean, 0.0);
+  EXPECT_GT(budgeted->steps_ms_mean, 0.0);
+  EXPECT_NEAR(budgeted->plan_ms_mean + budgeted->steps_ms_mean + budgeted->sync_ms_mean,
+              budgeted->frame_ms_mean, 1e-9);
+  EXPECT_GT(budgeted->work_ms_mean, 0.0);
+  EXPECT_GE(budgeted->work_ms_p99, budgeted->work_ms_mean * 0.5);
+  EXPECT_EQ(budgeted->frame_ms.size(), 6u * 60u - 60u);  // the steady frames: less the first second
+  EXPECT_GT(budgeted->update_us_mean, 0.0);              // from the timed sample of the steps
+}
+
 TEST(CrowdThreads, AnInvalidBudgetIsRefusedByMessage) {
   const std::shared_ptr<const ControllerDatabase> shared = fresh_controller_database();
   ASSERT_NE(shared, nullptr);

@@ -134,6 +134,11 @@ nlohmann::json report_run(const CrowdResult& run) {
           {"tier_counts", tier_counts_json(run.tier_counts)},
           {"full_min", run.full_min},
           {"planned_cost_us_mean", run.planned_cost_us_mean},
+          {"plan_ms_mean", run.plan_ms_mean},
+          {"steps_ms_mean", run.steps_ms_mean},
+          {"sync_ms_mean", run.sync_ms_mean},
+          {"work_ms_mean", run.work_ms_mean},
+          {"work_ms_p99", run.work_ms_p99},
           {"max_characters_60hz", run.max_characters_60hz}};
 }
 
@@ -184,9 +189,12 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
     if (options.lod) {
       std::printf(
           "%8s tiers at the end: full %d, half %d, quarter %d, move_only %d; fewest at "
-          "full %d; planned %.2f ms of work per frame\n",
+          "full %d; planned %.2f ms of work per frame\n"
+          "%8s frame ms: plan %.3f, steps (longest thread) %.3f, the rest (hand-off, waits) "
+          "%.3f; work (CPU ms, all threads) mean %.3f, p99 %.3f\n",
           "", run->tier_counts[0], run->tier_counts[1], run->tier_counts[2], run->tier_counts[3],
-          run->full_min, run->planned_cost_us_mean * 1e-3);
+          run->full_min, run->planned_cost_us_mean * 1e-3, "", run->plan_ms_mean,
+          run->steps_ms_mean, run->sync_ms_mean, run->work_ms_mean, run->work_ms_p99);
     }
     if (reference.empty()) {
       reference = run->final_positions;

@@ -175,6 +175,7 @@ void CrowdView::step(float dt, const glm::vec3& camera) {
   time_ += dt;
   const float t = std::fmod(time_, script_seconds_);
   for (size_t i = 0; i < controllers_.size(); ++i) {
+    if (i + 2 < controllers_.size()) scheduler_->prefetch_ahead(i + 2, controllers_[i + 2]);
     if (i + 1 < controllers_.size()) scheduler_->prefetch(i + 1, controllers_[i + 1]);
     const ControllerInput input = scheduler_->updates(i) ? scripts_[i].at(t) : ControllerInput{};
     scheduler_->step(i, controllers_[i], dt, input);

@@ -430,9 +430,11 @@ class Controller {
   // character instead of every joint. With settings.compute_skinning the pose is settled at
   // once (the skinning matrices need every joint).
   void update_move_only(float dt, const ControllerInput& input);
-  // Asks the cache for what the next update_move_only() reads and writes (the simulation
-  // object, the root), so a crowd's loop can overlap one character's memory latency with the
-  // step before it. No effect on any result.
+  // Ask the cache for what the next update_move_only() reads and writes, so a crowd's loop can
+  // overlap one character's memory latency with the steps before it: first the members (the
+  // simulation object, the root's state; nothing is read), a step or two ahead, then the heap
+  // arrays (the root's joint; reads their pointers). No effect on any result.
+  void prefetch_move_only_members() const;
   void prefetch_move_only() const;
   // Whether joints 1.. of global_transforms() are still those of the last update, hanging from
   // carried_from() (after update_move_only()).

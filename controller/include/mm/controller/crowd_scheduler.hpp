@@ -99,9 +99,12 @@ class CrowdScheduler {
   // characters update on staggered frames ((frame + i) % period == 0), so the work is even over
   // the frames. Thread-safe for distinct i. `input` is read only when updates(i).
   void step(size_t i, Controller& controller, float dt, const ControllerInput& input);
-  // Asks the cache for what step(i, controller) will touch (its per-character state and
-  // poses, and the controller's when it only moves): call it for the next character before
-  // stepping this one. No effect on any result; no allocation.
+  // Ask the cache for what step(i, controller) will touch, in two stages a crowd's loop calls
+  // ahead of its steps: prefetch_ahead for the character after next (a moving character's
+  // controller members: nothing read, so nothing waited for), prefetch for the next one (the
+  // scheduler's per-character state and poses, and a moving controller's root joint, whose
+  // heap pointers prefetch_ahead brought in). No effect on any result; no allocation.
+  void prefetch_ahead(size_t i, const Controller& controller) const;
   void prefetch(size_t i, const Controller& controller) const;
   // Whether step(i) calls the controller this frame (so needs an input).
   bool updates(size_t i) const;

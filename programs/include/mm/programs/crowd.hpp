@@ -85,6 +85,19 @@ struct CrowdResult {
   std::array<int, kCrowdTierCount> tier_counts{};
   int full_min = 0;
   double planned_cost_us_mean = 0.0;
+  // Budgeted runs: where the steady frames' wall time went (mean ms per frame): the plan
+  // (significances and CrowdScheduler::plan, one thread), the longest thread's steps, and the
+  // rest (the threads' hand-off at the frame's barriers, waits for a core); and every steady
+  // frame's wall time (ms). Zero and empty without a budget.
+  double plan_ms_mean = 0.0;
+  double steps_ms_mean = 0.0;
+  double sync_ms_mean = 0.0;
+  // Budgeted runs: the threads' CPU time stepping characters per steady frame (ms, all threads
+  // together): the work the plan asked for, whose p99 against its mean is how unevenly the
+  // frames' work falls, whatever else runs on the machine.
+  double work_ms_mean = 0.0;
+  double work_ms_p99 = 0.0;
+  std::vector<double> frame_ms;
 };
 
 // Runs the crowd. Fails on invalid options or settings.
@@ -93,8 +106,9 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
 
 // The scheduler's cost model measured on this machine: `characters` of the options' crowd, every
 // one at a tier for two seconds, stepped on the threads the budget is planned for (options.lod);
-// the tier's cost is the CPU time the threads spent stepping over the last second, per character
-// and frame (us; clock_gettime(CLOCK_THREAD_CPUTIME_ID) around each thread's share of a frame).
+// the tier's cost is the CPU time the threads spent stepping, per character and frame (us;
+// clock_gettime(CLOCK_THREAD_CPUTIME_ID) around each thread's share of a frame), the median of
+// five samples over the last second (one noisy sample does not move it).
 // Measured at the crowd's size, it holds the cache misses of a large crowd; measured as CPU time
 // rather than wall time times threads, it leaves out the time a thread waited for a core that
 // other processes held, or at the frame's barrier for the other thread.
