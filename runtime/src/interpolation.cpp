@@ -248,8 +248,12 @@ Transform interpolate(const Transform& a, const Transform& b, float t, Interpola
 }
 
 float quat_yaw(const glm::quat& q) {
-  const glm::vec3 forward = q * glm::vec3(0.0f, 0.0f, 1.0f);
-  return atan2_polynomial(forward.x, forward.z);
+  // The x and z of q * (0, 0, 1), GLM's rotation written out for that vector (the same
+  // expression for any q, unit or not): two products and a sum each instead of two cross
+  // products of a general vector.
+  const float x = 2.0f * (q.w * q.y + q.x * q.z);
+  const float z = 1.0f - 2.0f * (q.x * q.x + q.y * q.y);
+  return atan2_polynomial(x, z);
 }
 
 float wrap_angle(float angle) {
