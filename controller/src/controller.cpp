@@ -1408,25 +1408,32 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
                          kKneeForwardBias * (globals_[0].rotation * kForward);
   // The foot's subtree is refreshed once, below, after its rotation is set.
-  apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
-                              knee, foot, ankle_target, pole);
-  const glm::quat raised_foot = glm::normalize(heel_rise * foot_rotation);
+  const TwoBoneIkResult solved =
+      apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
+                                  knee, foot, ankle_target, pole);
+  // A heel on the ground (no lift at all) leaves the foot its turned rotation and the toe its
+  // local one: the toe's turn below is then the foot's rotation undone by itself.
+  const bool heel_lifted = heel_rise != glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  const glm::quat raised_foot =
+      heel_lifted ? glm::normalize(heel_rise * foot_rotation) : foot_rotation;
   locals_[static_cast<size_t>(foot)].rotation =
       glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * raised_foot);
   // The toe stays flat on the ground while the heel rises: it bends at the ball of the foot.
-  if (leg[3] >= 0) {
+  if (leg[3] >= 0 && heel_lifted) {
     Transform& toe = locals_[static_cast<size_t>(leg[3])];
     toe.rotation = glm::normalize(glm::conjugate(raised_foot) * foot_rotation * toe.rotation);
   }
   refresh_subtree(foot);
-  restore_leg_lengths(side);
+  // A solve that reached its target unclamped turned the bones only, so their lengths hold and
+  // there is nothing to check.
+  if (!solved.reached) restore_leg_lengths(side);
 }
 
 // Distance-constraint relaxation over the leg's joints with the hip pinned, then each bone
 // turned to point at its relaxed child: the leg keeps the bone lengths of the pose being played
 // (actors differ, so not the skeleton's rest lengths). After an exact two-bone solve the
-// constraints already hold and nothing moves; it is the safety net for a solve that could not
-// keep them (a degenerate or clamped chain).
+// constraints already hold and nothing moves (reach does not call it then); it is the safety net
+// for a solve that could not keep them (a degenerate or clamped chain).
 void Controller::restore_leg_lengths(int side) {
   const std::vector<int>& leg = leg_joints_[side];
   const int count = leg[3] >= 0 ? 4 : 3;

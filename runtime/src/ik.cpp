@@ -67,20 +67,32 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
   return glm::normalize(glm::cross(un, other));
 }
 
-TwoBoneIkResult unchanged(const TwoBoneIkInput& in) {
-  TwoBoneIkResult r;
-  r.root_global = in.root.rotation;
-  r.mid_global = in.mid.rotation;
-  r.root_local = glm::conjugate(in.root_parent_rotation) * in.root.rotation;
-  r.mid_local = glm::conjugate(in.root.rotation) * in.mid.rotation;
-  r.mid_position = in.mid.translation;
-  r.end_position = in.end.translation;
-  return r;
+// A quaternion product and a rotated vector in GLM's formulas, always inlined: the solve's few
+// products and rotations were calls to GLM's out-of-line copies.
+[[gnu::always_inline]] inline glm::quat mul(const glm::quat& p, const glm::quat& q) {
+  return glm::quat(
+      p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
+      p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x);
 }
 
-}  // namespace
+[[gnu::always_inline]] inline glm::vec3 rotate(const glm::quat& q, const glm::vec3& v) {
+  const glm::vec3 u(q.x, q.y, q.z);
+  const glm::vec3 uv = glm::cross(u, v);
+  const glm::vec3 uuv = glm::cross(u, uv);
+  return v + ((uv * q.w) + uuv) * 2.0f;
+}
 
-TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
+// The solve as two turns: the hip's (bend, swing, twist: every joint of the chain turns by it)
+// and the knee's bend (about the same axis as the hip's bend, so the two commute and the knee's
+// new local rotation is its bend seen from the hip, whatever the swing and the twist).
+struct ChainTurns {
+  glm::quat hip_turn{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::quat knee_bend{1.0f, 0.0f, 0.0f, 0.0f};
+  bool reached = false;
+};
+
+// False for zero-length bones or non-finite input (the chain is then left as it is).
+bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 a = in.root.translation;
   const glm::vec3 b = in.mid.translation;
   const glm::vec3 c = in.end.translation;
@@ -89,7 +101,7 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
       !finite(in.root.rotation) || !finite(in.mid.rotation) || !finite(in.root_parent_rotation) ||
       !std::isfinite(in.extension_epsilon) || upper < kMinBoneLength || lower < kMinBoneLength) {
-    return unchanged(in);
+    return false;
   }
 
   // Clamp the wanted hip-to-ankle distance to what the two bones can make.
@@ -125,15 +137,15 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   const glm::quat knee_bend =
       rotation_about(triangle_angle(upper, lower, reach), knee_angle_now, bend_axis);
 
-  glm::vec3 knee = a + hip_bend * ab;
-  glm::vec3 ankle = knee + knee_bend * (hip_bend * (c - b));
+  const glm::vec3 knee = rotate(hip_bend, ab);  // from the hip
+  const glm::vec3 ankle = knee + rotate(knee_bend, rotate(hip_bend, c - b));
 
   // 2. Swing the whole chain about the hip so the ankle lies on the line toward the target.
-  const glm::quat swing = quat_between(ankle - a, direction);
+  const glm::quat swing = quat_between(ankle, direction);
 
   // 3. Twist about that line so the knee is in the half-plane of the pole.
-  const glm::vec3 knee_offset = swing * (knee - a);
-  glm::quat twist(1.0f, 0.0f, 0.0f, 0.0f);
+  const glm::vec3 knee_offset = rotate(swing, knee);
+  glm::quat turn = swing;
   const glm::vec3 knee_across = knee_offset - glm::dot(knee_offset, direction) * direction;
   const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
   if (glm::length(knee_across) > 1e-6f * upper && glm::length(pole_across) > 1e-6f) {
@@ -142,27 +154,48 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
     const float cosine = glm::dot(knee_across, pole_across);
     const float sine = glm::dot(direction, glm::cross(knee_across, pole_across));
     const float r = std::sqrt(cosine * cosine + sine * sine);
-    if (r > 0.0f) twist = rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction);
+    if (r > 0.0f)
+      turn = mul(rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction), swing);
   }
+  out.hip_turn = mul(turn, hip_bend);
+  out.knee_bend = knee_bend;
+  out.reached = target_distance >= min_reach && target_distance <= max_reach;
+  return true;
+}
 
-  // Products group from the left, so twist * swing is the same first factor of both.
-  const glm::quat turn = twist * swing;
-  const glm::quat hip_turn = turn * hip_bend;
-  const glm::quat knee_turn = turn * knee_bend * hip_bend;
+}  // namespace
+
+TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& in) {
   TwoBoneIkResult r;
-  r.root_global = glm::normalize(hip_turn * in.root.rotation);
-  r.mid_global = glm::normalize(knee_turn * in.mid.rotation);
-  r.root_local = glm::normalize(glm::conjugate(in.root_parent_rotation) * r.root_global);
-  r.mid_local = glm::normalize(glm::conjugate(r.root_global) * r.mid_global);
-  r.mid_position = a + hip_turn * ab;
-  r.end_position = r.mid_position + knee_turn * (c - b);
-  r.reached = target_distance >= min_reach && target_distance <= max_reach;
+  ChainTurns t;
+  if (!solve_turns(in, t)) {
+    r.root_global = in.root.rotation;
+    r.mid_global = in.mid.rotation;
+    r.root_local = glm::conjugate(in.root_parent_rotation) * in.root.rotation;
+    r.mid_local = glm::conjugate(in.root.rotation) * in.mid.rotation;
+    r.mid_position = in.mid.translation;
+    r.end_position = in.end.translation;
+    return r;
+  }
+  const glm::quat bent_mid = mul(t.knee_bend, in.mid.rotation);
+  r.root_global = glm::normalize(mul(t.hip_turn, in.root.rotation));
+  r.mid_global = glm::normalize(mul(t.hip_turn, bent_mid));
+  r.root_local = glm::normalize(mul(glm::conjugate(in.root_parent_rotation), r.root_global));
+  r.mid_local = glm::normalize(mul(glm::conjugate(in.root.rotation), bent_mid));
+  const glm::vec3 a = in.root.translation;
+  r.mid_position = a + rotate(t.hip_turn, in.mid.translation - a);
+  r.end_position = r.mid_position +
+                   rotate(t.hip_turn, rotate(t.knee_bend, in.end.translation - in.mid.translation));
+  r.reached = t.reached;
   return r;
 }
 
 namespace {
 
-// The solve of a pose's chain, its local rotations written and the root's global refreshed.
+// The solve of a pose's chain, its local rotations written and the root's global refreshed (its
+// rotation only: the root's translation and scale do not move). A chain the solve cannot bend
+// keeps its locals. The result's global rotations and positions are not filled in: the pose's
+// callers read the globals they refresh.
 TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform> local,
                                std::span<Transform> global, int root, int mid, int end,
                                const glm::vec3& target, const glm::vec3& pole,
@@ -170,21 +203,34 @@ TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform
   MM_ASSERT(parents.size() == local.size() && parents.size() == global.size());
   MM_ASSERT(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
   MM_ASSERT(parents[mid] == root && parents[end] == mid);
+  const size_t r = static_cast<size_t>(root), m = static_cast<size_t>(mid);
   TwoBoneIkInput in;
-  in.root = global[root];
-  in.mid = global[mid];
-  in.end = global[end];
-  const int root_parent = parents[root];
-  in.root_parent_rotation =
-      root_parent >= 0 ? global[root_parent].rotation : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+  in.root = global[r];
+  in.mid = global[m];
+  in.end = global[static_cast<size_t>(end)];
+  const int root_parent = parents[r];
+  in.root_parent_rotation = root_parent >= 0 ? global[static_cast<size_t>(root_parent)].rotation
+                                             : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   in.target = target;
   in.pole = pole;
   in.extension_epsilon = extension_epsilon;
-  const TwoBoneIkResult r = solve_two_bone_ik(in);
-  local[root].rotation = r.root_local;
-  local[mid].rotation = r.mid_local;
-  global[root] = parents[root] < 0 ? local[root] : compose(global[parents[root]], local[root]);
-  return r;
+  TwoBoneIkResult result;
+  ChainTurns t;
+  if (!solve_turns(in, t)) {
+    result.root_local = local[r].rotation;
+    result.mid_local = local[m].rotation;
+    return result;
+  }
+  local[r].rotation = glm::normalize(
+      mul(glm::conjugate(in.root_parent_rotation), mul(t.hip_turn, in.root.rotation)));
+  local[m].rotation =
+      glm::normalize(mul(glm::conjugate(in.root.rotation), mul(t.knee_bend, in.mid.rotation)));
+  global[r].rotation =
+      root_parent >= 0 ? mul(in.root_parent_rotation, local[r].rotation) : local[r].rotation;
+  result.root_local = local[r].rotation;
+  result.mid_local = local[m].rotation;
+  result.reached = t.reached;
+  return result;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include "mm/runtime/assert.hpp"
+#include "mm/runtime/atan2_polynomial.hpp"
 
 #include <glm/gtc/constants.hpp>
 
@@ -46,7 +47,7 @@ glm::vec3 quat_log(const glm::quat& q) {
   // Only an exactly (or denormally) zero vector part is special; atan2(s, w) / s is accurate
   // for every other s, tiny ones included, because atan2 keeps relative precision near 0.
   if (s < 1e-30f) return q.w >= 0.0f ? v : glm::vec3(glm::pi<float>(), 0.0f, 0.0f);
-  return v * (std::atan2(s, q.w) / s);
+  return v * (atan2_polynomial(s, q.w) / s);
 }
 
 glm::quat quat_exp(const glm::vec3& half_angle_axis) {
@@ -247,8 +248,12 @@ Transform interpolate(const Transform& a, const Transform& b, float t, Interpola
 }
 
 float quat_yaw(const glm::quat& q) {
-  const glm::vec3 forward = q * glm::vec3(0.0f, 0.0f, 1.0f);
-  return std::atan2(forward.x, forward.z);
+  // The x and z of q * (0, 0, 1), GLM's rotation written out for that vector (the same
+  // expression for any q, unit or not): two products and a sum each instead of two cross
+  // products of a general vector.
+  const float x = 2.0f * (q.w * q.y + q.x * q.z);
+  const float z = 1.0f - 2.0f * (q.x * q.x + q.y * q.y);
+  return atan2_polynomial(x, z);
 }
 
 float wrap_angle(float angle) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include "mm/runtime/assert.hpp"
+#include "mm/runtime/atan2_polynomial.hpp"
 
 namespace mm {
 
@@ -54,9 +55,10 @@ void bone_lengths(std::span<const int> parents, std::span<const Transform> globa
 
 float pair_yaw(const glm::vec3& left, const glm::vec3& right, float fallback) {
   const glm::vec3 across = left - right;
-  // (left - right) x up = (-across.z, 0, across.x).
-  if (std::hypot(across.x, across.z) <= 1e-6f) return fallback;
-  return std::atan2(-across.z, across.x);
+  // (left - right) x up = (-across.z, 0, across.x). Squared: a product underflowing to 0 or
+  // overflowing to infinity lands on the same side of the threshold as the length would.
+  if (across.x * across.x + across.z * across.z <= 1e-12f) return fallback;
+  return atan2_polynomial(-across.z, across.x);
 }
 
 }  // namespace mm

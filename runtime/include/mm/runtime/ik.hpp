@@ -47,7 +47,9 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& input);
 
 // Solves the chain root -> mid -> end of a pose in place: writes the new local rotations of
 // root and mid and recomputes the global transforms of root and its descendants. Requires
-// parents[mid] == root, parents[end] == mid, and `global` to be the FK of `local`.
+// parents[mid] == root, parents[end] == mid, and `global` to be the FK of `local`. The result
+// holds the locals and `reached` only (the new globals are in `global`); a chain the solve cannot
+// bend (zero-length bones, non-finite input) keeps its locals.
 TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
                                   std::span<Transform> global, int root, int mid, int end,
                                   const glm::vec3& target, const glm::vec3& pole,
