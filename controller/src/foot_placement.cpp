@@ -28,10 +28,17 @@ constexpr float kStepRise = 0.02f;
 // Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
 constexpr float kEdgeRise = 0.01f;
 
-// Probe slots: per side, heel now, toe now, heel ahead, toe ahead.
-constexpr int kHeel = 0, kToe = 1, kHeelAhead = 2, kToeAhead = 3;
+// Probe slots: per side, heel and toe now, where the body takes them, where their own velocity
+// takes them.
+constexpr int kHeel = 0, kToe = 1, kHeelAhead = 2, kToeAhead = 3, kHeelOwn = 4, kToeOwn = 5;
+constexpr int kPerSide = 6;
+static_assert(2 * kPerSide == FootPlacement::kProbes);
 constexpr int slot(int side, int which) {
-  return side * 4 + which;
+  return side * kPerSide + which;
+}
+// The heel's or the toe's slot that a look-ahead slot looks ahead of.
+constexpr int now_of(int which) {
+  return which % 2;
 }
 
 void follow_ground(float& height, float& velocity, float goal, float dt) {
@@ -109,10 +116,11 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   keep_steps_ahead();
 }
 
-// Heel and toe, where they are and (for a foot in the air) where its own or the body's velocity
-// takes them shortly: a swinging toe sees the riser before it reaches it. A planted foot looks only
-// where it is: ahead, up a slope, it would rise off the surface it stands on. Then the toe's
-// footprint around it.
+// Heel and toe, where they are and (for a foot in the air) where the body's velocity takes them
+// shortly and where their own does: a swinging toe sees the riser before it reaches it, also
+// when the body moves another way (a step to the side, a turn's step, a swing across the body's
+// path on a circle). A planted foot looks only where it is: ahead, up a slope, it would rise off
+// the surface it stands on. Then the toe's footprint around it.
 void FootPlacement::place_probes(const FootPlacementSettings& settings,
                                  std::span<const PlacementLeg, 2> legs, float body_ground,
                                  const glm::vec3& body_velocity) {
@@ -128,14 +136,15 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
   }
   for (int side = 0; side < 2; ++side) {
     const PlacementLeg& leg = legs[side];
-    const glm::vec3 own = feet_[side].toe_velocity * kToeLookahead;
-    const glm::vec3 farther = glm::length(own) > glm::length(ahead) ? own : ahead;
-    const glm::vec3 look = leg.planted ? glm::vec3(0.0f) : farther;
+    const glm::vec3 body = leg.planted ? glm::vec3(0.0f) : ahead;
+    const glm::vec3 own = leg.planted ? glm::vec3(0.0f) : feet_[side].toe_velocity * kToeLookahead;
     probe_points_[slot(side, kHeel)] = leg.ankle;
     probe_points_[slot(side, kToe)] = leg.toe;
-    probe_points_[slot(side, kHeelAhead)] = leg.ankle + look;
-    probe_points_[slot(side, kToeAhead)] = leg.toe + look;
-    for (const int which : {kHeel, kToe, kHeelAhead, kToeAhead}) {
+    probe_points_[slot(side, kHeelAhead)] = leg.ankle + body;
+    probe_points_[slot(side, kToeAhead)] = leg.toe + body;
+    probe_points_[slot(side, kHeelOwn)] = leg.ankle + own;
+    probe_points_[slot(side, kToeOwn)] = leg.toe + own;
+    for (int which = 0; which < kPerSide; ++which) {
       const glm::vec3& p = probe_points_[slot(side, which)];
       probes_[slot(side, which)] = GroundProbe{glm::vec3(p.x, top[side], p.z), reach[side], 0.0f};
     }
@@ -179,8 +188,8 @@ void FootPlacement::stand_on_edges(float body_ground, const FootPlacementSetting
 // will meet as it gets there (counted now, a landing foot would lock in the air).
 void FootPlacement::keep_steps_ahead() {
   for (int side = 0; side < 2; ++side) {
-    for (const int now : {kHeel, kToe}) {
-      const int later = now + 2;  // kHeelAhead, kToeAhead
+    for (const int later : {kHeelAhead, kToeAhead, kHeelOwn, kToeOwn}) {
+      const int now = now_of(later);
       glm::vec3& ahead_ground = probe_grounds_[slot(side, later)];
       const glm::vec3& here = probe_grounds_[slot(side, now)];
       const GroundHit& hit = hits_[slot(side, now)];
@@ -192,13 +201,13 @@ void FootPlacement::keep_steps_ahead() {
   }
 }
 
-// The heights a foot's heel and toe go to: the higher of now and ahead, then each raised to
+// The heights a foot's heel and toe go to: the highest of now and ahead, then each raised to
 // within the steepest tilt of the other (a foot over a step's edge rests on the higher side).
 FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
                                float foot_length) const {
   const auto height = [&](int which) { return probe_grounds_[slot(side, which)].y; };
-  const float heel = std::max(height(kHeel), height(kHeelAhead));
-  const float toe = std::max(height(kToe), height(kToeAhead));
+  const float heel = std::max({height(kHeel), height(kHeelAhead), height(kHeelOwn)});
+  const float toe = std::max({height(kToe), height(kToeAhead), height(kToeOwn)});
   const float rise = foot_length * std::tan(settings.max_foot_tilt);
   return FootGround{std::max(heel, toe - rise), std::max(toe, heel - rise)};
 }

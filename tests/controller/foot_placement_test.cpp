@@ -178,6 +178,30 @@ TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   EXPECT_EQ(p.ground(1).toe, 0.0f);
 }
 
+// On a circle or a step to the side the swinging toe heads where the body does not, and
+// farther in the body's 0.2 s than in its own 0.1 s: looking only the farther way, the toe met
+// the riser it swung into (the course off its lanes, circle at 1/144: 12 cm into the stairs).
+TEST(FootPlacement, AToeSwingingAcrossTheBodysPathRisesBeforeTheRiserItHeadsFor) {
+  AnalyticWorld world;
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.3f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, -0.35f, 0.0f),
+                                   standing_leg(0.1f, 0.0f, 0.0f)};
+  legs[0].planted = legs[0].near_ground = false;
+  p.reset(0.0f);
+  const FootPlacementSettings settings;
+  const glm::vec3 body_velocity(3.0f, 0.0f, 0.0f);  // sideways: 0.6 m in 0.2 s
+  const glm::vec3 toe_velocity(0.0f, 0.0f, 2.0f);   // toward the riser: 0.2 m in 0.1 s
+  for (int f = 0; f < 14; ++f) {
+    legs[0].toe += toe_velocity * kDt;
+    legs[0].ankle += toe_velocity * kDt;
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, body_velocity, kDt);
+  }
+  ASSERT_LT(legs[0].toe.z, 0.3f);  // still over the lower ground, the riser 3 cm ahead
+  EXPECT_GT(p.ground(0).toe, 0.15f);
+}
+
 TEST(FootPlacement, AProbeThatMissesFallsBackToTheBodysGround) {
   AnalyticWorld world;
   world.height = [](double, double) { return -5.0; };  // far below any probe's reach

@@ -5,7 +5,7 @@
 // step up, a tread down, a slope under the toe. Once per update, after forward kinematics and
 // before foot locking, FootPlacement
 // 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
-//    (the body's velocity ahead), in one batched call of kProbes probes;
+//    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes;
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
@@ -61,8 +61,8 @@ struct FootGround {
 
 class FootPlacement {
  public:
-  // Heel and toe of each foot, now and ahead.
-  static constexpr int kProbes = 8;
+  // Heel and toe of each foot, now, where the body takes them and where their own velocity does.
+  static constexpr int kProbes = 12;
   // Around each toe, kFootprint probes kFootprintRadius out (m): a toe joint at a tread's or a
   // ramp's edge is a point the ground under it changes at, and a probe a millimetre on the low
   // side let a toe sink below the edge it was on. The toe stands on the highest of them.
@@ -70,9 +70,8 @@ class FootPlacement {
   static constexpr float kFootprintRadius = 0.015f;
   // Ground probes per update, all in one call.
   static constexpr int kQueries = kProbes + 2 * kFootprint;
-  // How far ahead the probes look: the body's velocity times this (s), or the toe's own
-  // (a step to the side or a turn's step goes where the body does not) times kToeLookahead,
-  // whichever goes farther.
+  // How far ahead the probes look: the body's velocity times this (s), and the toe's own
+  // (a step to the side or a turn's step goes where the body does not) times kToeLookahead.
   static constexpr float kLookahead = 0.2f;
   static constexpr float kToeLookahead = 0.1f;
   // A leg may straighten to this share of its length to reach a lower foot's ground before
