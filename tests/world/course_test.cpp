@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "course_support.hpp"
 #include "mm/database/files.hpp"
 #include "mm/world/bullet_world.hpp"
 #include "mm/world/course.hpp"
@@ -23,40 +24,15 @@ namespace fs = std::filesystem;
 const fs::path kShipped = fs::path(MM_SOURCE_DIR) / "data" / "levels" / "course.glb";
 
 BulletWorld shipped_world() {
-  Result<Level> level = load_level(kShipped);
-  EXPECT_TRUE(level.ok()) << level.message();
-  if (!level) return std::move(BulletWorld::create(Level{})).value();
-  Result<BulletWorld> world = BulletWorld::create(*level);
-  EXPECT_TRUE(world.ok()) << world.message();
-  return std::move(world).value();
+  return test::course_world(kShipped);
 }
 
-GroundHit probe(const BulletWorld& world, double x, double z, float min_walkable_normal_y = 0.7f) {
-  const GroundProbe query{
-      {static_cast<float>(x), 3.0f, static_cast<float>(z)}, 4.0f, min_walkable_normal_y};
-  GroundHit hit;
-  world.probe_ground(glm::dvec3(0.0), std::span(&query, 1), std::span(&hit, 1));
-  return hit;
-}
-
-// A walk along +Z at x from z0 to z1, as the controller sweeps: lifted 0.35 m.
-SweepHit walk(const BulletWorld& world, double x, double z0, double z1) {
-  const ShapeSweep query{{static_cast<float>(x), 0.35f, static_cast<float>(z0)},
-                         {static_cast<float>(x), 0.35f, static_cast<float>(z1)},
-                         0.3f,
-                         1.7f};
-  SweepHit hit;
-  world.sweep(glm::dvec3(0.0), std::span(&query, 1), std::span(&hit, 1));
-  return hit;
-}
+using test::probe;
+using test::walk;
 
 const CoursePart& part(const std::string& name) {
   static const std::vector<CoursePart> parts = course_parts();
-  for (const CoursePart& p : parts) {
-    if (p.name == name) return p;
-  }
-  ADD_FAILURE() << "no part " << name;
-  return parts.front();
+  return test::course_part(parts, name);
 }
 
 TEST(Course, TheGeneratorReproducesTheShippedFile) {

@@ -16,6 +16,7 @@
 namespace mm {
 namespace {
 
+using course_mesh::HeightField;
 using course_mesh::Mesh;
 using course_mesh::metres;
 using course_mesh::Placed;
@@ -117,33 +118,7 @@ double rough_field(double u, double v) {
   return window(u, kRoughWidth) * window(v, kRoughLength) * bumps;
 }
 
-// The height field at a grid vertex, as the mesh stores it (rounded to float).
-double rough_vertex(int column, int row) {
-  return static_cast<float>(rough_field(column * kRoughCell, row * kRoughCell));
-}
-
-// The mesh's own surface between the vertices: every cell is split along the diagonal from its
-// (low u, low v) corner to its (high u, high v) corner.
-double rough_height(double u, double v) {
-  const int column = std::clamp(static_cast<int>(std::floor(u / kRoughCell)), 0, kRoughColumns - 1);
-  const int row = std::clamp(static_cast<int>(std::floor(v / kRoughCell)), 0, kRoughRows - 1);
-  const double a = u / kRoughCell - column;
-  const double b = v / kRoughCell - row;
-  const double h00 = rough_vertex(column, row);
-  const double h10 = rough_vertex(column + 1, row);
-  const double h01 = rough_vertex(column, row + 1);
-  const double h11 = rough_vertex(column + 1, row + 1);
-  if (a >= b) return h00 + a * (h10 - h00) + b * (h11 - h10);
-  return h00 + b * (h01 - h00) + a * (h11 - h01);
-}
-
-double rough_top() {
-  double top = 0.0;
-  for (int column = 0; column <= kRoughColumns; ++column) {
-    for (int row = 0; row <= kRoughRows; ++row) top = std::max(top, rough_vertex(column, row));
-  }
-  return top;
-}
+constexpr HeightField kRough{rough_field, kRoughCell, kRoughColumns, kRoughRows};
 
 // (x, z) in the turned wall's own frame: its face runs along +z from 0 to kTurnedLength at x = 0,
 // its thickness is x in [-kWallThickness, 0].
@@ -187,26 +162,7 @@ std::vector<Placed> course_meshes() {
     }
     parts.push_back(std::move(stairs));
   }
-  {
-    Placed rough{"rough", {}, {kRoughX, 0.0, kLaneStart}, 0.0};
-    Mesh& m = rough.mesh;
-    for (int row = 0; row <= kRoughRows; ++row) {
-      for (int column = 0; column <= kRoughColumns; ++column) {
-        m.vertex({column * kRoughCell, rough_vertex(column, row), row * kRoughCell});
-      }
-    }
-    auto at = [](int column, int row) {
-      return static_cast<uint32_t>(row * (kRoughColumns + 1) + column);
-    };
-    for (int row = 0; row < kRoughRows; ++row) {
-      for (int column = 0; column < kRoughColumns; ++column) {
-        // The diagonal rough_height() assumes: (column, row) to (column + 1, row + 1).
-        m.triangle(at(column, row), at(column + 1, row), at(column + 1, row + 1), {0, 1, 0});
-        m.triangle(at(column, row), at(column + 1, row + 1), at(column, row + 1), {0, 1, 0});
-      }
-    }
-    parts.push_back(std::move(rough));
-  }
+  parts.push_back(Placed{"rough", kRough.mesh(), {kRoughX, 0.0, kLaneStart}, 0.0});
   {
     Placed wall{"wall_head_on", {}, {kHeadOnX[0], 0.0, kHeadOnZ}, 0.0};
     wall.mesh.box({0.0, 0.0, 0.0}, {kHeadOnX[1] - kHeadOnX[0], kWallHeight, kWallThickness});
@@ -261,8 +217,8 @@ std::vector<CoursePart> course_parts() {
   parts.push_back({"rough",
                    {kRoughX, kRoughX + kRoughWidth},
                    {kLaneStart, kLaneStart + kRoughLength},
-                   rough_top(),
-                   "bumps of 0 to " + metres(100.0 * rough_top()) +
+                   kRough.top(),
+                   "bumps of 0 to " + metres(100.0 * kRough.top()) +
                        " cm (a smooth height field on a " + metres(100.0 * kRoughCell) +
                        " cm grid); walk +Z at x = " + metres(kRoughX + 0.5 * kRoughWidth)});
   parts.push_back({"wall_head_on",
@@ -338,7 +294,7 @@ double course_height(double x, double z) {
   }
   if (inside(x, kRoughX, kRoughX + kRoughWidth) &&
       inside(z, kLaneStart, kLaneStart + kRoughLength)) {
-    return rough_height(x - kRoughX, z - kLaneStart);
+    return kRough.height(x - kRoughX, z - kLaneStart);
   }
   if (inside(x, kHeadOnX[0], kHeadOnX[1]) && inside(z, kHeadOnZ, kHeadOnZ + kWallThickness)) {
     return kWallHeight;

@@ -15,6 +15,7 @@
 namespace mm {
 namespace {
 
+using course_mesh::HeightField;
 using course_mesh::Mesh;
 using course_mesh::metres;
 using course_mesh::Placed;
@@ -185,31 +186,7 @@ double rough_field(double u, double v) {
   return window(u, kRoughWidth) * window(v, kRoughLength) * bumps;
 }
 
-double rough_vertex(int column, int row) {
-  return static_cast<float>(rough_field(column * kRoughCell, row * kRoughCell));
-}
-
-// The mesh's surface: every cell split from its (low u, low v) corner to its (high u, high v).
-double rough_height(double u, double v) {
-  const int column = std::clamp(static_cast<int>(std::floor(u / kRoughCell)), 0, kRoughColumns - 1);
-  const int row = std::clamp(static_cast<int>(std::floor(v / kRoughCell)), 0, kRoughRows - 1);
-  const double a = u / kRoughCell - column;
-  const double b = v / kRoughCell - row;
-  const double h00 = rough_vertex(column, row);
-  const double h10 = rough_vertex(column + 1, row);
-  const double h01 = rough_vertex(column, row + 1);
-  const double h11 = rough_vertex(column + 1, row + 1);
-  if (a >= b) return h00 + a * (h10 - h00) + b * (h11 - h10);
-  return h00 + b * (h01 - h00) + a * (h11 - h01);
-}
-
-double rough_top() {
-  double top = 0.0;
-  for (int column = 0; column <= kRoughColumns; ++column) {
-    for (int row = 0; row <= kRoughRows; ++row) top = std::max(top, rough_vertex(column, row));
-  }
-  return top;
-}
+constexpr HeightField kRough{rough_field, kRoughCell, kRoughColumns, kRoughRows};
 
 double slope_top() {
   return kSlopeWidth * std::tan(radians(kSlopeDegrees));
@@ -262,23 +239,7 @@ Placed flat_ground() {
 }
 
 Placed rough_patch() {
-  Placed rough{"rough", {}, {kRoughX, 0.0, kLaneStart}, 0.0};
-  Mesh& m = rough.mesh;
-  for (int row = 0; row <= kRoughRows; ++row) {
-    for (int column = 0; column <= kRoughColumns; ++column) {
-      m.vertex({column * kRoughCell, rough_vertex(column, row), row * kRoughCell});
-    }
-  }
-  auto at = [](int column, int row) {
-    return static_cast<uint32_t>(row * (kRoughColumns + 1) + column);
-  };
-  for (int row = 0; row < kRoughRows; ++row) {
-    for (int column = 0; column < kRoughColumns; ++column) {
-      m.triangle(at(column, row), at(column + 1, row), at(column + 1, row + 1), {0, 1, 0});
-      m.triangle(at(column, row), at(column + 1, row + 1), at(column, row + 1), {0, 1, 0});
-    }
-  }
-  return rough;
+  return Placed{"rough", kRough.mesh(), {kRoughX, 0.0, kLaneStart}, 0.0};
 }
 
 Placed boxes(const char* name, const std::vector<Rect>& rects, double height) {
@@ -468,8 +429,8 @@ std::vector<CoursePart> course2_parts() {
   parts.push_back({"rough",
                    {kRoughX, kRoughX + kRoughWidth},
                    {kLaneStart, kLaneStart + kRoughLength},
-                   rough_top(),
-                   "bumps of 0 to " + metres(100.0 * rough_top()) +
+                   kRough.top(),
+                   "bumps of 0 to " + metres(100.0 * kRough.top()) +
                        " cm (a smooth height field on a " + metres(100.0 * kRoughCell) +
                        " cm grid)" + walk(kRoughX + 0.5 * kRoughWidth)});
   add_wall_rows(parts);
@@ -511,7 +472,7 @@ double course2_height(double x, double z) {
   if (inside(x, kStairsDownX, kStairsDownX + kStairsWidth)) return stairs_down_height(z);
   if (inside(x, kRoughX, kRoughX + kRoughWidth) &&
       inside(z, kLaneStart, kLaneStart + kRoughLength)) {
-    return rough_height(x - kRoughX, z - kLaneStart);
+    return kRough.height(x - kRoughX, z - kLaneStart);
   }
   for (const TurnedWall& wall : kTurnedWalls) {
     const glm::dvec2 local = wall_frame(wall, x, z);

@@ -156,4 +156,49 @@ std::vector<unsigned char> write_glb(const std::vector<Placed>& parts, const std
   return {bytes.begin(), bytes.end()};
 }
 
+double HeightField::vertex(int column, int row) const {
+  return static_cast<float>(field(column * cell, row * cell));
+}
+
+double HeightField::height(double u, double v) const {
+  const int column = std::clamp(static_cast<int>(std::floor(u / cell)), 0, columns - 1);
+  const int row = std::clamp(static_cast<int>(std::floor(v / cell)), 0, rows - 1);
+  const double a = u / cell - column;
+  const double b = v / cell - row;
+  const double h00 = vertex(column, row);
+  const double h10 = vertex(column + 1, row);
+  const double h01 = vertex(column, row + 1);
+  const double h11 = vertex(column + 1, row + 1);
+  if (a >= b) return h00 + a * (h10 - h00) + b * (h11 - h10);
+  return h00 + b * (h01 - h00) + a * (h11 - h01);
+}
+
+double HeightField::top() const {
+  double highest = 0.0;
+  for (int column = 0; column <= columns; ++column) {
+    for (int row = 0; row <= rows; ++row) highest = std::max(highest, vertex(column, row));
+  }
+  return highest;
+}
+
+Mesh HeightField::mesh() const {
+  Mesh m;
+  for (int row = 0; row <= rows; ++row) {
+    for (int column = 0; column <= columns; ++column) {
+      m.vertex({column * cell, vertex(column, row), row * cell});
+    }
+  }
+  const auto at = [this](int column, int row) {
+    return static_cast<uint32_t>(row * (columns + 1) + column);
+  };
+  for (int row = 0; row < rows; ++row) {
+    for (int column = 0; column < columns; ++column) {
+      // The diagonal height() assumes: (column, row) to (column + 1, row + 1).
+      m.triangle(at(column, row), at(column + 1, row), at(column + 1, row + 1), {0, 1, 0});
+      m.triangle(at(column, row), at(column + 1, row + 1), at(column, row + 1), {0, 1, 0});
+    }
+  }
+  return m;
+}
+
 }  // namespace mm::course_mesh

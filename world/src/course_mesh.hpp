@@ -32,6 +32,23 @@ struct Mesh {
   void box(const glm::dvec3& low, const glm::dvec3& high);
 };
 
+// A patch of bumps: `field(u, v)` (metres into the patch) sampled every `cell` over `columns`
+// by `rows` cells. Its mesh splits every cell along the diagonal from its (low u, low v) corner
+// to its (high u, high v) corner; height() is that mesh's surface exactly.
+struct HeightField {
+  double (*field)(double u, double v);
+  double cell;
+  int columns;
+  int rows;
+
+  // The field at a grid vertex, as the mesh stores it (rounded to float).
+  double vertex(int column, int row) const;
+  double height(double u, double v) const;
+  double top() const;
+  // The patch's mesh, its (0, 0) corner at the origin, u along x and v along z.
+  Mesh mesh() const;
+};
+
 // A part's node: its mesh in its own frame, where the node puts it.
 struct Placed {
   std::string name;
