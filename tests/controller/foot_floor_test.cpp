@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "controller_support.hpp"
@@ -19,6 +21,28 @@ namespace mm {
 namespace {
 
 using test::normal_controller_database;
+
+constexpr float kEveryRate[] = {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f};
+
+// Each shipped script in `names` run at each of `rates` on the normal database, its metrics
+// handed to `check(name, dt, metrics)`.
+template <typename Check>
+void for_each_run(std::initializer_list<const char*> names, std::span<const float> rates,
+                  Check check) {
+  const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
+  for (const char* name : names) {
+    Result<InputScript> script =
+        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
+    ASSERT_TRUE(script.ok()) << script.message();
+    for (const float dt : rates) {
+      EvaluationOptions options;
+      options.dt = dt;
+      Result<EvaluationResult> run = evaluate_script(shared, *script, options);
+      ASSERT_TRUE(run.ok()) << run.message();
+      check(name, dt, run->metrics);
+    }
+  }
+}
 
 // The data's lowest toe, found again here with the runtime's forward kinematics over every
 // frame of the database.
@@ -50,18 +74,10 @@ TEST(FootFloorTest, TheDataLowestToeIsTheLowestOfEveryFrame) {
 TEST(FootFloorTest, ToesStayAtOrAboveTheDataLowestWithIk) {
   const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
   const float floor = std::min(shared->lowest_foot_end(0), shared->lowest_foot_end(1));
-  for (const char* name : {"reversals.txt", "walk-run.txt", "showcase.txt"}) {
-    Result<InputScript> script =
-        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
-    ASSERT_TRUE(script.ok()) << script.message();
-    for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
-      EvaluationOptions options;
-      options.dt = dt;
-      Result<EvaluationResult> run = evaluate_script(shared, *script, options);
-      ASSERT_TRUE(run.ok()) << run.message();
-      EXPECT_GE(run->metrics.toe_height_min_cm, 100.0 * floor - 0.01) << name << " dt " << dt;
-    }
-  }
+  for_each_run({"reversals.txt", "walk-run.txt", "showcase.txt"}, kEveryRate,
+               [&](const char* name, float dt, const EvaluationMetrics& m) {
+                 EXPECT_GE(m.toe_height_min_cm, 100.0 * floor - 0.01) << name << " dt " << dt;
+               });
 }
 
 // Planted through blends (issue 29): counted by geometry alone (low and slow), the toes slide
@@ -69,45 +85,29 @@ TEST(FootFloorTest, ToesStayAtOrAboveTheDataLowestWithIk) {
 // was dragged beyond the leg's softened reach or let go mid-blend, at the coarsest and the
 // finest rate; and the transitions stay as smooth as the target.
 TEST(FootFloorTest, GeometricSkatingIsNoMoreThanTheDataOwn) {
-  const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
-  for (const char* name : {"circle.txt", "reversals.txt", "zigzag.txt"}) {
-    Result<InputScript> script =
-        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
-    ASSERT_TRUE(script.ok()) << script.message();
-    for (const float dt : {1.0f / 30.0f, 1.0f / 144.0f}) {
-      EvaluationOptions options;
-      options.dt = dt;
-      Result<EvaluationResult> run = evaluate_script(shared, *script, options);
-      ASSERT_TRUE(run.ok()) << run.message();
-      const EvaluationMetrics& m = run->metrics;
-      EXPECT_GT(m.foot_skate_geom_data_cm_s_mean, 0.0) << name << " dt " << dt;
-      // On this database (the idles are the Bandai ones, which shuffle) the data's own is high;
-      // held toes reached by the heel's lift, not dragged, stay under half of it.
-      EXPECT_LE(m.ground.foot_skate_geom_cm_s_mean, 0.5 * m.foot_skate_geom_data_cm_s_mean)
-          << name << " dt " << dt;
-      EXPECT_LE(m.transition_accel_ratio, 0.9) << name << " dt " << dt;
-    }
-  }
+  const float rates[] = {1.0f / 30.0f, 1.0f / 144.0f};
+  for_each_run(
+      {"circle.txt", "reversals.txt", "zigzag.txt"}, rates,
+      [](const char* name, float dt, const EvaluationMetrics& m) {
+        EXPECT_GT(m.foot_skate_geom_data_cm_s_mean, 0.0) << name << " dt " << dt;
+        // On this database (the idles are the Bandai ones, which shuffle) the data's
+        // own is high; held toes reached by the heel's lift, not dragged, stay under
+        // half of it.
+        EXPECT_LE(m.ground.foot_skate_geom_cm_s_mean, 0.5 * m.foot_skate_geom_data_cm_s_mean)
+            << name << " dt " << dt;
+        EXPECT_LE(m.transition_accel_ratio, 0.9) << name << " dt " << dt;
+      });
 }
 
 // Turning the body over a planted foot twists the leg, not the foot (issue 29, foot pivot <=
 // 25 deg/s): on the scripts where labelled contacts sweep in at landings or out at push-offs,
 // and where a held heading was kept on a foot the blend had lifted, at every rate.
 TEST(FootFloorTest, PlantedFeetPivotNoFasterThanTheTarget) {
-  const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
-  for (const char* name : {"walk-run.txt", "reversals.txt"}) {
-    Result<InputScript> script =
-        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
-    ASSERT_TRUE(script.ok()) << script.message();
-    for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
-      EvaluationOptions options;
-      options.dt = dt;
-      Result<EvaluationResult> run = evaluate_script(shared, *script, options);
-      ASSERT_TRUE(run.ok()) << run.message();
-      EXPECT_GT(run->metrics.foot_pivot_frames, 100) << name << " dt " << dt;
-      EXPECT_LE(run->metrics.foot_pivot_deg_s_mean, 25.0) << name << " dt " << dt;
-    }
-  }
+  for_each_run({"walk-run.txt", "reversals.txt"}, kEveryRate,
+               [](const char* name, float dt, const EvaluationMetrics& m) {
+                 EXPECT_GT(m.foot_pivot_frames, 100) << name << " dt " << dt;
+                 EXPECT_LE(m.foot_pivot_deg_s_mean, 25.0) << name << " dt " << dt;
+               });
 }
 
 // Each frame's foot direction (ankle to toe) of both legs, and the toes' heights.
