@@ -111,6 +111,8 @@ struct CrowdTimes {
   // per frame, and each thread's wall time stepping characters (frame-major).
   std::vector<double> plan_seconds;
   std::vector<double> step_wall_seconds;
+  // Budgeted runs: each thread's steps by kind, per frame (frame-major, threads per frame).
+  std::vector<CrowdFrameRecord> step_records;
 };
 
 // The mean update time (microseconds) over frames [first, last), of the updates that were
@@ -264,9 +266,10 @@ Result<ScheduledCrowd> make_scheduled_crowd(
 }
 
 // Steps character i at game time t and keeps its position; returns the step's wall time (s)
-// when `timed`, else NaN, and adds what its update spent searching to `search`.
+// when `timed`, else NaN, adds what its update spent searching to `search`, and counts the
+// step by kind into `record` when there is one.
 float step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double& search,
-                     bool timed = false) {
+                     bool timed = false, CrowdFrameRecord* record = nullptr) {
   const bool updates = crowd.scheduler.updates(i);
   const ControllerInput& input = updates ? scripted_input(crowd, i, t) : kNoInput;
   Controller& controller = crowd.controllers[i];
@@ -280,6 +283,11 @@ float step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double&
   }
   crowd.positions[i] = controller.root_transform().translation;
   if (updates) search += controller.debug().search_seconds;
+  if (record != nullptr && updates) {
+    ++record->steps[static_cast<size_t>(crowd.scheduler.tier(i))];
+    record->searches += controller.debug().searched ? 1 : 0;
+    record->transitions += controller.debug().transitioned ? 1 : 0;
+  }
   return elapsed;
 }
 
@@ -312,6 +320,7 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
   times.step_cpu_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
   times.step_wall_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
   times.plan_seconds.assign(frames, 0.0);
+  times.step_records.assign(frames * static_cast<size_t>(threads), CrowdFrameRecord{});
   auto worker = [&](int index) {
     Clock::time_point frame_start = Clock::now();
     for (size_t f = 0; f < frames; ++f) {
@@ -330,16 +339,18 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
       sync.arrive_and_wait();
       const Clock::time_point steps_start = Clock::now();
       const double cpu_start = thread_cpu_seconds();
+      const size_t slot = f * static_cast<size_t>(threads) + static_cast<size_t>(index);
+      CrowdFrameRecord& record = times.step_records[slot];
       for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
         for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
           if (i + 2 < n) crowd.scheduler.prefetch_ahead(i + 2, crowd.controllers[i + 2]);
           if (i + 1 < n) crowd.scheduler.prefetch(i + 1, crowd.controllers[i + 1]);
           const bool timed = (i + f) % kTimedEvery == 0;
           times.update_us[f * n + i] =
-              step_character(crowd, i, t, options.dt, times.search_seconds[i], timed) * 1e6f;
+              step_character(crowd, i, t, options.dt, times.search_seconds[i], timed, &record) *
+              1e6f;
         }
       }
-      const size_t slot = f * static_cast<size_t>(threads) + static_cast<size_t>(index);
       times.step_cpu_seconds[slot] = thread_cpu_seconds() - cpu_start;
       times.step_wall_seconds[slot] =
           std::chrono::duration<double>(Clock::now() - steps_start).count();
@@ -370,6 +381,7 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
                    std::vector<double>(frames, 0.0),
                    std::vector<double>(n, 0.0),
                    std::vector<double>(n, 0.0),
+                   {},
                    {},
                    {},
                    {}};
@@ -420,6 +432,21 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
   result.frame_ms.assign(times.frame_seconds.begin() + static_cast<std::ptrdiff_t>(warm),
                          times.frame_seconds.end());
   for (double& ms : result.frame_ms) ms *= 1e3;
+  result.frame_records.resize(frames - warm);
+  for (size_t f = warm; f < frames; ++f) {
+    CrowdFrameRecord& record = result.frame_records[f - warm];
+    record.frame_ms = static_cast<float>(times.frame_seconds[f] * 1e3);
+    record.plan_ms = static_cast<float>(times.plan_seconds[f] * 1e3);
+    record.planned_us = static_cast<float>(plans.planned_us[f]);
+    for (size_t k = 0; k < static_cast<size_t>(threads); ++k) {
+      const size_t slot = f * static_cast<size_t>(threads) + k;
+      record.work_ms += static_cast<float>(times.step_cpu_seconds[slot] * 1e3);
+      const CrowdFrameRecord& part = times.step_records[slot];
+      for (size_t t = 0; t < record.steps.size(); ++t) record.steps[t] += part.steps[t];
+      record.searches += part.searches;
+      record.transitions += part.transitions;
+    }
+  }
   const size_t joints = crowd->scheduler.joints();
   result.final_poses.resize(n * joints);
   for (size_t i = 0; i < n; ++i) {
@@ -462,6 +489,7 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
                    std::vector<double>(frames, 0.0),
                    std::vector<double>(n, 0.0),
                    std::vector<double>(n, 0.0),
+                   {},
                    {},
                    {},
                    {}};
@@ -604,6 +632,7 @@ Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
                      std::vector<double>(frames, 0.0),
                      std::vector<double>(n, 0.0),
                      std::vector<double>(n, 0.0),
+                     {},
                      {},
                      {},
                      {}};

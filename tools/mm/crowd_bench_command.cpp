@@ -29,6 +29,8 @@ struct Arguments {
   std::string db_path;
   std::string json_path;
   std::string world_path;
+  std::string frames_csv_path;
+  bool budget_only = false;
   CrowdOptions options;
   int extra_threads = 0;
   double budget_ms = 0.0;            // 0: none
@@ -100,6 +102,14 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
       ->delimiter(',')
       ->type_name("F,H,Q,M");
   app.add_option("--json", out.json_path, "also write the results as JSON")->type_name("FILE");
+  app.add_option("--frames-csv", out.frames_csv_path,
+                 "with --budget-ms: also write every steady frame of the budgeted runs as CSV "
+                 "(thread count, frame, frame/plan/work ms, updates per tier, move steps, "
+                 "searches, transitions, planned us), to find what makes a frame dear")
+      ->type_name("FILE");
+  app.add_flag("--budget-only", out.budget_only,
+               "with --budget-ms: leave out the full-rate runs (their max_characters_60hz "
+               "figures), for quicker measurements of the budgeted crowd");
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   return check_settings(app, out.options.settings);
 }
@@ -140,6 +150,23 @@ nlohmann::json report_run(const CrowdResult& run) {
           {"work_ms_mean", run.work_ms_mean},
           {"work_ms_p99", run.work_ms_p99},
           {"max_characters_60hz", run.max_characters_60hz}};
+}
+
+// Appends the steady frames of a budgeted run to the CSV at `path` (the header first when
+// `header`); false when it cannot be written.
+bool write_frame_records(const std::string& path, const CrowdResult& run, bool header) {
+  std::ofstream file(path, header ? std::ios::trunc : std::ios::app);
+  if (header) {
+    file << "threads,frame,frame_ms,plan_ms,work_ms,full_updates,half_updates,quarter_updates,"
+            "moves,searches,transitions,planned_us\n";
+  }
+  for (size_t f = 0; f < run.frame_records.size(); ++f) {
+    const CrowdFrameRecord& r = run.frame_records[f];
+    file << run.threads << ',' << f << ',' << r.frame_ms << ',' << r.plan_ms << ',' << r.work_ms
+         << ',' << r.steps[0] << ',' << r.steps[1] << ',' << r.steps[2] << ',' << r.steps[3] << ','
+         << r.searches << ',' << r.transitions << ',' << r.planned_us << '\n';
+  }
+  return static_cast<bool>(file);
 }
 
 // Whether a run ends in the reference's poses, exactly.
@@ -186,6 +213,12 @@ std::optional<bool> run_thread_counts(const std::shared_ptr<const ControllerData
       return std::nullopt;
     }
     json["runs"].push_back(report_run(*run));
+    if (options.lod && !arguments.frames_csv_path.empty() &&
+        !write_frame_records(arguments.frames_csv_path, *run, reference.empty())) {
+      std::fprintf(stderr, "mm crowd-bench: could not write %s\n",
+                   arguments.frames_csv_path.c_str());
+      return std::nullopt;
+    }
     if (options.lod) {
       std::printf(
           "%8s tiers at the end: full %d, half %d, quarter %d, move_only %d; fewest at "
@@ -363,7 +396,10 @@ int run_crowd_bench(const std::vector<std::string>& args) {
     full_rate.options.seconds = std::min(arguments.options.seconds, kFullRateSecondsBesideBudget);
     std::printf("at full rate:\n");
   }
-  std::optional<bool> same = run_thread_counts(*shared, full_rate, json);
+  std::optional<bool> same = true;
+  if (!(arguments.budget_only && arguments.budget_ms > 0.0)) {
+    same = run_thread_counts(*shared, full_rate, json);
+  }
   if (!same) return 1;
   if (arguments.budget_ms > 0.0) {
     const std::optional<bool> same_budgeted = run_budget(*shared, arguments, json);
