@@ -25,6 +25,11 @@
 namespace mm::cli {
 namespace {
 
+// The share of the budget the plan holds back by default (CrowdSchedulerSettings::headroom):
+// the 2-thread frames' p99 on a quiet machine was 1.39 times their mean, and the cost model
+// undercounted the 2-thread work by a tenth (docs/crowd.md, "crowd5"), so a plan that fills the
+// budget makes its mean frame, not its p99, fit.
+constexpr double kDefaultBudgetHeadroom = 0.25;
 struct Arguments {
   std::string db_path;
   std::string json_path;
@@ -33,7 +38,8 @@ struct Arguments {
   bool budget_only = false;
   CrowdOptions options;
   int extra_threads = 0;
-  double budget_ms = 0.0;            // 0: none
+  double budget_ms = 0.0;  // 0: none
+  double budget_headroom = kDefaultBudgetHeadroom;
   std::vector<float> tier_costs_us;  // empty: calibrated
 };
 
@@ -95,6 +101,12 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "of the run; the full-rate runs beside it then last at most 10 s")
       ->check(number_over(0.0, 1000.0))
       ->type_name("MS");
+  app.add_option("--budget-headroom", out.budget_headroom,
+                 "the share of the budget the plan leaves unspent, for frames dearer than the "
+                 "cost model (taken from the tiers below full rate; default " +
+                     std::to_string(kDefaultBudgetHeadroom).substr(0, 4) + ")")
+      ->check(number_in(0.0, 0.95))
+      ->type_name("SHARE");
   app.add_option("--tier-costs-us", out.tier_costs_us,
                  "the budget's cost model: work per character per frame (us) at full, half, "
                  "quarter and move_only; default: measured before the runs")
@@ -312,6 +324,7 @@ std::optional<bool> run_budget(const std::shared_ptr<const ControllerDatabase>& 
   CrowdSchedulerSettings lod;
   lod.budget_ms = static_cast<float>(arguments.budget_ms);
   lod.threads = std::max(2, arguments.extra_threads);
+  lod.headroom = static_cast<float>(arguments.budget_headroom);
   budgeted.options.lod = lod;
   const std::optional<std::array<float, kCrowdTierCount>> costs = tier_costs(shared, budgeted);
   if (!costs) return std::nullopt;
@@ -327,16 +340,17 @@ std::optional<bool> run_budget(const std::shared_ptr<const ControllerDatabase>& 
         (*costs)[static_cast<size_t>(t)];
   }
   std::printf(
-      "under a budget of %.2f ms per frame, planned for %d threads; cost model (us per character "
-      "per frame): full %.2f, half %.2f, quarter %.2f, move_only %.2f\n",
-      arguments.budget_ms, lod.threads, static_cast<double>((*costs)[0]),
-      static_cast<double>((*costs)[1]), static_cast<double>((*costs)[2]),
-      static_cast<double>((*costs)[3]));
+      "under a budget of %.2f ms per frame, planned for %d threads, %.0f%% of it held back; cost "
+      "model (us per character per frame): full %.2f, half %.2f, quarter %.2f, move_only %.2f\n",
+      arguments.budget_ms, lod.threads, 100.0 * arguments.budget_headroom,
+      static_cast<double>((*costs)[0]), static_cast<double>((*costs)[1]),
+      static_cast<double>((*costs)[2]), static_cast<double>((*costs)[3]));
   nlohmann::json runs;
   const std::optional<bool> same = run_thread_counts(shared, budgeted, runs);
   if (!same) return std::nullopt;
   json["budget_ms"] = arguments.budget_ms;
   json["budget_threads"] = lod.threads;
+  json["budget_headroom"] = arguments.budget_headroom;
   json["tier_cost_us"] = costs_json;
   json["budget_runs"] = runs["runs"];
   for (const char* key : {"frame_ms_mean", "frame_ms_p99", "tier_counts"}) json[key] = runs[key];
