@@ -406,12 +406,12 @@ int run_crowd_bench(const std::vector<std::string>& args) {
   }
   // Beside a budget, the full-rate runs are short (kFullRateSecondsBesideBudget).
   Arguments full_rate = arguments;
-  if (arguments.budget_ms > 0.0) {
-    full_rate.options.seconds = std::min(arguments.options.seconds, kFullRateSecondsBesideBudget);
-    std::printf("at full rate:\n");
-  }
   std::optional<bool> same = true;
   if (!(arguments.budget_only && arguments.budget_ms > 0.0)) {
+    if (arguments.budget_ms > 0.0) {
+      full_rate.options.seconds = std::min(arguments.options.seconds, kFullRateSecondsBesideBudget);
+      std::printf("at full rate:\n");
+    }
     same = run_thread_counts(*shared, full_rate, json);
   }
   if (!same) return 1;
