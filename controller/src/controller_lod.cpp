@@ -23,8 +23,13 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
   // motion of the whole pose, so the body is neither bent nor stretched.
   const glm::quat turn =
       glm::angleAxis(wrap_angle(quat_yaw(sim_rotation_) - yaw_before), glm::vec3(0.0f, 1.0f, 0.0f));
-  const glm::vec3 root = sim_position_ + turn * (locals_[0].translation - before);
-  move_root(root, glm::normalize(turn * locals_[0].rotation));
+  // The root alone moves; the playback's anchor (move_root: the transition's source, the
+  // sampled root and its velocities) is re-anchored once, at settle_carried_pose(), to where the
+  // moves ended: it depends only on the root then, and re-anchoring on every move sampled the
+  // database's root and turned the velocities for nothing that a move reads.
+  Transform& root = locals_[0];
+  root.translation = sim_position_ + turn * (root.translation - before);
+  root.rotation = glm::normalize(turn * root.rotation);
   if (!pose_carried_) {
     // The first move after a posed frame: the other joints stay behind, hanging from the root
     // as it is now. Held toes would pull the legs back to where the character was; the body's
@@ -58,6 +63,8 @@ Transform Controller::carried_from() const {
 void Controller::settle_carried_pose() {
   if (!pose_carried_) return;
   pose_carried_ = false;
+  const Transform moved = locals_[0];
+  move_root(moved.translation, moved.rotation);
   // The rigid motion from where the held joints hang to where the root is: a turn about +Y
   // (each move turned the root about the vertical) and a translation.
   const Transform& root = globals_[0];
@@ -90,27 +97,21 @@ void Controller::prefetch_move_only_members() const {
   prefetch_lines(&sim_position_,
                  static_cast<size_t>(reinterpret_cast<const char*>(&clip_time_) -
                                      reinterpret_cast<const char*>(&sim_position_)));
-  prefetch_lines(&transition_src_position_, sizeof(transition_src_position_) * 4);
   prefetch_lines(&settings_.max_dt, sizeof(settings_.max_dt));
-  prefetch_lines(&root_offsets_, sizeof(root_offsets_));
   prefetch_lines(&feet_, sizeof(feet_));
   prefetch_lines(&last_root_, sizeof(last_root_));
   prefetch_lines(&debug_.searched, sizeof(debug_.searched));
   prefetch_lines(&debug_.transitioned, sizeof(debug_.transitioned));
   prefetch_lines(&debug_.search_seconds, sizeof(debug_.search_seconds));
   prefetch_lines(&pose_carried_, sizeof(pose_carried_));
-  prefetch_lines(&sampled_, sizeof(sampled_));
   prefetch_lines(&locals_, sizeof(locals_));
   prefetch_lines(&globals_, sizeof(globals_));
   prefetch_lines(&world_globals_, sizeof(world_globals_));
 }
 
 void Controller::prefetch_move_only() const {
-  // The poses and the root's offsets are heap arrays: their pointers are read here (from the
-  // lines prefetch_move_only_members() asked for a step earlier).
-  prefetch_lines(root_offsets_.rotations.data(), sizeof(glm::vec3));
-  prefetch_lines(root_offsets_.positions.data(), sizeof(glm::vec3));
-  prefetch_lines(sampled_.data(), sizeof(Transform));
+  // The poses are heap arrays: their pointers are read here (from the lines
+  // prefetch_move_only_members() asked for a step earlier).
   prefetch_lines(locals_.data(), sizeof(Transform));
   // Only the root moves (the rest of the pose is carried, not rewritten).
   prefetch_lines(globals_.data(), sizeof(Transform));

@@ -55,6 +55,9 @@ Status CrowdSchedulerSettings::validate() const {
   if (!(full_share >= 0.0f && full_share <= 1.0f)) {
     return Error{"crowd scheduler: full_share must be in [0, 1]"};
   }
+  if (!(headroom >= 0.0f && headroom < 1.0f)) {
+    return Error{"crowd scheduler: headroom must be in [0, 1)"};
+  }
   if (!std::isfinite(hysteresis) || !(hysteresis >= 0.0f)) {
     return Error{"crowd scheduler: hysteresis must be a number >= 0"};
   }
@@ -102,9 +105,12 @@ void CrowdScheduler::plan(std::span<const float> significance) {
   MM_ASSERT(significance.size() == tier_.size());
   const double capacity =
       static_cast<double>(settings_.budget_ms) * 1000.0 * static_cast<double>(settings_.threads);
+  // What the plan may spend: the capacity less the headroom kept for frames dearer than the
+  // model says.
+  const double spendable = capacity * (1.0 - static_cast<double>(settings_.headroom));
   const double n = static_cast<double>(tier_.size());
   if (settings_.budget_ms == 0.0f || !std::isfinite(capacity) ||
-      n * settings_.cost_us[0] <= capacity) {
+      n * settings_.cost_us[0] <= spendable) {
     plan_all(CrowdTier::Full);
     return;
   }
@@ -113,13 +119,13 @@ void CrowdScheduler::plan(std::span<const float> significance) {
   // none can: over budget, the least work there is).
   CrowdTier floor = CrowdTier::MoveOnly;
   for (int t = 1; t < kCrowdTierCount; ++t) {
-    if (n * settings_.cost_us[static_cast<size_t>(t)] <= capacity) {
+    if (n * settings_.cost_us[static_cast<size_t>(t)] <= spendable) {
       floor = static_cast<CrowdTier>(t);
       break;
     }
   }
   rank(significance);
-  assign(floor, capacity);
+  assign(floor, capacity, spendable);
 }
 
 void CrowdScheduler::plan_all(CrowdTier tier) {
@@ -166,9 +172,9 @@ void CrowdScheduler::rank(std::span<const float> significance) {
 }
 
 // Everyone at the floor; then the most significant at full rate, within full_share of the
-// capacity; then the rest raised a tier at a time, in rank order, while the capacity lasts.
-// Each pass stops at the first character it cannot raise, so tiers never rise with rank.
-void CrowdScheduler::assign(CrowdTier floor, double capacity) {
+// capacity; then the rest raised a tier at a time, in rank order, while what may be spent
+// lasts. Each pass stops at the first character it cannot raise, so tiers never rise with rank.
+void CrowdScheduler::assign(CrowdTier floor, double capacity, double spendable) {
   const auto& cost = settings_.cost_us;
   const size_t n = order_.size();
   const size_t lowest = static_cast<size_t>(floor);
@@ -178,14 +184,16 @@ void CrowdScheduler::assign(CrowdTier floor, double capacity) {
   size_t top = 0;
   for (; top < n; ++top) {
     const double raise = cost[0] - cost[lowest];
-    if (static_cast<double>(top + 1) * cost[0] > full_capacity || spent + raise > capacity) break;
+    if (static_cast<double>(top + 1) * cost[0] > full_capacity || spent + raise > spendable) {
+      break;
+    }
     tier_[order_[top]] = 0;
     spent += raise;
   }
   for (size_t level = lowest; level-- > 0;) {
     const double raise = cost[level] - cost[level + 1];
     for (size_t r = top; r < n && tier_[order_[r]] == level + 1; ++r) {
-      if (spent + raise > capacity) break;
+      if (spent + raise > spendable) break;
       tier_[order_[r]] = static_cast<uint8_t>(level);
       spent += raise;
     }

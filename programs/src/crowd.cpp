@@ -4,6 +4,7 @@
 #include "mm/programs/crowd.hpp"
 #include "mm/programs/ground_metrics.hpp"
 #include "mm/runtime/float_to_integer.hpp"
+#include "statistics.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -98,7 +99,8 @@ Result<std::vector<Controller>> make_characters(
   return characters;
 }
 
-// What the frames of a run measured, frame-major: update_us[f * characters + i].
+// What the frames of a run measured, frame-major: update_us[f * characters + i] (runs at full
+// rate; a budgeted run keeps its sampled steps' times in fixed memory, below).
 struct CrowdTimes {
   std::vector<float> update_us;
   std::vector<double> frame_seconds;   // barrier to barrier
@@ -111,7 +113,28 @@ struct CrowdTimes {
   // per frame, and each thread's wall time stepping characters (frame-major).
   std::vector<double> plan_seconds;
   std::vector<double> step_wall_seconds;
+  // Budgeted runs: each thread's steps by kind, per frame (frame-major, threads per frame).
+  std::vector<CrowdFrameRecord> step_records;
+  // Budgeted runs: the timed steps (one in kTimedEvery), per frame and thread their summed time
+  // (us) and count (frame-major), and per thread the histogram of their times for the p99: memory
+  // by frames and threads, not by frames and characters (a 120 s run of 10,000 characters kept
+  // 288 MB of per-step times).
+  std::vector<double> timed_us_sum;
+  std::vector<uint32_t> timed_count;
+  std::vector<detail::PercentileHistogram> timed_us;
 };
+
+// The mean time (us) of a budgeted run's timed steps over frames [first, last).
+double mean_timed_us(const CrowdTimes& times, size_t first, size_t last) {
+  const size_t threads = times.timed_us.size();
+  double sum = 0.0;
+  size_t count = 0;
+  for (size_t k = first * threads; k < last * threads; ++k) {
+    sum += times.timed_us_sum[k];
+    count += times.timed_count[k];
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
 
 // The mean update time (microseconds) over frames [first, last), of the updates that were
 // timed (a budgeted run times a sample of them; the others are NaN).
@@ -133,7 +156,9 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
   const size_t frames = times.frame_seconds.size();
   const size_t steady = replay_start;
   CrowdResult result;
-  result.update_us_mean = mean_update_us(times, n, 0, steady);
+  const bool sampled = times.update_us.empty();  // a budgeted run's fixed-memory timings
+  result.update_us_mean =
+      sampled ? mean_timed_us(times, 0, steady) : mean_update_us(times, n, 0, steady);
   double search = 0.0, replay = 0.0;
   for (size_t i = 0; i < n; ++i) {
     search += times.search_seconds[i];
@@ -141,9 +166,11 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
   }
   const double update = result.update_us_mean * 1e-6 * static_cast<double>(n * steady);
   result.search_share = update > 0.0 ? std::min(1.0, search / update) : 0.0;
-  result.update_us_last_window = mean_update_us(times, n, frames - window, frames);
-  result.update_us_first_window = steady == frames ? mean_update_us(times, n, 0, window)
-                                                   : replay * 1e6 / static_cast<double>(n * window);
+  result.update_us_last_window = sampled ? mean_timed_us(times, frames - window, frames)
+                                         : mean_update_us(times, n, frames - window, frames);
+  result.update_us_first_window = steady != frames ? replay * 1e6 / static_cast<double>(n * window)
+                                  : sampled        ? mean_timed_us(times, 0, window)
+                                                   : mean_update_us(times, n, 0, window);
   // The frames' figures leave the start out (warm_up_frames).
   const size_t warm = warm_up_frames(steady, dt);
   double frame_seconds = 0.0;
@@ -154,6 +181,12 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
       p99(std::span<double>(times.frame_seconds.data() + warm, steady - warm)) * 1e3;
   result.max_characters_60hz =
       clamped_integer<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / frame_mean));
+  if (sampled) {
+    detail::PercentileHistogram all;
+    for (const detail::PercentileHistogram& thread : times.timed_us) all.merge(thread);
+    result.update_us_p99 = all.percentile(99.0);
+    return result;
+  }
   // The p99 of the steady frames' timed updates, which come first in the frame-major times.
   const auto untimed = std::partition(
       times.update_us.begin(), times.update_us.begin() + static_cast<std::ptrdiff_t>(steady * n),
@@ -264,9 +297,10 @@ Result<ScheduledCrowd> make_scheduled_crowd(
 }
 
 // Steps character i at game time t and keeps its position; returns the step's wall time (s)
-// when `timed`, else NaN, and adds what its update spent searching to `search`.
+// when `timed`, else NaN, adds what its update spent searching to `search`, and counts the
+// step by kind into `record` when there is one.
 float step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double& search,
-                     bool timed = false) {
+                     bool timed = false, CrowdFrameRecord* record = nullptr) {
   const bool updates = crowd.scheduler.updates(i);
   const ControllerInput& input = updates ? scripted_input(crowd, i, t) : kNoInput;
   Controller& controller = crowd.controllers[i];
@@ -280,6 +314,11 @@ float step_character(ScheduledCrowd& crowd, size_t i, float t, float dt, double&
   }
   crowd.positions[i] = controller.root_transform().translation;
   if (updates) search += controller.debug().search_seconds;
+  if (record != nullptr && updates) {
+    ++record->steps[static_cast<size_t>(crowd.scheduler.tier(i))];
+    record->searches += controller.debug().searched ? 1 : 0;
+    record->transitions += controller.debug().transitioned ? 1 : 0;
+  }
   return elapsed;
 }
 
@@ -312,6 +351,12 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
   times.step_cpu_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
   times.step_wall_seconds.assign(frames * static_cast<size_t>(threads), 0.0);
   times.plan_seconds.assign(frames, 0.0);
+  times.step_records.assign(frames * static_cast<size_t>(threads), CrowdFrameRecord{});
+  times.timed_us_sum.assign(frames * static_cast<size_t>(threads), 0.0);
+  times.timed_count.assign(frames * static_cast<size_t>(threads), 0);
+  times.timed_us.assign(static_cast<size_t>(threads), detail::PercentileHistogram{});
+  // The histograms' bins are allocated by their first value: before the frames.
+  for (detail::PercentileHistogram& histogram : times.timed_us) histogram.reserve();
   auto worker = [&](int index) {
     Clock::time_point frame_start = Clock::now();
     for (size_t f = 0; f < frames; ++f) {
@@ -330,16 +375,23 @@ void run_scheduled_frames(ScheduledCrowd& crowd, const CrowdOptions& options, in
       sync.arrive_and_wait();
       const Clock::time_point steps_start = Clock::now();
       const double cpu_start = thread_cpu_seconds();
+      const size_t slot = f * static_cast<size_t>(threads) + static_cast<size_t>(index);
+      CrowdFrameRecord& record = times.step_records[slot];
       for (size_t first = next.fetch_add(kChunk); first < n; first = next.fetch_add(kChunk)) {
         for (size_t i = first; i < std::min(n, first + kChunk); ++i) {
           if (i + 2 < n) crowd.scheduler.prefetch_ahead(i + 2, crowd.controllers[i + 2]);
           if (i + 1 < n) crowd.scheduler.prefetch(i + 1, crowd.controllers[i + 1]);
           const bool timed = (i + f) % kTimedEvery == 0;
-          times.update_us[f * n + i] =
-              step_character(crowd, i, t, options.dt, times.search_seconds[i], timed) * 1e6f;
+          const float us =
+              step_character(crowd, i, t, options.dt, times.search_seconds[i], timed, &record) *
+              1e6f;
+          if (timed) {
+            times.timed_us[static_cast<size_t>(index)].add(us);
+            times.timed_us_sum[slot] += us;
+            ++times.timed_count[slot];
+          }
         }
       }
-      const size_t slot = f * static_cast<size_t>(threads) + static_cast<size_t>(index);
       times.step_cpu_seconds[slot] = thread_cpu_seconds() - cpu_start;
       times.step_wall_seconds[slot] =
           std::chrono::duration<double>(Clock::now() - steps_start).count();
@@ -366,13 +418,10 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
   Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, options, n, *options.lod);
   if (!crowd) return Error{crowd.message()};
   const int threads = std::min<int>(options.threads, options.characters);
-  CrowdTimes times{std::vector<float>(frames * n),
-                   std::vector<double>(frames, 0.0),
-                   std::vector<double>(n, 0.0),
-                   std::vector<double>(n, 0.0),
-                   {},
-                   {},
-                   {}};
+  CrowdTimes times;
+  times.frame_seconds.assign(frames, 0.0);
+  times.search_seconds.assign(n, 0.0);
+  times.replay_seconds.assign(n, 0.0);
   PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                    std::vector<double>(frames, 0.0)};
   const auto start = std::chrono::steady_clock::now();
@@ -420,6 +469,21 @@ Result<CrowdResult> run_budgeted(const std::shared_ptr<const ControllerDatabase>
   result.frame_ms.assign(times.frame_seconds.begin() + static_cast<std::ptrdiff_t>(warm),
                          times.frame_seconds.end());
   for (double& ms : result.frame_ms) ms *= 1e3;
+  result.frame_records.resize(frames - warm);
+  for (size_t f = warm; f < frames; ++f) {
+    CrowdFrameRecord& record = result.frame_records[f - warm];
+    record.frame_ms = static_cast<float>(times.frame_seconds[f] * 1e3);
+    record.plan_ms = static_cast<float>(times.plan_seconds[f] * 1e3);
+    record.planned_us = static_cast<float>(plans.planned_us[f]);
+    for (size_t k = 0; k < static_cast<size_t>(threads); ++k) {
+      const size_t slot = f * static_cast<size_t>(threads) + k;
+      record.work_ms += static_cast<float>(times.step_cpu_seconds[slot] * 1e3);
+      const CrowdFrameRecord& part = times.step_records[slot];
+      for (size_t t = 0; t < record.steps.size(); ++t) record.steps[t] += part.steps[t];
+      record.searches += part.searches;
+      record.transitions += part.transitions;
+    }
+  }
   const size_t joints = crowd->scheduler.joints();
   result.final_poses.resize(n * joints);
   for (size_t i = 0; i < n; ++i) {
@@ -458,13 +522,11 @@ Result<CrowdResult> run_crowd(std::shared_ptr<const ControllerDatabase> database
   }
 
   const int threads = std::min<int>(options.threads, options.characters);
-  CrowdTimes times{std::vector<float>(frames * n),
-                   std::vector<double>(frames, 0.0),
-                   std::vector<double>(n, 0.0),
-                   std::vector<double>(n, 0.0),
-                   {},
-                   {},
-                   {}};
+  CrowdTimes times;
+  times.update_us.assign(frames * n, 0.0f);
+  times.frame_seconds.assign(frames, 0.0);
+  times.search_seconds.assign(n, 0.0);
+  times.replay_seconds.assign(n, 0.0);
   std::barrier sync(threads);
   using Clock = std::chrono::steady_clock;
   // Every update's time, replays included, summed per thread: what the world's share is of.
@@ -600,13 +662,10 @@ Result<std::array<float, kCrowdTierCount>> calibrate_crowd_tiers(
   for (int tier = 0; tier < kCrowdTierCount; ++tier) {
     Result<ScheduledCrowd> crowd = make_scheduled_crowd(database, calibration, n, settings);
     if (!crowd) return Error{crowd.message()};
-    CrowdTimes times{std::vector<float>(frames * n),
-                     std::vector<double>(frames, 0.0),
-                     std::vector<double>(n, 0.0),
-                     std::vector<double>(n, 0.0),
-                     {},
-                     {},
-                     {}};
+    CrowdTimes times;
+    times.frame_seconds.assign(frames, 0.0);
+    times.search_seconds.assign(n, 0.0);
+    times.replay_seconds.assign(n, 0.0);
     PlanRecord plans{std::vector<std::array<int, kCrowdTierCount>>(frames),
                      std::vector<double>(frames, 0.0)};
     run_scheduled_frames(*crowd, calibration, threads, times, plans, static_cast<CrowdTier>(tier));

@@ -43,6 +43,21 @@ class PercentileHistogram {
   size_t count() const { return count_; }
   double max() const { return count_ > 0 ? max_ : 0.0; }
 
+  // Allocates the bins now rather than at the first value (before a timed loop).
+  void reserve() {
+    if (bins_.empty()) bins_.assign(kBinCount, 0);
+  }
+
+  // Counts `other`'s values as if they had been added here (e.g. one histogram per thread).
+  void merge(const PercentileHistogram& other) {
+    if (other.count_ == 0) return;
+    if (bins_.empty()) bins_.assign(kBinCount, 0);
+    for (size_t bin = 0; bin < kBinCount; ++bin) bins_[bin] += other.bins_[bin];
+    min_ = count_ == 0 ? other.min_ : std::min(min_, other.min_);
+    max_ = count_ == 0 ? other.max_ : std::max(max_, other.max_);
+    count_ += other.count_;
+  }
+
   // The p-th percentile (0..100) by nearest rank (see the class); 0 for no values.
   double percentile(double p) const {
     if (count_ == 0) return 0.0;

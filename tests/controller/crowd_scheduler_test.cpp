@@ -63,6 +63,11 @@ TEST(CrowdScheduler, RefusesBadSettingsByMessage) {
   s.full_share = 1.5f;
   EXPECT_EQ(message(s), "crowd scheduler: full_share must be in [0, 1]");
   s = {};
+  s.headroom = 1.0f;
+  EXPECT_EQ(message(s), "crowd scheduler: headroom must be in [0, 1)");
+  s.headroom = -0.1f;
+  EXPECT_EQ(message(s), "crowd scheduler: headroom must be in [0, 1)");
+  s = {};
   s.blend_halflife = 0.0f;
   EXPECT_EQ(message(s), "crowd scheduler: blend_halflife must be a positive number of seconds");
   Result<CrowdScheduler> none = CrowdScheduler::create(0, 4, CrowdSchedulerSettings{});
@@ -102,6 +107,33 @@ TEST(CrowdScheduler, TheBudgetIsSpentByTheCostModel) {
   CrowdScheduler doubled = make_scheduler(12, two);
   doubled.plan(significance);
   EXPECT_EQ(doubled.tier_counts(), counts(1, 1, 4, 6));
+}
+
+// 20 characters at 60 us with half of it held back: 30 us to spend. The floor is move_only (20 *
+// 2 = 40 > 30), 10 us; full rate may take 0.4 of the whole 60 us (three characters) but the
+// third would bring the plan to 32.5: two (25); then quarters +1.5 each: three (29.5). The same
+// crowd under a plain 30 us budget gets one at full rate (full_share of 30 is 12 us) and eight at
+// quarter: the headroom comes out of the tiers below full.
+TEST(CrowdScheduler, TheHeadroomIsTakenFromTheTiersBelowFull) {
+  CrowdSchedulerSettings held = budgeted(60.0f);
+  held.headroom = 0.5f;
+  CrowdScheduler scheduler = make_scheduler(20, held);
+  std::vector<float> significance(20);
+  for (size_t i = 0; i < 20; ++i) significance[i] = -static_cast<float>(i);
+  scheduler.plan(significance);
+  EXPECT_EQ(scheduler.tier_counts(), counts(2, 0, 3, 15));
+  EXPECT_DOUBLE_EQ(scheduler.planned_cost_us(), 29.5);
+  CrowdScheduler plain = make_scheduler(20, budgeted(30.0f));
+  plain.plan(significance);
+  EXPECT_EQ(plain.tier_counts(), counts(1, 0, 8, 11));
+  EXPECT_DOUBLE_EQ(plain.planned_cost_us(), 29.5);
+  // A budget that holds everyone at full rate only without the headroom: not all at full.
+  CrowdSchedulerSettings tight = budgeted(160.0f);
+  tight.headroom = 0.25f;
+  CrowdScheduler below = make_scheduler(20, tight);
+  below.plan(significance);
+  EXPECT_LT(below.tier_counts()[0], 20);
+  EXPECT_LE(below.planned_cost_us(), 120.0);
 }
 
 // Any budget, any crowd: the plan never exceeds the budget once the floor fits, and tiers never

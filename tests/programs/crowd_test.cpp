@@ -191,6 +191,26 @@ TEST(CrowdThreads, AnAmpleBudgetMovesTheCrowdAsTheLoopWithoutOne) {
   EXPECT_GE(budgeted->work_ms_p99, budgeted->work_ms_mean * 0.5);
   EXPECT_EQ(budgeted->frame_ms.size(), 6u * 60u - 60u);  // the steady frames: less the first second
   EXPECT_GT(budgeted->update_us_mean, 0.0);              // from the timed sample of the steps
+  // The timed sample is kept in fixed memory (sums per frame, a histogram): its p99 and windows.
+  EXPECT_GT(budgeted->update_us_p99, 0.0);
+  EXPECT_GT(budgeted->update_us_first_window, 0.0);
+  EXPECT_GT(budgeted->update_us_last_window, 0.0);
+  // Every steady frame's record: all 12 characters updated at full rate, none moved, and the
+  // frame's times as the run's.
+  ASSERT_EQ(budgeted->frame_records.size(), budgeted->frame_ms.size());
+  double work = 0.0;
+  int searches = 0;
+  for (size_t f = 0; f < budgeted->frame_records.size(); ++f) {
+    const CrowdFrameRecord& record = budgeted->frame_records[f];
+    EXPECT_EQ(record.steps[0], 12) << f;
+    EXPECT_EQ(record.steps[3], 0) << f;
+    EXPECT_FLOAT_EQ(record.frame_ms, static_cast<float>(budgeted->frame_ms[f])) << f;
+    work += record.work_ms;
+    searches += record.searches;
+  }
+  EXPECT_NEAR(work / static_cast<double>(budgeted->frame_records.size()), budgeted->work_ms_mean,
+              1e-3 * budgeted->work_ms_mean);
+  EXPECT_GT(searches, 0);
 }
 
 TEST(CrowdThreads, AnInvalidBudgetIsRefusedByMessage) {

@@ -327,12 +327,13 @@ TEST(ControllerCli, CrowdBenchUnderABudgetReportsTiersAndFrameTimes) {
   const fs::path json_path = dir / "crowd-budget.json";
   const CommandRun run = run_mm("crowd-bench --db '" + small_database().string() +
                                 "' --characters 24 --seconds 2 --budget-ms 0.05 --tier-costs-us "
-                                "8,3,2,0.5 --json '" +
+                                "8,3,2,0.5 --budget-headroom 0 --json '" +
                                 json_path.string() + "'");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json json = nlohmann::json::parse(read_text(json_path));
   EXPECT_TRUE(json["same_result_every_thread_count"].get<bool>());
   EXPECT_EQ(json["budget_ms"].get<double>(), 0.05);
+  EXPECT_EQ(json["budget_headroom"].get<double>(), 0.0);
   for (const char* key : {"frame_ms_mean", "frame_ms_p99", "max_characters_60hz_1_thread"}) {
     ASSERT_TRUE(json.contains(key)) << key;
     EXPECT_GT(json[key].get<double>(), 0.0) << key;
@@ -356,6 +357,20 @@ TEST(ControllerCli, CrowdBenchUnderABudgetReportsTiersAndFrameTimes) {
   }
   EXPECT_EQ(json["tier_cost_us"]["quarter"].get<double>(), 2.0);
   EXPECT_NE(run.output.find("tiers at the end: full 5, half 19"), std::string::npos) << run.output;
+
+  // The default headroom holds back a quarter: 75 us to spend, all at half (72 us), and raising
+  // one to full (+5) would pass it. --budget-only leaves out the full-rate runs.
+  const fs::path held_path = dir / "crowd-headroom.json";
+  const CommandRun held = run_mm("crowd-bench --db '" + small_database().string() +
+                                 "' --characters 24 --seconds 2 --budget-ms 0.05 --tier-costs-us "
+                                 "8,3,2,0.5 --budget-only --json '" +
+                                 held_path.string() + "'");
+  ASSERT_EQ(held.exit_code, 0) << held.output;
+  const nlohmann::json held_json = nlohmann::json::parse(read_text(held_path));
+  EXPECT_EQ(held_json["budget_headroom"].get<double>(), 0.25);
+  EXPECT_EQ(held_json["tier_counts"]["half"].get<int>(), 24);
+  EXPECT_FALSE(held_json.contains("max_characters_60hz_1_thread"));
+  EXPECT_EQ(held.output.find("at full rate"), std::string::npos) << held.output;
 
   const CommandRun bad =
       run_mm("crowd-bench --db '" + small_database().string() +

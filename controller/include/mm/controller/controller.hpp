@@ -441,7 +441,8 @@ class Controller {
   bool pose_carried() const { return pose_carried_; }
   // The root the held joints hang from while pose_carried() (world, as global_transforms()).
   Transform carried_from() const;
-  // Carries the held joints rigidly with the root (no effect unless pose_carried()).
+  // Carries the held joints rigidly with the root, and re-anchors the playback (the
+  // transition's source) to where the moves left the root (no effect unless pose_carried()).
   void settle_carried_pose();
 
   // Places the character and its simulation object (cold; clears any transition).

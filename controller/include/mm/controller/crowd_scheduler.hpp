@@ -59,6 +59,12 @@ struct CrowdSchedulerSettings {
   // rest is spread over the others a tier at a time (0: no character at full rate unless every
   // other is raised to half first).
   float full_share = 0.4f;
+  // The share of the budget the plan leaves unspent, so that the frames the cost model
+  // underestimates (the spread of real frames about their mean: other processes, cache misses,
+  // searches falling together) still fit: the plan spends (1 - headroom) of the capacity. It is
+  // taken from the tiers below full (full_share stays a share of the whole capacity), so the
+  // most significant characters keep their rate. 0: the plan spends the whole budget.
+  float headroom = 0.0f;
   // Hysteresis (significance units): a character ranks as if its significance were this much
   // higher per tier it holds above MoveOnly, so one near a tier's boundary is not swapped back
   // and forth by small changes of significance.
@@ -69,7 +75,7 @@ struct CrowdSchedulerSettings {
   float blend_halflife = 0.06f;
 
   // Finite, budget >= 0, threads in [1, 1024], costs positive and not increasing from Full to
-  // MoveOnly, full_share in [0, 1], hysteresis >= 0, blend_halflife > 0.
+  // MoveOnly, full_share in [0, 1], headroom in [0, 1), hysteresis >= 0, blend_halflife > 0.
   Status validate() const;
 };
 
@@ -135,7 +141,7 @@ class CrowdScheduler {
   CrowdScheduler() = default;
   enum class Step : uint8_t { None, Update, Hold, Move };
   void rank(std::span<const float> significance);
-  void assign(CrowdTier floor, double capacity);
+  void assign(CrowdTier floor, double capacity, double spendable);
   void start_blend(size_t i, std::span<const Transform> predicted);
   void keep_update(size_t i, const Controller& controller, Step now, Step last_step);
   // Joint j of the last step's pose: last_, carried when the step only moved.

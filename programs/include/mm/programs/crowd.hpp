@@ -56,6 +56,19 @@ struct CrowdOptions {
 // the characters' start area (half its extent across), once round every 60 s.
 glm::vec3 crowd_camera(const CrowdOptions& options, float t);
 
+// One frame of a budgeted run: its times, and the steps by kind that made its work.
+struct CrowdFrameRecord {
+  float frame_ms = 0.0f;  // barrier to barrier
+  float plan_ms = 0.0f;
+  float work_ms = 0.0f;  // the threads' CPU time stepping, all threads
+  // Controller updates by the tier of the character (a half- or quarter-rate character's
+  // update frames only), and Controller::update_move_only steps.
+  std::array<int, kCrowdTierCount> steps{};
+  int searches = 0;         // updates that searched
+  int transitions = 0;      // updates that jumped to a new frame
+  float planned_us = 0.0f;  // the plan's work by the cost model, averaged over periods
+};
+
 // The steady figures (mean, p99, search share, frame time, max characters) are over the frames
 // before the last window when the run has a replay (its frames carry twice the work), else over
 // the whole run.
@@ -98,6 +111,8 @@ struct CrowdResult {
   double work_ms_mean = 0.0;
   double work_ms_p99 = 0.0;
   std::vector<double> frame_ms;
+  // Budgeted runs: what each steady frame did, for finding what makes a frame dear.
+  std::vector<CrowdFrameRecord> frame_records;
 };
 
 // Runs the crowd. Fails on invalid options or settings.
