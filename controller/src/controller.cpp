@@ -1114,7 +1114,8 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
 }
 
 void Controller::finish_pose() {
-  fk_plan_.run(locals_, globals_);
+  // The pose is sampled from the database, which stores no scales: every scale is one.
+  fk_plan_.run_unit_scale(locals_, globals_);
   const Database& db = *db_;
   const ClipRange& clip = db.clips()[static_cast<size_t>(clip_)];
   const int frame =
