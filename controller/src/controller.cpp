@@ -681,15 +681,14 @@ void Controller::start_transition() {
 
 // The playing clip (sampled_, at the new time) through the running transitions into locals_.
 void Controller::show_transitions(float dt) {
-  const float halflife = settings_.inertialization_halflife;
+  const CriticalSpringStep& step = offset_step_.step(settings_.inertialization_halflife, dt);
   inertialize_update(root_offsets_,
-                     root_part(sampled_, sampled_velocities_, sampled_angular_velocities_),
-                     halflife, dt, std::span(locals_).first(1), {}, {});
+                     root_part(sampled_, sampled_velocities_, sampled_angular_velocities_), step,
+                     std::span(locals_).first(1), {}, {});
   const PoseMotion incoming = body_part(sampled_, sampled_velocities_, sampled_angular_velocities_);
   switch (settings_.transition_mode) {
     case TransitionMode::Inertialization:
-      inertialize_update(body_offsets_, incoming, halflife, dt, std::span(locals_).subspan(1), {},
-                         {});
+      inertialize_update(body_offsets_, incoming, step, std::span(locals_).subspan(1), {}, {});
       return;
     case TransitionMode::DeadBlending:
       dead_blend_update(body_blend_, incoming, settings_.dead_blend_time,
@@ -813,7 +812,7 @@ void Controller::simulate(float dt) {
   } else {
     const glm::quat before_rotation = sim_rotation_;
     critical_spring_update(sim_rotation_, sim_angular_velocity_, simulation_goal_rotation_,
-                           settings_.simulation_rotation_halflife, dt);
+                           sim_rotation_step_.step(settings_.simulation_rotation_halflife, dt));
     limit_turn_rate(before_rotation, dt);
   }
   if (world_) {
