@@ -128,6 +128,14 @@ constexpr float kFloorSoftness = 0.005f;
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
 
+// GLM's quaternion product, always inlined: reach's products were out-of-line calls, or not,
+// as the inliner's budget for this file fell, and its register use changed with each.
+[[gnu::always_inline]] inline glm::quat product(const glm::quat& p, const glm::quat& q) {
+  return glm::quat(
+      p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
+      p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x);
+}
+
 // `keep_animated` in [0, 1] is how much of the animation's own extension beyond kSoftReach is
 // kept (1 standing, 0 in motion, eased between, so the reach never jumps).
 glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, float keep_animated,
@@ -681,15 +689,14 @@ void Controller::start_transition() {
 
 // The playing clip (sampled_, at the new time) through the running transitions into locals_.
 void Controller::show_transitions(float dt) {
-  const float halflife = settings_.inertialization_halflife;
+  const CriticalSpringStep& step = offset_step_.step(settings_.inertialization_halflife, dt);
   inertialize_update(root_offsets_,
-                     root_part(sampled_, sampled_velocities_, sampled_angular_velocities_),
-                     halflife, dt, std::span(locals_).first(1), {}, {});
+                     root_part(sampled_, sampled_velocities_, sampled_angular_velocities_), step,
+                     std::span(locals_).first(1), {}, {});
   const PoseMotion incoming = body_part(sampled_, sampled_velocities_, sampled_angular_velocities_);
   switch (settings_.transition_mode) {
     case TransitionMode::Inertialization:
-      inertialize_update(body_offsets_, incoming, halflife, dt, std::span(locals_).subspan(1), {},
-                         {});
+      inertialize_update(body_offsets_, incoming, step, std::span(locals_).subspan(1), {}, {});
       return;
     case TransitionMode::DeadBlending:
       dead_blend_update(body_blend_, incoming, settings_.dead_blend_time,
@@ -813,7 +820,7 @@ void Controller::simulate(float dt) {
   } else {
     const glm::quat before_rotation = sim_rotation_;
     critical_spring_update(sim_rotation_, sim_angular_velocity_, simulation_goal_rotation_,
-                           settings_.simulation_rotation_halflife, dt);
+                           sim_rotation_step_.step(settings_.simulation_rotation_halflife, dt));
     limit_turn_rate(before_rotation, dt);
   }
   if (world_) {
@@ -1114,7 +1121,8 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
 }
 
 void Controller::finish_pose() {
-  fk_plan_.run(locals_, globals_);
+  // The pose is sampled from the database, which stores no scales: every scale is one.
+  fk_plan_.run_unit_scale(locals_, globals_);
   const Database& db = *db_;
   const ClipRange& clip = db.clips()[static_cast<size_t>(clip_)];
   const int frame =
@@ -1369,10 +1377,10 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   glm::quat swivel = yaw_rotation(feet_[side].heading_offset);
   if (world_) {
     const glm::vec3 along = swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
-    swivel = foot_placement_.tilt(side, along, settings_.max_foot_tilt) * swivel;
+    swivel = product(foot_placement_.tilt(side, along, settings_.max_foot_tilt), swivel);
   }
   const glm::quat foot_rotation =
-      glm::normalize(swivel * globals_[static_cast<size_t>(foot)].rotation);
+      glm::normalize(product(swivel, globals_[static_cast<size_t>(foot)].rotation));
   const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
   glm::vec3 ankle_target =
       target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
@@ -1415,13 +1423,14 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // local one: the toe's turn below is then the foot's rotation undone by itself.
   const bool heel_lifted = heel_rise != glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   const glm::quat raised_foot =
-      heel_lifted ? glm::normalize(heel_rise * foot_rotation) : foot_rotation;
-  locals_[static_cast<size_t>(foot)].rotation =
-      glm::normalize(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation) * raised_foot);
+      heel_lifted ? glm::normalize(product(heel_rise, foot_rotation)) : foot_rotation;
+  locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
+      product(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation), raised_foot));
   // The toe stays flat on the ground while the heel rises: it bends at the ball of the foot.
   if (leg[3] >= 0 && heel_lifted) {
     Transform& toe = locals_[static_cast<size_t>(leg[3])];
-    toe.rotation = glm::normalize(glm::conjugate(raised_foot) * foot_rotation * toe.rotation);
+    toe.rotation =
+        glm::normalize(product(product(glm::conjugate(raised_foot), foot_rotation), toe.rotation));
   }
   refresh_subtree(foot);
   // A solve that reached its target unclamped turned the bones only, so their lengths hold and

@@ -84,8 +84,72 @@ Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   return scale(scale(v, _mm_div_ps(atan_x_over_x, a.w)), c(2.0f));
 }
 
-// Joints first .. first + 3 of extrapolate_joint; false (nothing written) when a lane leaves the
-// exponential's series or its rotation has no length: the caller then steps them one by one.
+// The lanes outside a series (`ok` clear) are redone by the scalar function: a joint far from
+// its incoming pose (or turning fast) costs its logarithm's or exponential's general branch in
+// that lane alone, while the rest of its arithmetic stays in the lanes. Lane by lane each
+// result equals the scalar quat_to_scaled_angle_axis' and quat_exp's to the bit. The redoing is
+// out of line so that the lanes' common path keeps its registers.
+struct Lanes {
+  alignas(16) float w[4], x[4], y[4], z[4];
+};
+
+[[gnu::noinline]] void scaled_angle_axis_outside(const Quat4& q, int inside, Vec4x3& d) {
+  Lanes in, out;
+  _mm_store_ps(in.w, q.w);
+  _mm_store_ps(in.x, q.x);
+  _mm_store_ps(in.y, q.y);
+  _mm_store_ps(in.z, q.z);
+  _mm_store_ps(out.x, d.x);
+  _mm_store_ps(out.y, d.y);
+  _mm_store_ps(out.z, d.z);
+  for (int l = 0; l < 4; ++l) {
+    if (inside & (1 << l)) continue;
+    const glm::vec3 r = quat_to_scaled_angle_axis(glm::quat(in.w[l], in.x[l], in.y[l], in.z[l]));
+    out.x[l] = r.x;
+    out.y[l] = r.y;
+    out.z[l] = r.z;
+  }
+  d = {_mm_load_ps(out.x), _mm_load_ps(out.y), _mm_load_ps(out.z)};
+}
+
+[[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_lanes(const Quat4& q) {
+  __m128 ok;
+  Vec4x3 d = scaled_angle_axis_series(q, ok);
+  const int inside = _mm_movemask_ps(ok);
+  if (inside != 0xF) scaled_angle_axis_outside(q, inside, d);
+  return d;
+}
+
+[[gnu::noinline]] void exp_outside(const Vec4x3& h, int inside, Quat4& q) {
+  Lanes in, out;
+  _mm_store_ps(in.x, h.x);
+  _mm_store_ps(in.y, h.y);
+  _mm_store_ps(in.z, h.z);
+  _mm_store_ps(out.w, q.w);
+  _mm_store_ps(out.x, q.x);
+  _mm_store_ps(out.y, q.y);
+  _mm_store_ps(out.z, q.z);
+  for (int l = 0; l < 4; ++l) {
+    if (inside & (1 << l)) continue;
+    const glm::quat r = quat_exp(glm::vec3(in.x[l], in.y[l], in.z[l]));
+    out.w[l] = r.w;
+    out.x[l] = r.x;
+    out.y[l] = r.y;
+    out.z[l] = r.z;
+  }
+  q = {_mm_load_ps(out.w), _mm_load_ps(out.x), _mm_load_ps(out.y), _mm_load_ps(out.z)};
+}
+
+[[gnu::always_inline]] inline Quat4 exp_lanes(const Vec4x3& h) {
+  __m128 ok;
+  Quat4 q = exp_series(h, ok);
+  const int inside = _mm_movemask_ps(ok);
+  if (inside != 0xF) exp_outside(h, inside, q);
+  return q;
+}
+
+// Joints first .. first + 3 of extrapolate_joint; false (nothing written) when a lane's rotation
+// has no length: the caller then steps them one by one.
 bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
   Transform* s = &blend.source[first];
   glm::vec3* velocities = &blend.source_velocities[first];
@@ -93,12 +157,10 @@ bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
   const __m128 travel4 = c(travel), keep4 = c(keep);
   const Vec4x3 v = load_vec3s(velocities);
   const Vec4x3 w = load_vec3s(angular_velocities);
-  __m128 ok;
-  const Quat4 step = exp_series(scale(scale(w, travel4), c(0.5f)), ok);
+  const Quat4 step = exp_lanes(scale(scale(w, travel4), c(0.5f)));
   __m128 length;
   const Quat4 rotation = normalize(multiply(step, transform_rotations(s)), length);
-  ok = _mm_and_ps(ok, _mm_cmpgt_ps(length, _mm_setzero_ps()));
-  if (_mm_movemask_ps(ok) != 0xF) return false;
+  if (_mm_movemask_ps(_mm_cmpgt_ps(length, _mm_setzero_ps())) != 0xF) return false;
   const Translations4 t = load_translations(s);
   store_translations(add(t.t, scale(v, travel4)), t.scale_x, s);
   store_quats(rotation, &s[0].rotation, sizeof(Transform));
@@ -116,8 +178,8 @@ bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
 #endif
 
 // Moves the source on by dt with velocities decaying at rate `decay` (1/s), exactly, so the
-// result does not depend on how a span of time is cut into updates. Four joints at a time where
-// their steps are small (every lane equal to extrapolate_joint's result to the bit).
+// result does not depend on how a span of time is cut into updates. Four joints at a time (every
+// lane equal to extrapolate_joint's result to the bit).
 void extrapolate(DeadBlend& blend, float decay, float dt) {
   const float keep = std::exp(-decay * dt);
   const float travel = decay > 0.0f ? (1.0f - keep) / decay : dt;
@@ -168,20 +230,18 @@ JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incom
 }
 
 #if defined(__SSE2__)
-// Joints first .. first + 3 of blend_joint without velocities, into out; a lane outside the
-// logarithm's or the exponential's series (joints far apart) is done by blend_joint itself.
+// Joints first .. first + 3 of blend_joint without velocities, into out; a lane whose rotation
+// has no length is done by blend_joint itself.
 void blend_x4(const DeadBlend& blend, size_t first, const PoseMotion& incoming, Weight w,
               std::span<Transform> out) {
   const Transform* s = &blend.source[first];
   const Transform* in = &incoming.local[first];
   const Quat4 source = transform_rotations(s);
-  __m128 log_ok, exp_ok, length;
-  const Vec4x3 d =
-      scaled_angle_axis_series(multiply(transform_rotations(in), conjugate(source)), log_ok);
-  const Quat4 partial = exp_series(scale(scale(d, c(w.value)), c(0.5f)), exp_ok);
+  __m128 length;
+  const Vec4x3 d = scaled_angle_axis_lanes(multiply(transform_rotations(in), conjugate(source)));
+  const Quat4 partial = exp_lanes(scale(scale(d, c(w.value)), c(0.5f)));
   const Quat4 rotation = normalize(multiply(partial, source), length);
-  const int ok = _mm_movemask_ps(
-      _mm_and_ps(_mm_and_ps(log_ok, exp_ok), _mm_cmpgt_ps(length, _mm_setzero_ps())));
+  const int ok = _mm_movemask_ps(_mm_cmpgt_ps(length, _mm_setzero_ps()));
   // glm::mix: source (1 - w) + incoming w; the scale is the incoming one.
   const Translations4 ts = load_translations(s);
   const Translations4 ti = load_translations(in);

@@ -54,12 +54,24 @@ ForwardKinematicsPlan::ForwardKinematicsPlan(std::span<const int> parents)
 
 namespace {
 
-// compose(parent, child), GLM's way: the one joint form of the lanes below.
+// compose(parent, child), GLM's way: the one joint form of the lanes below. With unit scales
+// (both scales exactly one) the scale's products are the identity and left out.
+template <bool kUnitScale>
 void compose_joint(std::span<const int> parents, std::span<const Transform> local,
                    std::span<Transform> global, int j) {
   const size_t k = static_cast<size_t>(j);
   const int p = parents[k];
-  global[k] = p < 0 ? local[k] : compose(global[static_cast<size_t>(p)], local[k]);
+  if (p < 0) {
+    global[k] = local[k];
+  } else if (kUnitScale) {
+    const Transform& parent = global[static_cast<size_t>(p)];
+    Transform& out = global[k];
+    out.rotation = parent.rotation * local[k].rotation;
+    out.translation = parent.rotation * local[k].translation + parent.translation;
+    out.scale = glm::vec3(1.0f);
+  } else {
+    global[k] = compose(global[static_cast<size_t>(p)], local[k]);
+  }
 }
 
 #if defined(__SSE2__)
@@ -71,6 +83,7 @@ struct Transforms4 {
   Vec4x3 translation, scale;
 };
 
+template <bool kUnitScale>
 Transforms4 gather(const Transform* a, const Transform* b, const Transform* c, const Transform* d) {
   __m128 q0 = _mm_loadu_ps(&a->rotation.x), q1 = _mm_loadu_ps(&b->rotation.x);
   __m128 q2 = _mm_loadu_ps(&c->rotation.x), q3 = _mm_loadu_ps(&d->rotation.x);
@@ -79,6 +92,10 @@ Transforms4 gather(const Transform* a, const Transform* b, const Transform* c, c
   __m128 t0 = _mm_loadu_ps(&a->translation.x), t1 = _mm_loadu_ps(&b->translation.x);
   __m128 t2 = _mm_loadu_ps(&c->translation.x), t3 = _mm_loadu_ps(&d->translation.x);
   _MM_TRANSPOSE4_PS(t0, t1, t2, t3);
+  if (kUnitScale) {
+    const __m128 one = _mm_set1_ps(1.0f);
+    return {{q3, q0, q1, q2}, {t0, t1, t2}, {one, one, one}};
+  }
   __m128 s0 = _mm_loadu_ps(&a->translation.z), s1 = _mm_loadu_ps(&b->translation.z);
   __m128 s2 = _mm_loadu_ps(&c->translation.z), s3 = _mm_loadu_ps(&d->translation.z);
   _MM_TRANSPOSE4_PS(s0, s1, s2, s3);
@@ -104,19 +121,22 @@ Vec4x3 rotate(const Quat4& q, const Vec4x3& v) {
   return add(v, scale(add(scale(uv, q.w), uuv), c(2.0f)));
 }
 
+template <bool kUnitScale>
 void compose_block(std::span<const int> parents, std::span<const Transform> local,
                    std::span<Transform> global, const std::array<int, 4>& joints) {
   const auto at = [](auto span, int j) { return &span[static_cast<size_t>(j)]; };
   const auto parent = [&](int l) {
     return parents[static_cast<size_t>(joints[static_cast<size_t>(l)])];
   };
-  const Transforms4 p = gather(at(global, parent(0)), at(global, parent(1)), at(global, parent(2)),
-                               at(global, parent(3)));
-  const Transforms4 l = gather(at(local, joints[0]), at(local, joints[1]), at(local, joints[2]),
-                               at(local, joints[3]));
+  const Transforms4 p = gather<kUnitScale>(at(global, parent(0)), at(global, parent(1)),
+                                           at(global, parent(2)), at(global, parent(3)));
+  const Transforms4 l = gather<kUnitScale>(at(local, joints[0]), at(local, joints[1]),
+                                           at(local, joints[2]), at(local, joints[3]));
   const Quat4 rotation = multiply(p.rotation, l.rotation);
-  const Vec4x3 translation = add(rotate(p.rotation, times(p.scale, l.translation)), p.translation);
-  const Vec4x3 s = times(p.scale, l.scale);
+  const Vec4x3 translation =
+      add(rotate(p.rotation, kUnitScale ? l.translation : times(p.scale, l.translation)),
+          p.translation);
+  const Vec4x3 s = kUnitScale ? p.scale : times(p.scale, l.scale);
   __m128 x = rotation.x, y = rotation.y, z = rotation.z, w = rotation.w;
   _MM_TRANSPOSE4_PS(x, y, z, w);
   __m128 tx = translation.x, ty = translation.y, tz = translation.z, sx = s.x;
@@ -139,19 +159,30 @@ void compose_block(std::span<const int> parents, std::span<const Transform> loca
 
 }  // namespace
 
-void ForwardKinematicsPlan::run(std::span<const Transform> local,
-                                std::span<Transform> global) const {
+template <bool kUnitScale>
+void ForwardKinematicsPlan::run_blocks(std::span<const Transform> local,
+                                       std::span<Transform> global) const {
   MM_ASSERT(local.size() == parents_.size() && global.size() == parents_.size());
   for (const Block& b : blocks_) {
 #if defined(__SSE2__)
     if (b.lanes) {
-      compose_block(parents_, local, global, b.joints);
+      compose_block<kUnitScale>(parents_, local, global, b.joints);
       continue;
     }
 #endif
     for (int l = 0; l < b.count; ++l)
-      compose_joint(parents_, local, global, b.joints[static_cast<size_t>(l)]);
+      compose_joint<kUnitScale>(parents_, local, global, b.joints[static_cast<size_t>(l)]);
   }
+}
+
+void ForwardKinematicsPlan::run(std::span<const Transform> local,
+                                std::span<Transform> global) const {
+  run_blocks<false>(local, global);
+}
+
+void ForwardKinematicsPlan::run_unit_scale(std::span<const Transform> local,
+                                           std::span<Transform> global) const {
+  run_blocks<true>(local, global);
 }
 
 }  // namespace mm

@@ -124,8 +124,21 @@ void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incom
   MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
   MM_ASSERT(out_velocities.empty() || out_velocities.size() == n);
   MM_ASSERT(out_angular_velocities.empty() || out_angular_velocities.size() == n);
+  inertialize_update(offsets, incoming, critical_spring_step(halflife, dt), out_local,
+                     out_velocities, out_angular_velocities);
+}
+
+void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming,
+                        const CriticalSpringStep& step, std::span<Transform> out_local,
+                        std::span<glm::vec3> out_velocities,
+                        std::span<glm::vec3> out_angular_velocities) {
+  const size_t n = offsets.rotations.size();
+  MM_ASSERT(incoming.local.size() == n && out_local.size() == n);
+  MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
+  MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
+  MM_ASSERT(out_velocities.empty() || out_velocities.size() == n);
+  MM_ASSERT(out_angular_velocities.empty() || out_angular_velocities.size() == n);
   const glm::vec3 zero(0.0f);
-  const CriticalSpringStep step = critical_spring_step(halflife, dt);
   for (size_t i = 0; i < n; ++i) {
     critical_spring_apply(offsets.positions[i], offsets.velocities[i], zero, step);
     critical_spring_apply(offsets.rotations[i], offsets.rotation_rates[i], zero, step);

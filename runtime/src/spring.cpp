@@ -1,6 +1,7 @@
 #include "mm/runtime/spring.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include "mm/runtime/assert.hpp"
@@ -168,10 +169,28 @@ void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
 
 void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
                             float halflife, float dt) {
-  if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(goal)) return;
+  if (!(dt > 0.0f) || !usable(halflife, dt)) return;
+  critical_spring_update(rotation, angular_velocity, goal, critical_spring_step(halflife, dt));
+}
+
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
+                            const CriticalSpringStep& step) {
+  if (!step.moves || !finite(goal)) return;
   glm::vec3 error = quat_to_scaled_angle_axis(rotation * glm::conjugate(goal));
-  critical_spring_update(error, angular_velocity, glm::vec3(0.0f), halflife, dt);
+  critical_spring_apply(error, angular_velocity, glm::vec3(0.0f), step);
   rotation = glm::normalize(quat_from_scaled_angle_axis(error) * goal);
+}
+
+const CriticalSpringStep& CriticalSpringStepCache::step(float halflife, float dt) {
+  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
+  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
+  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
+    step_ = critical_spring_step(halflife, dt);
+    halflife_bits_ = h;
+    dt_bits_ = t;
+    known_ = true;
+  }
+  return step_;
 }
 
 void critical_spring_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,

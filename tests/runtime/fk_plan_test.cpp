@@ -54,5 +54,26 @@ TEST(ForwardKinematicsPlan, EqualsForwardKinematicsToTheBit) {
   }
 }
 
+TEST(ForwardKinematicsPlan, UnitScaleEqualsForwardKinematicsToTheBit) {
+  for (const int joints : {1, 2, 5, 23, 40}) {
+    for (int trial = 0; trial < 12; ++trial) {
+      Skeleton s = random_skeleton(joints, trial);
+      for (Transform& t : s.local) t.scale = glm::vec3(1.0f);
+      const ForwardKinematicsPlan plan(s.parents);
+      std::vector<Transform> expected(s.local.size()), global(s.local.size());
+      forward_kinematics(s.parents, s.local, expected);
+      // Scales other than one in the output beforehand: run_unit_scale writes every global.
+      for (Transform& g : global) g.scale = glm::vec3(3.0f);
+      plan.run_unit_scale(s.local, global);
+      for (size_t j = 0; j < global.size(); ++j) {
+        SCOPED_TRACE(testing::Message() << joints << " joints, trial " << trial << ", joint " << j);
+        EXPECT_EQ(global[j].rotation, expected[j].rotation);
+        EXPECT_EQ(global[j].translation, expected[j].translation);
+        EXPECT_EQ(global[j].scale, glm::vec3(1.0f));
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mm

@@ -539,5 +539,49 @@ TEST(SpringPredictionTable, EqualsThePredictionFromTheHalflifeAndFollowsChanges)
   EXPECT_NE(slow[3], fast[3]);
 }
 
+// The cached step is critical_spring_step's for the halflife and dt asked, also after either
+// changes (a new rate, a new setting) and for steps that do not move.
+TEST(CriticalSpringStepCache, EqualsTheStepOfTheHalflifeAndDtAskedAndFollowsChanges) {
+  CriticalSpringStepCache cache;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::array<std::array<float, 2>, 9> asked = {{{0.1f, 1.0f / 60.0f},
+                                                      {0.1f, 1.0f / 60.0f},
+                                                      {0.1f, 1.0f / 30.0f},
+                                                      {0.2f, 1.0f / 30.0f},
+                                                      {0.2f, 1.0f / 30.0f},
+                                                      {0.2f, 0.0f},
+                                                      {nan, 1.0f / 30.0f},
+                                                      {0.2f, 1.0f / 30.0f},
+                                                      {0.0f, 1.0f / 144.0f}}};
+  for (const auto& [halflife, dt] : asked) {
+    SCOPED_TRACE(testing::Message() << "halflife " << halflife << ", dt " << dt);
+    const CriticalSpringStep expected = critical_spring_step(halflife, dt);
+    const CriticalSpringStep& got = cache.step(halflife, dt);
+    EXPECT_EQ(got.moves, expected.moves);
+    EXPECT_EQ(got.xx, expected.xx);
+    EXPECT_EQ(got.xv, expected.xv);
+    EXPECT_EQ(got.vx, expected.vx);
+    EXPECT_EQ(got.vv, expected.vv);
+  }
+}
+
+// The rotation spring with a precomputed step is the one with the halflife and dt, to the bit.
+TEST(RotationSpring, APrecomputedStepEqualsTheHalflifeAndDt) {
+  for (int trial = 0; trial < 50; ++trial) {
+    const glm::quat goal = test::random_rotation();
+    glm::quat a = test::random_rotation(), b = a;
+    glm::vec3 va = test::random_vec3(-3.0f, 3.0f), vb = va;
+    const float halflife = test::uniform(0.05f, 0.5f);
+    const CriticalSpringStep step = critical_spring_step(halflife, 1.0f / 60.0f);
+    for (int i = 0; i < 10; ++i) {
+      critical_spring_update(a, va, goal, halflife, 1.0f / 60.0f);
+      critical_spring_update(b, vb, goal, step);
+    }
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(va, vb);
+    EXPECT_NE(a, goal);  // the spring moved, and not all the way
+  }
+}
+
 }  // namespace
 }  // namespace mm

@@ -616,6 +616,10 @@ class Controller {
   // The prediction's spring coefficients at those times, kept while the halflives stay.
   SpringPredictionTable position_springs_;
   SpringPredictionTable rotation_springs_;
+  // The per-update steps of the springs whose halflife and dt rarely change: the root's (and
+  // an inertialized body's) offsets, the simulation's rotation.
+  CriticalSpringStepCache offset_step_;
+  CriticalSpringStepCache sim_rotation_step_;
   struct TrajectoryColumn {
     int column = 0;      // first column in the feature row
     int time_index = 0;  // index into trajectory_times_

@@ -21,6 +21,11 @@ class ForwardKinematicsPlan {
 
   // forward_kinematics(parents, local, global) of the plan's skeleton, to the bit.
   void run(std::span<const Transform> local, std::span<Transform> global) const;
+  // The same for a pose whose every scale is exactly (1, 1, 1), as every pose sampled from a
+  // database is (it stores none): the scales' products, which would multiply by one, are
+  // skipped and the globals' scales written as one, so the result still equals run's to the
+  // bit. Scales other than one are not looked at (the caller's promise).
+  void run_unit_scale(std::span<const Transform> local, std::span<Transform> global) const;
 
   size_t joint_count() const { return parents_.size(); }
 
@@ -30,6 +35,9 @@ class ForwardKinematicsPlan {
     int count = 0;
     bool lanes = false;  // composed in SSE lanes: more than one joint, none a root
   };
+  template <bool kUnitScale>
+  void run_blocks(std::span<const Transform> local, std::span<Transform> global) const;
+
   std::vector<int> parents_;
   std::vector<Block> blocks_;
 };

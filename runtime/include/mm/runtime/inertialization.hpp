@@ -24,6 +24,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "mm/runtime/spring.hpp"
 #include "mm/runtime/transform.hpp"
 
 namespace mm {
@@ -63,6 +64,12 @@ void inertialize_transition(InertializationOffsets& offsets, const PoseMotion& o
 // A non-finite dt or halflife leaves the offsets as they are (see spring.hpp).
 void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming, float halflife,
                         float dt, std::span<Transform> out_local,
+                        std::span<glm::vec3> out_velocities,
+                        std::span<glm::vec3> out_angular_velocities);
+// The same with the offsets' step precomputed (critical_spring_step of the halflife and dt,
+// which a caller at a fixed rate keeps: CriticalSpringStepCache).
+void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incoming,
+                        const CriticalSpringStep& step, std::span<Transform> out_local,
                         std::span<glm::vec3> out_velocities,
                         std::span<glm::vec3> out_angular_velocities);
 

@@ -33,6 +33,7 @@
 // Nothing here allocates.
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 
 #include <glm/glm.hpp>
@@ -89,12 +90,29 @@ CriticalSpringStep critical_spring_step(float halflife, float dt);
 void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
                            const CriticalSpringStep& step);
 
+// The last step asked for, kept: at a fixed update rate and halflife every update takes the
+// same step, whose exponential is then computed once instead of in every update. The step is
+// computed again whenever the halflife or dt differs from the last call's (bit for bit, so a
+// change of settings or rate is never missed); the result is critical_spring_step's.
+class CriticalSpringStepCache {
+ public:
+  const CriticalSpringStep& step(float halflife, float dt);
+
+ private:
+  std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
+  bool known_ = false;
+  CriticalSpringStep step_;
+};
+
 // Advances a rotation spring toward goal by dt seconds along the shortest path. The state is
 // the rotation error e = angle*axis of rotation * inverse(goal) (world frame, |e| <= pi) and
 // angular_velocity = de/dt (rad/s, axis times rate), which is the true angular velocity
 // whenever the rotation stays about one axis (a facing about +Y, for instance).
 void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
                             float halflife, float dt);
+// The same with a precomputed step (critical_spring_step of the halflife and dt).
+void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,
+                            const CriticalSpringStep& step);
 
 // Predicts a 3D spring at future times (seconds from now, each >= 0) without changing it:
 // positions[i] and velocities[i] are the state after times[i]. Either output may be empty;
