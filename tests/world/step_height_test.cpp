@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "../controller/controller_support.hpp"
+#include "level_builder.hpp"
 #include "mm/controller/character_mover.hpp"
 #include "mm/controller/controller.hpp"
 #include "mm/world/bullet_world.hpp"
@@ -26,26 +27,10 @@ constexpr float kBoxFar = 6.2f;
 // A floor and one box of `top` (m) standing on it, as a level's triangles (the courses' boxes are
 // meshes, not Bullet boxes).
 BulletWorld box_world(float top) {
-  Level level;
-  const auto quad = [&level](const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
-                             const glm::vec3& d) {
-    const uint32_t first = static_cast<uint32_t>(level.positions.size());
-    level.positions.insert(level.positions.end(), {a, b, c, d});
-    level.indices.insert(level.indices.end(),
-                         {first, first + 1, first + 2, first, first + 2, first + 3});
-  };
-  quad({-20.0f, 0.0f, -20.0f}, {20.0f, 0.0f, -20.0f}, {20.0f, 0.0f, 20.0f}, {-20.0f, 0.0f, 20.0f});
-  const glm::vec3 lo(-0.6f, 0.0f, kBoxNear), hi(0.6f, top, kBoxFar);
-  const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z},
-                          {lo.x, hi.y, lo.z}, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z},
-                          {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  quad(c[0], c[1], c[2], c[3]);
-  quad(c[5], c[4], c[7], c[6]);
-  quad(c[4], c[0], c[3], c[7]);
-  quad(c[1], c[5], c[6], c[2]);
-  quad(c[3], c[2], c[6], c[7]);
-  quad(c[4], c[5], c[1], c[0]);
-  Result<BulletWorld> world = BulletWorld::create(level);
+  test::LevelBuilder b;
+  b.floor(20.0f);
+  b.box({-0.6f, 0.0f, kBoxNear}, {0.6f, top, kBoxFar});
+  Result<BulletWorld> world = BulletWorld::create(b.level);
   EXPECT_TRUE(world.ok()) << world.message();
   return std::move(world).value();
 }
@@ -95,9 +80,8 @@ TEST(StepHeight, ABoxUpToTheStepHeightIsClimbedNeverAWall) {
       }
       // Every move went the whole way: from 3 m before the box's centre to past its far side.
       const float yaw = glm::radians(degrees);
-      const glm::vec3 start =
-          glm::vec3(0.0f, 0.0f, 0.5f * (kBoxNear + kBoxFar)) -
-          3.0f * glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw));
+      const glm::vec3 start = glm::vec3(0.0f, 0.0f, 0.5f * (kBoxNear + kBoxFar)) -
+                              3.0f * glm::vec3(std::sin(yaw), 0.0f, std::cos(yaw));
       const glm::vec3 end = moves.back().position;
       EXPECT_NEAR(std::hypot(end.x - start.x, end.z - start.z),
                   kSpeed * kDt * static_cast<float>(moves.size()), 0.01f)
