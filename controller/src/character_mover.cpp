@@ -116,6 +116,14 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
       out[i].blocked = true;
       out[i].normal = normal;
       slide = rest - normal * glm::dot(rest, normal);
+      // Stopped kSkin short along a move that met the face at a glancing angle, the capsule is
+      // nearly touching it, and a slide along it swept from there met the same face where it
+      // started: stuck against a wall it was pushed along (off the lanes, up to 0.85 s at the 60°
+      // wall). The slide is swept kSkin off the face's plane, and made where the capsule is:
+      // parallel to the face, it comes no nearer to it.
+      const float gap = (sweep_hits_[k].fraction - travelled) * distance *
+                        std::max(0.0f, -glm::dot(d / distance, normal));
+      from += normal * std::max(0.0f, kSkin - gap);
     }
     if (glm::length(slide) < 1e-6f) continue;
     // Written over the sweeps already read: slot `slides` <= k.

@@ -8,7 +8,9 @@
 //    from the start toward the goal. A hit stops it `kSkin` short of the contact;
 // 2. slide: what the hit cut off, less its part into the obstacle (the contact normal made
 //    horizontal), is swept again from there: pushing diagonally along a wall keeps moving along
-//    it, pushing head-on stops. A second hit stops the slide (a corner). A step exactly
+//    it, pushing head-on stops. The slide is swept from kSkin off the face's plane (a stop kSkin
+//    short along a glancing move leaves the capsule nearly touching the face, and a sweep along
+//    it from there meets it at once). A second hit stops the slide (a corner). A step exactly
 //    step_height high (the physics engine's sweep meets its top within a few millimetres of the
 //    lifted capsule's bottom, a contact facing up, kStepTopNormalY) is climbed, not a wall: the
 //    rest is swept again kStepClearance higher. A step up to step_height is climbed; a higher one
