@@ -31,6 +31,13 @@ glm::vec3 lift(const CharacterShape& shape) {
   return glm::vec3(0.0f, shape.step_height, 0.0f);
 }
 
+// A contact this close to straight up is the lifted capsule's bottom resting on a step's top: the
+// step is as high as the lift, within a few millimetres (a contact a centimetre up its hemisphere
+// already leans 15 degrees).
+bool on_step_top(const glm::vec3& normal) {
+  return normal.y >= CharacterMover::kStepTopNormalY;
+}
+
 }  // namespace
 
 bool CharacterMover::accept(const ShapeSweep& query, SweepHit& hit) {
@@ -86,7 +93,7 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
   }
   if (count > 0)
     world.sweep(origin, std::span(sweeps_).first(count), std::span(sweep_hits_).first(count));
-  // 2. Slide what a hit cut off along the obstacle.
+  // 2. Slide what a hit cut off along the obstacle; climb a step the capsule's bottom rests on.
   size_t slides = 0;
   for (size_t k = 0; k < count; ++k) {
     if (!accept(sweeps_[k], sweep_hits_[k]) || !sweep_hits_[k].hit) continue;
@@ -95,33 +102,60 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
     const float distance = glm::length(d);
     const float travelled = safe_fraction(sweep_hits_[k].fraction, distance, kSkin);
     const glm::vec3 stop = starts[i] + d * travelled;
-    const glm::vec3 normal = horizontal_normal(sweep_hits_[k].normal, d);
-    out[i].position = stop;
-    out[i].blocked = true;
-    out[i].normal = normal;
     const glm::vec3 rest = d * (1.0f - travelled);
-    const glm::vec3 slide = rest - normal * glm::dot(rest, normal);
+    out[i].position = stop;
+    climbed_[k] = on_step_top(sweep_hits_[k].normal);
+    glm::vec3 from = stop + up, slide = rest;
+    if (climbed_[k]) {
+      // A step exactly as high as the lift: its top touches the capsule's bottom, and read as a
+      // wall head-on it stalled the character at its edge. The rest is swept again from a little
+      // higher; the ground probe (3.) finds the step's top and climbs it.
+      from.y += kStepClearance;
+    } else {
+      const glm::vec3 normal = horizontal_normal(sweep_hits_[k].normal, d);
+      out[i].blocked = true;
+      out[i].normal = normal;
+      slide = rest - normal * glm::dot(rest, normal);
+      // Stopped kSkin short along a move that met the face at a glancing angle, the capsule is
+      // nearly touching it, and a slide along it swept from there met the same face where it
+      // started: stuck against a wall it was pushed along (off the lanes, up to 0.85 s at the 60°
+      // wall). The slide is swept kSkin off the face's plane, and made where the capsule is:
+      // parallel to the face, it comes no nearer to it.
+      const float gap = (sweep_hits_[k].fraction - travelled) * distance *
+                        std::max(0.0f, -glm::dot(d / distance, normal));
+      from += normal * std::max(0.0f, kSkin - gap);
+    }
     if (glm::length(slide) < 1e-6f) continue;
     // Written over the sweeps already read: slot `slides` <= k.
-    sweeps_[slides] = ShapeSweep{stop + up, stop + up + slide, shape.radius, shape.height};
+    sweeps_[slides] = ShapeSweep{from, from + slide, shape.radius, shape.height};
+    climbed_[slides] = climbed_[k];
     slid_[slides++] = static_cast<int>(i);
   }
   if (slides > 0) {
     world.sweep(origin, std::span(sweeps_).first(slides), std::span(sweep_hits_).first(slides));
     for (size_t k = 0; k < slides; ++k) {
       accept(sweeps_[k], sweep_hits_[k]);
+      const SweepHit& hit = sweep_hits_[k];
       const glm::vec3 slide = sweeps_[k].to - sweeps_[k].from;
+      MoveResult& result = out[static_cast<size_t>(slid_[k])];
       const float travelled =
-          sweep_hits_[k].hit ? safe_fraction(sweep_hits_[k].fraction, glm::length(slide), kSkin)
-                             : 1.0f;
-      out[static_cast<size_t>(slid_[k])].position += slide * travelled;
+          hit.hit ? safe_fraction(hit.fraction, glm::length(slide), kSkin) : 1.0f;
+      result.position += slide * travelled;
+      // After a climb, what stops the rest is the obstacle met (a slide keeps its first one's).
+      if (climbed_[k] && hit.hit) {
+        result.blocked = true;
+        result.normal = horizontal_normal(hit.normal, slide);
+      }
     }
   }
-  // 3. The ground where each move ended, reached from the start's height, and ahead of it.
+  // 3. The ground where each move ended, reached from the start's height, and ahead of it. The
+  // probe starts kStepClearance above the lift: a ray starting exactly on a step's top (a step as
+  // high as step_height) passes through it and finds the ground under the step.
   size_t probes = 0;
   for (size_t i = 0; i < n; ++i) {
-    const glm::vec3 top(out[i].position.x, starts[i].y + shape.step_height, out[i].position.z);
-    const float reach = shape.step_height + shape.max_step_down;
+    const glm::vec3 top(out[i].position.x, starts[i].y + shape.step_height + kStepClearance,
+                        out[i].position.z);
+    const float reach = shape.step_height + kStepClearance + shape.max_step_down;
     probes_[probes++] = GroundProbe{top, reach, shape.min_walkable_normal_y};
     glm::vec3 d = goals[i] - starts[i];
     d.y = 0.0f;
@@ -142,8 +176,11 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
     GroundHit& hit = ground_hits_[k];
     const bool ground = accept(probes_[k], hit) && hit.hit && hit.walkable;
     // Measured from the end's own ground, not the start's: a trajectory sample a metre down a
-    // stair is far below the start and on no ledge.
-    const float floor = hit.point.y - shape.step_height;
+    // stair is far below the start and on no ledge. A drop up to kStepClearance deeper than a
+    // step is a step: walking back, the probe (which starts that much above the lift) finds the
+    // top the sweep, starting against its edge, does not; off a box exactly step_height high the
+    // floor reads a hair deeper than a step.
+    const float floor = hit.point.y - shape.step_height - kStepClearance;
     bool ledge = !ground;
     if (lead_[i] >= 0) {
       GroundHit& ahead = ground_hits_[++k];

@@ -563,7 +563,7 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
 class WorldReadings {
  public:
   WorldReadings(const WorldQueries* world, const JointRoleIndices& roles, size_t joints)
-      : world_(world), roles_(roles), sweeps_(joints), hits_(joints), joints_(joints) {
+      : world_(world), roles_(roles), walls_(joints) {
     toes_[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
     toes_[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
   }
@@ -601,36 +601,18 @@ class WorldReadings {
     }
   }
 
-  // The deepest any joint higher than a step above the ground is inside a wall: a small sphere
-  // swept from above the root, at the joint's height, to the joint; what lies beyond the first
-  // contact is inside. Lower joints meet the ground's slopes and steps, not walls, and are the
+  // The deepest any joint higher than a step above the ground is inside a wall
+  // (WallDepthReader). Lower joints meet the ground's slopes and steps, not walls, and are the
   // penetration metrics' to judge.
   void read_walls(const Controller& controller, const ControllerDebug& d, EvaluationFrame& r) {
-    constexpr float kRadius = 0.01f;
     const float above = d.ground_height + controller.settings().step_height;
-    size_t count = 0;
-    for (size_t j = 1; j < joints_; ++j) {
-      const glm::vec3& p = r.joints[j];
-      if (p.y < above || horizontal_distance(p, r.root_position) < 1e-4f) continue;
-      const glm::vec3 from(r.root_position.x, p.y - kRadius, r.root_position.z);
-      sweeps_[count++] = ShapeSweep{from, glm::vec3(p.x, p.y - kRadius, p.z), kRadius, 2 * kRadius};
-    }
-    if (count == 0) return;
-    world_->sweep(r.origin, std::span(sweeps_).first(count), std::span(hits_).first(count));
-    for (size_t k = 0; k < count; ++k) {
-      if (!hits_[k].hit || !std::isfinite(hits_[k].fraction)) continue;
-      const float length = horizontal_distance(sweeps_[k].to, sweeps_[k].from);
-      r.wall_depth =
-          std::max(r.wall_depth, (1.0f - std::clamp(hits_[k].fraction, 0.0f, 1.0f)) * length);
-    }
+    r.wall_depth = walls_.read(*world_, r.origin, r.root_position, r.joints.subspan(1), above);
   }
 
   const WorldQueries* world_;
   JointRoleIndices roles_;
   int toes_[2] = {-1, -1};
-  std::vector<ShapeSweep> sweeps_;
-  std::vector<SweepHit> hits_;
-  size_t joints_ = 0;
+  WallDepthReader walls_;
   glm::vec3 previous_sim_{0.0f};
 };
 

@@ -157,6 +157,69 @@ GroundMetrics GroundAccumulator::metrics() const {
   return m;
 }
 
+WallDepthReader::WallDepthReader(size_t joints)
+    : sweeps_(joints),
+      sweep_hits_(joints),
+      probes_(joints),
+      probe_hits_(joints),
+      depth_(joints),
+      joint_(joints) {}
+
+float WallDepthReader::read(const WorldQueries& world, const glm::dvec3& origin,
+                            const glm::vec3& root, std::span<const glm::vec3> joints, float above,
+                            int* deepest) {
+  if (deepest) *deepest = -1;
+  size_t count = 0;
+  for (size_t j = 0; j < joints.size() && count < sweeps_.size(); ++j) {
+    const glm::vec3& p = joints[j];
+    if (p.y < above || std::hypot(p.x - root.x, p.z - root.z) < 1e-4f) continue;
+    // The sphere's centre at the joint's height (a sweep's shape stands on its `from`).
+    const float bottom = p.y - kWallProbeRadius;
+    sweeps_[count] = ShapeSweep{glm::vec3(root.x, bottom, root.z), glm::vec3(p.x, bottom, p.z),
+                                kWallProbeRadius, 2.0f * kWallProbeRadius};
+    joint_[count++] = static_cast<int>(j);
+  }
+  if (count == 0) return 0.0f;
+  world.sweep(origin, std::span(sweeps_).first(count), std::span(sweep_hits_).first(count));
+  // Only the joints past a face need their top.
+  size_t behind = 0;
+  for (size_t k = 0; k < count; ++k) {
+    const SweepHit& hit = sweep_hits_[k];
+    const glm::vec3 n(hit.normal.x, 0.0f, hit.normal.z);
+    if (!hit.hit || !std::isfinite(hit.fraction) || !(glm::length(n) > 1e-3f)) continue;
+    const ShapeSweep& sweep = sweeps_[k];
+    const float fraction = std::clamp(hit.fraction, 0.0f, 1.0f);
+    const glm::vec3 centre = glm::mix(sweep.from, sweep.to, fraction);
+    // A sweep met at its start began inside or against the wall: where its face is, is unknown,
+    // and the whole way out to the joint is inside.
+    const float depth = fraction > 0.0f
+                            ? glm::dot(centre - sweep.to, glm::normalize(n)) - kWallProbeRadius
+                            : glm::distance(sweep.from, sweep.to);
+    if (!(depth > 0.0f)) continue;
+    const glm::vec3& p = joints[static_cast<size_t>(joint_[k])];
+    probes_[behind] =
+        GroundProbe{p + glm::vec3(0.0f, kTopProbeHeight, 0.0f), kTopProbeHeight + 1.0f, 0.0f};
+    depth_[behind] = depth;
+    joint_[behind++] = joint_[k];
+  }
+  if (behind == 0) return 0.0f;
+  world.probe_ground(origin, std::span(probes_).first(behind),
+                     std::span(probe_hits_).first(behind));
+  float deepest_depth = 0.0f;
+  for (size_t k = 0; k < behind; ++k) {
+    float depth = depth_[k];
+    const GroundHit& top = probe_hits_[k];
+    if (top.hit && std::isfinite(top.point.y)) {
+      depth = std::min(depth, top.point.y - joints[static_cast<size_t>(joint_[k])].y);
+    }
+    if (depth > deepest_depth) {
+      deepest_depth = depth;
+      if (deepest) *deepest = joint_[k];
+    }
+  }
+  return deepest_depth;
+}
+
 double database_geometric_skate(const Database& db, float dt, uint64_t excluded_tags) {
   if (!(dt > 0.0f)) return 0.0;
   const size_t joints = static_cast<size_t>(db.joint_count());

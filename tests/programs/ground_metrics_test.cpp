@@ -7,6 +7,8 @@
 #include <cmath>
 #include <vector>
 
+#include "analytic_world.hpp"
+
 namespace mm {
 namespace {
 
@@ -132,6 +134,37 @@ TEST(GroundMetrics, AShiftedFrameIsNotASlide) {
   }
   EXPECT_EQ(a.metrics().foot_skate_geom_frames, 8);
   EXPECT_NEAR(a.metrics().foot_skate_geom_cm_s_mean, 0.0, 1e-3);
+}
+
+// The wall depth (WallDepthReader) against analytic boxes: the root on the floor at z = 4.7, a
+// box 0.35 m high (a step exactly the default step_height) whose near face is z = 5, 1.2 m deep,
+// and a wall 2 m high beside it whose near face is z = 5 too.
+TEST(GroundMetrics, AJointIsInAWallByTheNearestFaceItIsBehind) {
+  test::AnalyticWorld world;
+  world.boxes.push_back(test::AnalyticBox{glm::vec2(0.0f, 5.6f), glm::vec2(0.6f), 0.0f, 0.35f});
+  world.boxes.push_back(
+      test::AnalyticBox{glm::vec2(2.0f, 5.15f), glm::vec2(1.0f, 0.15f), 0.0f, 2.0f});
+  const glm::vec3 root(0.0f, 0.0f, 4.7f);
+  WallDepthReader reader(4);
+  const auto depth = [&](const glm::vec3& joint, int* deepest = nullptr) {
+    const glm::vec3 joints[2] = {glm::vec3(0.0f, 1.0f, 4.7f),
+                                 joint};  // the first on the root's line
+    return reader.read(world, glm::dvec3(0.0), root, joints, 0.3f, deepest);
+  };
+  // A foot 5 mm over the box's top, 30 cm past its face: the sweep at its height meets the box's
+  // top edge, but the foot is above the box, in nothing.
+  EXPECT_EQ(depth({0.0f, 0.355f, 5.3f}), 0.0f);
+  // 1 cm below the top, 30 cm past the face: inside by the nearer face, the top.
+  EXPECT_NEAR(depth({0.0f, 0.34f, 5.3f}), 0.01f, 1e-4f);
+  // A hand 5 cm behind the tall wall's face, 1.2 m up: 80 cm below its top, 5 cm behind its face.
+  int deepest = -2;
+  EXPECT_NEAR(depth({2.0f, 1.2f, 5.05f}, &deepest), 0.05f, 1e-4f);
+  EXPECT_EQ(deepest, 1);
+  // On the face itself, in front of it, and lower than `above`: nothing.
+  EXPECT_NEAR(depth({2.0f, 1.2f, 5.0f}, &deepest), 0.0f, 1e-4f);
+  EXPECT_EQ(deepest, -1);
+  EXPECT_EQ(depth({2.0f, 1.2f, 4.9f}), 0.0f);
+  EXPECT_EQ(depth({2.0f, 0.25f, 5.05f}), 0.0f);
 }
 
 }  // namespace

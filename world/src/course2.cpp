@@ -16,10 +16,13 @@ namespace mm {
 namespace {
 
 using course_mesh::HeightField;
-using course_mesh::Mesh;
 using course_mesh::metres;
 using course_mesh::Placed;
 using course_mesh::radians;
+using course_mesh::RampProfile;
+using course_mesh::StairsProfile;
+using course_mesh::TurnedWall;
+using course_mesh::walk;
 
 // ---------------------------------------------------------------------------------------------
 // The layout (metres, degrees). Lanes run along +Z from kLaneStart, side by side along +X, each
@@ -27,21 +30,19 @@ using course_mesh::radians;
 
 constexpr double kLaneStart = 2.0;
 
-constexpr double kGroundLow[2] = {-2.0, -2.0};  // x, z
-constexpr double kGroundHigh[2] = {45.0, 16.0};
+const glm::dvec2 kGroundLow{-2.0, -2.0};  // x, z
+const glm::dvec2 kGroundHigh{45.0, 16.0};
 
 constexpr double kLaneWidth = 1.6;  // ramps and the rough patch's neighbours
 constexpr double kStairsWidth = 1.8;
 
-// Ramps up, across a plateau, and down.
+// Ramps up 0.8 m, across a 1.5 m plateau, and down.
 struct Ramp {
   const char* name;
-  double degrees;
+  RampProfile profile;
   double x;  // the lane's low x
 };
-constexpr Ramp kRamps[] = {{"ramp_15", 15.0, 0.0}, {"ramp_25", 25.0, 2.6}};
-constexpr double kRampRise = 0.8;
-constexpr double kRampPlateau = 1.5;
+constexpr Ramp kRamps[] = {{"ramp_15", {15.0, 0.8, 1.5}, 0.0}, {"ramp_25", {25.0, 0.8, 1.5}, 2.6}};
 
 // A platform the walk starts on, then a ramp or stairs down from its edge.
 constexpr double kPlatformStart = 0.5;  // z; the lane starts on it
@@ -58,13 +59,10 @@ constexpr double kStairsDownTread = 0.28;
 struct Stairs {
   const char* name;
   double x;
-  int steps;
-  double riser;
-  double tread;
-  double landing;
+  StairsProfile profile;
 };
-constexpr Stairs kStairs[] = {{"stairs_12_35", 7.8, 5, 0.12, 0.35, 1.2},
-                              {"stairs_20_25", 10.6, 4, 0.20, 0.25, 1.0}};
+constexpr Stairs kStairs[] = {{"stairs_12_35", 7.8, {5, 0.12, 0.35, 1.2}},
+                              {"stairs_20_25", 10.6, {4, 0.20, 0.25, 1.0}}};
 
 // The rough patch: a smooth height field sampled every kRoughCell.
 constexpr double kRoughX = 16.2;
@@ -77,16 +75,13 @@ constexpr int kRoughRows = 40;     // kRoughLength / kRoughCell
 // Walls turned from +Z toward +X, met by a walk along +Z.
 constexpr double kWallHeight = 2.0;
 constexpr double kTurnedThickness = 0.3;
-struct TurnedWall {
+struct Turned {
   const char* name;
-  double start_x;  // one end of its face
-  double start_z;
-  double length;
-  double degrees;
+  TurnedWall wall;
   double walk_x;  // a walk along +Z here meets its face
 };
-constexpr TurnedWall kTurnedWalls[] = {{"wall_45", 20.2, 4.0, 5.0, 45.0, 21.2},
-                                       {"wall_60", 24.8, 4.0, 4.0, 60.0, 25.8}};
+constexpr Turned kTurnedWalls[] = {{"wall_45", {20.2, 4.0, 5.0, 45.0, kTurnedThickness}, 21.2},
+                                   {"wall_60", {24.8, 4.0, 4.0, 60.0, kTurnedThickness}, 25.8}};
 
 // The corner: a wall across the lane and one along its +X side, meeting at kCornerAt (concave,
 // seen from the lane). The corridor: two walls kCorridorWidth apart.
@@ -120,22 +115,6 @@ constexpr double kSlopeDegrees = 12.0;
 // ---------------------------------------------------------------------------------------------
 // Profiles
 
-double ramp_run(const Ramp& ramp) {
-  return kRampRise / std::tan(radians(ramp.degrees));
-}
-
-double ramp_length(const Ramp& ramp) {
-  return 2.0 * ramp_run(ramp) + kRampPlateau;
-}
-
-double ramp_height(const Ramp& ramp, double along) {
-  const double run = ramp_run(ramp);
-  if (along <= 0.0 || along >= ramp_length(ramp)) return 0.0;
-  if (along < run) return kRampRise * along / run;
-  if (along <= run + kRampPlateau) return kRampRise;
-  return kRampRise * (ramp_length(ramp) - along) / run;
-}
-
 double ramp_down_run() {
   return kRampDownTop / std::tan(radians(kRampDownDegrees));
 }
@@ -161,50 +140,19 @@ double stairs_down_height(double z) {
          (kStairsDownSteps - 1 - std::floor((z - kPlatformEdge) / kStairsDownTread));
 }
 
-double stairs_length(const Stairs& stairs) {
-  return 2.0 * (stairs.steps - 1) * stairs.tread + stairs.landing;
-}
-
-double stairs_height(const Stairs& stairs, double along) {
-  if (along < 0.0 || along > stairs_length(stairs)) return 0.0;
-  const double up = (stairs.steps - 1) * stairs.tread;
-  if (along < up) return stairs.riser * (std::floor(along / stairs.tread) + 1.0);
-  if (along <= up + stairs.landing) return stairs.riser * stairs.steps;
-  return stairs.riser *
-         (stairs.steps - 1 - std::floor((along - up - stairs.landing) / stairs.tread));
-}
-
 // Bumps of other wavelengths and amplitude than the first course's, on a window that brings them
 // smoothly down to the ground within 0.4 m of the patch's edges.
 double rough_field(double u, double v) {
-  auto window = [](double s, double length) {
-    const double t = std::clamp(std::min(s, length - s) / 0.4, 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
-  };
   const double bumps = 0.06 + 0.035 * std::sin(2.0 * std::numbers::pi * u / 1.1) +
                        0.025 * std::sin(2.0 * std::numbers::pi * v / 0.7 + 1.3);
-  return window(u, kRoughWidth) * window(v, kRoughLength) * bumps;
+  return course_mesh::edge_window(u, kRoughWidth, 0.4) *
+         course_mesh::edge_window(v, kRoughLength, 0.4) * bumps;
 }
 
 constexpr HeightField kRough{rough_field, kRoughCell, kRoughColumns, kRoughRows};
 
 double slope_top() {
   return kSlopeWidth * std::tan(radians(kSlopeDegrees));
-}
-
-// A turned wall's face direction and its outward normal's opposite (its thickness), in (x, z).
-glm::dvec2 wall_along(const TurnedWall& wall) {
-  return {std::sin(radians(wall.degrees)), std::cos(radians(wall.degrees))};
-}
-glm::dvec2 wall_across(const TurnedWall& wall) {
-  return {std::cos(radians(wall.degrees)), -std::sin(radians(wall.degrees))};
-}
-
-// (x, z) in a turned wall's own frame: its face along +z from 0 to its length at x = 0, its
-// thickness x in [-kTurnedThickness, 0].
-glm::dvec2 wall_frame(const TurnedWall& wall, double x, double z) {
-  const glm::dvec2 d(x - wall.start_x, z - wall.start_z);
-  return {glm::dot(d, wall_across(wall)), glm::dot(d, wall_along(wall))};
 }
 
 struct Rect {
@@ -226,18 +174,6 @@ std::vector<Rect> corridor_walls() {
 // ---------------------------------------------------------------------------------------------
 // Meshes, in each part's own frame
 
-Placed flat_ground() {
-  Placed ground{"ground", {}, {0.0, 0.0, 0.0}, 0.0};
-  Mesh& m = ground.mesh;
-  const uint32_t a = m.vertex({kGroundLow[0], 0.0, kGroundLow[1]});
-  const uint32_t b = m.vertex({kGroundHigh[0], 0.0, kGroundLow[1]});
-  const uint32_t c = m.vertex({kGroundHigh[0], 0.0, kGroundHigh[1]});
-  const uint32_t d = m.vertex({kGroundLow[0], 0.0, kGroundHigh[1]});
-  m.triangle(a, b, c, {0.0, 1.0, 0.0});
-  m.triangle(a, c, d, {0.0, 1.0, 0.0});
-  return ground;
-}
-
 Placed rough_patch() {
   return Placed{"rough", kRough.mesh(), {kRoughX, 0.0, kLaneStart}, 0.0};
 }
@@ -250,12 +186,8 @@ Placed boxes(const char* name, const std::vector<Rect>& rects, double height) {
 
 void add_ramps_and_stairs(std::vector<Placed>& parts) {
   for (const Ramp& ramp : kRamps) {
-    Placed placed{ramp.name, {}, {ramp.x, 0.0, kLaneStart}, 0.0};
-    const double run = ramp_run(ramp);
-    placed.mesh.prism(
-        {{0.0, 0.0}, {run, kRampRise}, {run + kRampPlateau, kRampRise}, {ramp_length(ramp), 0.0}},
-        0.0, kLaneWidth);
-    parts.push_back(std::move(placed));
+    parts.push_back(
+        Placed{ramp.name, ramp.profile.mesh(kLaneWidth), {ramp.x, 0.0, kLaneStart}, 0.0});
   }
   {
     Placed placed{"ramp_down_20", {}, {kRampDownX, 0.0, 0.0}, 0.0};
@@ -267,16 +199,8 @@ void add_ramps_and_stairs(std::vector<Placed>& parts) {
     parts.push_back(std::move(placed));
   }
   for (const Stairs& stairs : kStairs) {
-    // One box per tread (the landing is one): columns standing on the ground.
-    Placed placed{stairs.name, {}, {stairs.x, 0.0, kLaneStart}, 0.0};
-    double along = 0.0;
-    for (int step = 1; step <= 2 * stairs.steps - 1; ++step) {
-      const double length = step == stairs.steps ? stairs.landing : stairs.tread;
-      const double height = stairs_height(stairs, along + 0.5 * length);
-      placed.mesh.box({0.0, 0.0, along}, {kStairsWidth, height, along + length});
-      along += length;
-    }
-    parts.push_back(std::move(placed));
+    parts.push_back(
+        Placed{stairs.name, stairs.profile.mesh(kStairsWidth), {stairs.x, 0.0, kLaneStart}, 0.0});
   }
   {
     // The platform, then one box per tread down.
@@ -293,13 +217,12 @@ void add_ramps_and_stairs(std::vector<Placed>& parts) {
 
 std::vector<Placed> course2_meshes() {
   std::vector<Placed> parts;
-  parts.push_back(flat_ground());
+  parts.push_back(course_mesh::flat_ground(kGroundLow, kGroundHigh));
   add_ramps_and_stairs(parts);
   parts.push_back(rough_patch());
-  for (const TurnedWall& wall : kTurnedWalls) {
-    Placed placed{wall.name, {}, {wall.start_x, 0.0, wall.start_z}, wall.degrees};
-    placed.mesh.box({-kTurnedThickness, 0.0, 0.0}, {0.0, kWallHeight, wall.length});
-    parts.push_back(std::move(placed));
+  for (const Turned& t : kTurnedWalls) {
+    parts.push_back(Placed{
+        t.name, t.wall.mesh(kWallHeight), {t.wall.start_x, 0.0, t.wall.start_z}, t.wall.degrees});
   }
   parts.push_back(boxes("corner", corner_walls(), kWallHeight));
   parts.push_back(boxes("corridor", corridor_walls(), kWallHeight));
@@ -320,23 +243,9 @@ std::vector<Placed> course2_meshes() {
 // ---------------------------------------------------------------------------------------------
 // The table's rows
 
-std::string walk(double x) {
-  return "; walk +Z at x = " + metres(x);
-}
-
 void add_ramp_rows(std::vector<CoursePart>& parts) {
   for (const Ramp& ramp : kRamps) {
-    const double run = ramp_run(ramp);
-    const double z = kLaneStart;
-    parts.push_back({ramp.name,
-                     {ramp.x, ramp.x + kLaneWidth},
-                     {z, z + ramp_length(ramp)},
-                     kRampRise,
-                     metres(ramp.degrees) + "° up (z " + metres(z) + " to " + metres(z + run) +
-                         "), plateau " + metres(kRampRise) + " m high (to " +
-                         metres(z + run + kRampPlateau) + "), " + metres(ramp.degrees) +
-                         "° down (to " + metres(z + ramp_length(ramp)) + ")" +
-                         walk(ramp.x + 0.5 * kLaneWidth)});
+    parts.push_back(ramp.profile.row(ramp.name, ramp.x, kLaneWidth, kLaneStart));
   }
   parts.push_back({"ramp_down_20",
                    {kRampDownX, kRampDownX + kLaneWidth},
@@ -350,17 +259,7 @@ void add_ramp_rows(std::vector<CoursePart>& parts) {
 
 void add_stairs_rows(std::vector<CoursePart>& parts) {
   for (const Stairs& s : kStairs) {
-    const double up = (s.steps - 1) * s.tread;
-    parts.push_back(
-        {s.name,
-         {s.x, s.x + kStairsWidth},
-         {kLaneStart, kLaneStart + stairs_length(s)},
-         s.riser * s.steps,
-         std::to_string(s.steps) + " risers of " + metres(s.riser) + " m up (treads " +
-             metres(s.tread) + " m, z " + metres(kLaneStart) + " to " + metres(kLaneStart + up) +
-             "), landing " + metres(s.riser * s.steps) + " m high (to " +
-             metres(kLaneStart + up + s.landing) + "), " + std::to_string(s.steps) + " down (to " +
-             metres(kLaneStart + stairs_length(s)) + ")" + walk(s.x + 0.5 * kStairsWidth)});
+    parts.push_back(s.profile.row(s.name, s.x, kStairsWidth, kLaneStart));
   }
   parts.push_back({"stairs_down",
                    {kStairsDownX, kStairsDownX + kStairsWidth},
@@ -375,28 +274,7 @@ void add_stairs_rows(std::vector<CoursePart>& parts) {
 }
 
 void add_wall_rows(std::vector<CoursePart>& parts) {
-  for (const TurnedWall& wall : kTurnedWalls) {
-    const glm::dvec2 start(wall.start_x, wall.start_z);
-    glm::dvec2 low(1e9), high(-1e9);
-    for (double a : {0.0, wall.length}) {
-      for (double t : {-kTurnedThickness, 0.0}) {
-        const glm::dvec2 corner = start + a * wall_along(wall) + t * wall_across(wall);
-        low = glm::min(low, corner);
-        high = glm::max(high, corner);
-      }
-    }
-    const glm::dvec2 end = start + wall.length * wall_along(wall);
-    const double meet_z =
-        start.y + (wall.walk_x - start.x) / wall_along(wall).x * wall_along(wall).y;
-    parts.push_back({wall.name,
-                     {low.x, high.x},
-                     {low.y, high.y},
-                     kWallHeight,
-                     "wall " + metres(wall.length) + " m long turned " + metres(wall.degrees) +
-                         "° from +Z, its face from (" + metres(start.x) + ", " + metres(start.y) +
-                         ") to (" + metres(end.x) + ", " + metres(end.y) + ")" + walk(wall.walk_x) +
-                         " to meet it at z = " + metres(meet_z)});
-  }
+  for (const Turned& t : kTurnedWalls) parts.push_back(t.wall.row(t.name, kWallHeight, t.walk_x));
   parts.push_back({"corner",
                    {kCornerFarLowX, kCornerAt[0] + kCornerThickness},
                    {kCornerSideStartZ, kCornerAt[1] + kCornerThickness},
@@ -419,29 +297,14 @@ void add_wall_rows(std::vector<CoursePart>& parts) {
 
 std::vector<CoursePart> course2_parts() {
   std::vector<CoursePart> parts;
-  parts.push_back({"ground",
-                   {kGroundLow[0], kGroundHigh[0]},
-                   {kGroundLow[1], kGroundHigh[1]},
-                   0.0,
-                   "flat ground (y = 0) under the whole course"});
+  parts.push_back(course_mesh::ground_row(kGroundLow, kGroundHigh));
   add_ramp_rows(parts);
   add_stairs_rows(parts);
-  parts.push_back({"rough",
-                   {kRoughX, kRoughX + kRoughWidth},
-                   {kLaneStart, kLaneStart + kRoughLength},
-                   kRough.top(),
-                   "bumps of 0 to " + metres(100.0 * kRough.top()) +
-                       " cm (a smooth height field on a " + metres(100.0 * kRoughCell) +
-                       " cm grid)" + walk(kRoughX + 0.5 * kRoughWidth)});
+  parts.push_back(kRough.row("rough", kRoughX, kLaneStart));
   add_wall_rows(parts);
   for (const Box& box : kBoxes) {
-    parts.push_back({box.name,
-                     {box.x[0], box.x[1]},
-                     {box.z[0], box.z[1]},
-                     box.top,
-                     std::string(box.what) + " " + metres(box.x[1] - box.x[0]) + " by " +
-                         metres(box.z[1] - box.z[0]) + " m, " + metres(box.top) + " m high" +
-                         walk(0.5 * (box.x[0] + box.x[1]))});
+    parts.push_back(course_mesh::box_row(box.name, box.what, {box.x[0], box.x[1]},
+                                         {box.z[0], box.z[1]}, box.top));
   }
   parts.push_back({"slope_across",
                    {kSlopeX, kSlopeX + kSlopeWidth},
@@ -461,24 +324,21 @@ double course2_height(double x, double z) {
   auto in_rect = [&](const Rect& r) { return inside(x, r.x0, r.x1) && inside(z, r.z0, r.z1); };
   for (const Ramp& ramp : kRamps) {
     if (inside(x, ramp.x, ramp.x + kLaneWidth) &&
-        inside(z, kLaneStart, kLaneStart + ramp_length(ramp))) {
-      return ramp_height(ramp, z - kLaneStart);
+        inside(z, kLaneStart, kLaneStart + ramp.profile.length())) {
+      return ramp.profile.height(z - kLaneStart);
     }
   }
   if (inside(x, kRampDownX, kRampDownX + kLaneWidth)) return ramp_down_height(z);
   for (const Stairs& stairs : kStairs) {
-    if (inside(x, stairs.x, stairs.x + kStairsWidth)) return stairs_height(stairs, z - kLaneStart);
+    if (inside(x, stairs.x, stairs.x + kStairsWidth)) return stairs.profile.height(z - kLaneStart);
   }
   if (inside(x, kStairsDownX, kStairsDownX + kStairsWidth)) return stairs_down_height(z);
   if (inside(x, kRoughX, kRoughX + kRoughWidth) &&
       inside(z, kLaneStart, kLaneStart + kRoughLength)) {
     return kRough.height(x - kRoughX, z - kLaneStart);
   }
-  for (const TurnedWall& wall : kTurnedWalls) {
-    const glm::dvec2 local = wall_frame(wall, x, z);
-    if (inside(local.x, -kTurnedThickness, 0.0) && inside(local.y, 0.0, wall.length)) {
-      return kWallHeight;
-    }
+  for (const Turned& t : kTurnedWalls) {
+    if (t.wall.contains(x, z)) return kWallHeight;
   }
   for (const Rect& r : corner_walls()) {
     if (in_rect(r)) return kWallHeight;

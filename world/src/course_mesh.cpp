@@ -4,6 +4,9 @@
 
 #include <tiny_gltf.h>
 
+// offline/src (world/'s private include path): the glTF exporter's buffer writer.
+#include "gltf_buffer_writer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,34 +15,6 @@
 #include <utility>
 
 namespace mm::course_mesh {
-namespace {
-
-// Appends arrays to the model's one buffer, each in its own 4-byte aligned buffer view.
-int add_accessor(tinygltf::Model& model, std::vector<unsigned char>& buffer, const void* data,
-                 size_t bytes, int component_type, int type, size_t count, int target,
-                 std::vector<double> min = {}, std::vector<double> max = {}) {
-  while (buffer.size() % 4 != 0) buffer.push_back(0);
-  tinygltf::BufferView view;
-  view.buffer = 0;
-  view.byteOffset = buffer.size();
-  view.byteLength = bytes;
-  view.target = target;
-  const auto* p = static_cast<const unsigned char*>(data);
-  buffer.insert(buffer.end(), p, p + bytes);
-  model.bufferViews.push_back(std::move(view));
-  tinygltf::Accessor accessor;
-  accessor.bufferView = static_cast<int>(model.bufferViews.size() - 1);
-  accessor.byteOffset = 0;
-  accessor.componentType = component_type;
-  accessor.type = type;
-  accessor.count = count;
-  accessor.minValues = std::move(min);
-  accessor.maxValues = std::move(max);
-  model.accessors.push_back(std::move(accessor));
-  return static_cast<int>(model.accessors.size() - 1);
-}
-
-}  // namespace
 
 double radians(double degrees) {
   return degrees * std::numbers::pi / 180.0;
@@ -89,12 +64,162 @@ void Mesh::prism(const std::vector<glm::dvec2>& profile, double x0, double x1) {
 void Mesh::box(const glm::dvec3& low, const glm::dvec3& high) {
   prism({{low.z, low.y}, {high.z, low.y}, {high.z, high.y}, {low.z, high.y}}, low.x, high.x);
 }
+std::string walk(double x) {
+  return "; walk +Z at x = " + metres(x);
+}
+
+double RampProfile::run() const {
+  return rise / std::tan(radians(degrees));
+}
+
+double RampProfile::length() const {
+  return 2.0 * run() + plateau;
+}
+
+double RampProfile::height(double along) const {
+  const double slope = run();
+  if (along <= 0.0 || along >= length()) return 0.0;
+  if (along < slope) return rise * along / slope;
+  if (along <= slope + plateau) return rise;
+  return rise * (length() - along) / slope;
+}
+
+Mesh RampProfile::mesh(double width) const {
+  Mesh m;
+  const double slope = run();
+  m.prism({{0.0, 0.0}, {slope, rise}, {slope + plateau, rise}, {length(), 0.0}}, 0.0, width);
+  return m;
+}
+
+CoursePart RampProfile::row(const std::string& name, double x, double width, double z) const {
+  const double slope = run();
+  return {name,
+          {x, x + width},
+          {z, z + length()},
+          rise,
+          metres(degrees) + "° up (z " + metres(z) + " to " + metres(z + slope) + "), plateau " +
+              metres(rise) + " m high (to " + metres(z + slope + plateau) + "), " +
+              metres(degrees) + "° down (to " + metres(z + length()) + ")" + walk(x + 0.5 * width)};
+}
+
+double StairsProfile::length() const {
+  return 2.0 * (steps - 1) * tread + landing;
+}
+
+double StairsProfile::top() const {
+  return riser * steps;
+}
+
+double StairsProfile::height(double along) const {
+  if (along < 0.0 || along > length()) return 0.0;
+  const double up = (steps - 1) * tread;
+  if (along < up) return riser * (std::floor(along / tread) + 1.0);
+  if (along <= up + landing) return riser * steps;
+  return riser * (steps - 1 - std::floor((along - up - landing) / tread));
+}
+
+Mesh StairsProfile::mesh(double width) const {
+  Mesh m;
+  double along = 0.0;
+  for (int step = 1; step <= 2 * steps - 1; ++step) {
+    const double depth = step == steps ? landing : tread;
+    m.box({0.0, 0.0, along}, {width, height(along + 0.5 * depth), along + depth});
+    along += depth;
+  }
+  return m;
+}
+
+CoursePart StairsProfile::row(const std::string& name, double x, double width, double z) const {
+  const double up = (steps - 1) * tread;
+  return {name,
+          {x, x + width},
+          {z, z + length()},
+          top(),
+          std::to_string(steps) + " risers of " + metres(riser) + " m up (treads " + metres(tread) +
+              " m, z " + metres(z) + " to " + metres(z + up) + "), landing " + metres(top()) +
+              " m high (to " + metres(z + up + landing) + "), " + std::to_string(steps) +
+              " down (to " + metres(z + length()) + ")" + walk(x + 0.5 * width)};
+}
+
+glm::dvec2 TurnedWall::along() const {
+  return {std::sin(radians(degrees)), std::cos(radians(degrees))};
+}
+
+glm::dvec2 TurnedWall::across() const {
+  return {std::cos(radians(degrees)), -std::sin(radians(degrees))};
+}
+
+glm::dvec2 TurnedWall::frame(double x, double z) const {
+  const glm::dvec2 d(x - start_x, z - start_z);
+  return {glm::dot(d, across()), glm::dot(d, along())};
+}
+
+bool TurnedWall::contains(double x, double z) const {
+  const glm::dvec2 local = frame(x, z);
+  return local.x >= -thickness && local.x <= 0.0 && local.y >= 0.0 && local.y <= length;
+}
+
+Mesh TurnedWall::mesh(double height) const {
+  Mesh m;
+  m.box({-thickness, 0.0, 0.0}, {0.0, height, length});
+  return m;
+}
+
+CoursePart TurnedWall::row(const std::string& name, double height, double walk_x) const {
+  const glm::dvec2 start(start_x, start_z);
+  glm::dvec2 low(1e9), high(-1e9);
+  for (double a : {0.0, length}) {
+    for (double t : {-thickness, 0.0}) {
+      const glm::dvec2 corner = start + a * along() + t * across();
+      low = glm::min(low, corner);
+      high = glm::max(high, corner);
+    }
+  }
+  const glm::dvec2 end = start + length * along();
+  const double meet_z = start.y + (walk_x - start.x) / along().x * along().y;
+  return {name,
+          {low.x, high.x},
+          {low.y, high.y},
+          height,
+          "wall " + metres(length) + " m long turned " + metres(degrees) +
+              "° from +Z, its face from (" + metres(start.x) + ", " + metres(start.y) + ") to (" +
+              metres(end.x) + ", " + metres(end.y) + ")" + walk(walk_x) +
+              " to meet it at z = " + metres(meet_z)};
+}
+
+CoursePart box_row(const std::string& name, const std::string& what, const glm::dvec2& x,
+                   const glm::dvec2& z, double top) {
+  return {name, x, z, top,
+          what + " " + metres(x.y - x.x) + " by " + metres(z.y - z.x) + " m, " + metres(top) +
+              " m high" + walk(0.5 * (x.x + x.y))};
+}
+
+Placed flat_ground(const glm::dvec2& low, const glm::dvec2& high) {
+  Placed ground{"ground", {}, {0.0, 0.0, 0.0}, 0.0};
+  Mesh& m = ground.mesh;
+  const uint32_t a = m.vertex({low.x, 0.0, low.y});
+  const uint32_t b = m.vertex({high.x, 0.0, low.y});
+  const uint32_t c = m.vertex({high.x, 0.0, high.y});
+  const uint32_t d = m.vertex({low.x, 0.0, high.y});
+  m.triangle(a, b, c, {0.0, 1.0, 0.0});
+  m.triangle(a, c, d, {0.0, 1.0, 0.0});
+  return ground;
+}
+
+CoursePart ground_row(const glm::dvec2& low, const glm::dvec2& high) {
+  return {"ground",
+          {low.x, high.x},
+          {low.y, high.y},
+          0.0,
+          "flat ground (y = 0) under the whole course"};
+}
+
 std::vector<unsigned char> write_glb(const std::vector<Placed>& parts, const std::string& root_name,
                                      const std::string& generator) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = generator;
-  std::vector<unsigned char> buffer;
+  gltf_export::BufferWriter buffer(model);
   tinygltf::Node root;
   root.name = root_name;
   for (const Placed& part : parts) {
@@ -108,14 +233,13 @@ std::vector<unsigned char> write_glb(const std::vector<Placed>& parts, const std
         high[static_cast<size_t>(k)] = std::max(high[static_cast<size_t>(k)], double{v});
       }
     }
-    const int position_accessor =
-        add_accessor(model, buffer, positions.data(), positions.size() * sizeof(float),
-                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, part.mesh.positions.size(),
-                     TINYGLTF_TARGET_ARRAY_BUFFER, low, high);
-    const int index_accessor = add_accessor(
-        model, buffer, part.mesh.indices.data(), part.mesh.indices.size() * sizeof(uint32_t),
-        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, part.mesh.indices.size(),
-        TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    const int position_accessor = buffer.add(
+        positions.data(), positions.size() * sizeof(float), TINYGLTF_COMPONENT_TYPE_FLOAT,
+        TINYGLTF_TYPE_VEC3, part.mesh.positions.size(), TINYGLTF_TARGET_ARRAY_BUFFER, low, high);
+    const int index_accessor =
+        buffer.add(part.mesh.indices.data(), part.mesh.indices.size() * sizeof(uint32_t),
+                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                   part.mesh.indices.size(), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     tinygltf::Primitive primitive;
     primitive.attributes["POSITION"] = position_accessor;
     primitive.indices = index_accessor;
@@ -144,16 +268,18 @@ std::vector<unsigned char> write_glb(const std::vector<Placed>& parts, const std
   scene.nodes = {static_cast<int>(model.nodes.size() - 1)};
   model.scenes.push_back(std::move(scene));
   model.defaultScene = 0;
-  while (buffer.size() % 4 != 0) buffer.push_back(0);
-  tinygltf::Buffer gltf_buffer;
-  gltf_buffer.data = std::move(buffer);
-  model.buffers.push_back(std::move(gltf_buffer));
+  buffer.finish();
 
   std::ostringstream stream;
   tinygltf::TinyGLTF writer;
   writer.WriteGltfSceneToStream(&model, stream, /*prettyPrint=*/false, /*writeBinary=*/true);
   const std::string bytes = stream.str();
   return {bytes.begin(), bytes.end()};
+}
+
+double edge_window(double s, double length, double margin) {
+  const double t = std::clamp(std::min(s, length - s) / margin, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
 }
 
 double HeightField::vertex(int column, int row) const {
@@ -199,6 +325,16 @@ Mesh HeightField::mesh() const {
     }
   }
   return m;
+}
+
+CoursePart HeightField::row(const std::string& name, double x, double z) const {
+  const double width = columns * cell;
+  return {name,
+          {x, x + width},
+          {z, z + rows * cell},
+          top(),
+          "bumps of 0 to " + metres(100.0 * top()) + " cm (a smooth height field on a " +
+              metres(100.0 * cell) + " cm grid)" + walk(x + 0.5 * width)};
 }
 
 }  // namespace mm::course_mesh

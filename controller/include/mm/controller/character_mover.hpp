@@ -8,8 +8,16 @@
 //    from the start toward the goal. A hit stops it `kSkin` short of the contact;
 // 2. slide: what the hit cut off, less its part into the obstacle (the contact normal made
 //    horizontal), is swept again from there: pushing diagonally along a wall keeps moving along
-//    it, pushing head-on stops. A second hit stops the slide (a corner);
-// 3. ground: a probe down from step_height above the start's height, as far as step_height +
+//    it, pushing head-on stops. The slide is swept from kSkin off the face's plane (a stop kSkin
+//    short along a glancing move leaves the capsule nearly touching the face, and a sweep along
+//    it from there meets it at once). A second hit stops the slide (a corner). A step exactly
+//    step_height high (the physics engine's sweep meets its top within a few millimetres of the
+//    lifted capsule's bottom, a contact facing up, kStepTopNormalY) is climbed, not a wall: the
+//    rest is swept again kStepClearance higher. A step up to step_height is climbed; a higher one
+//    meets the capsule's side and is slid along. Taken head-on it stalled the character at the
+//    step's edge for seconds;
+// 3. ground: a probe down from step_height + kStepClearance above the start's height (a ray
+//    starting exactly on a step's top misses it), as far as step_height + kStepClearance +
 //    max_step_down, at where the sweeps ended. Walkable ground there is the new height (up a
 //    step, down a step, along a slope). No ground within reach (a ledge) or ground too steep:
 //    the move does not happen, the character stays where it was (never launched into the air,
@@ -63,6 +71,13 @@ class CharacterMover {
   // Where ahead of the capsule's centre, in radii along the move, a drop makes a ledge: within
   // one tread of steep stairs (a 0.26 m tread is more than half a 0.3 m radius).
   static constexpr float kLedgeLead = 0.5f;
+  // A sweep's contact whose normal is at least this close to straight up (its y) is the lifted
+  // capsule's bottom on the top of a step as high as the lift (step_height): climbed, not a wall.
+  static constexpr float kStepTopNormalY = 0.99f;
+  // How much higher (m) the rest of a move is swept after meeting such a step, how far above the
+  // lift the ground probe starts, and how much deeper than step_height a drop may be and still be
+  // a step down.
+  static constexpr float kStepClearance = 0.02f;
 
   // Moves each start[i] toward goal[i] (y ignored) and writes where it ended to out[i]: three
   // batched calls to the world (sweep, slide, ground), whatever the count (at most kMaxMoves).
@@ -99,8 +114,9 @@ class CharacterMover {
   std::array<SweepHit, kMaxMoves> sweep_hits_{};
   std::array<GroundProbe, 2 * kMaxMoves> probes_{};  // per move: its end, then ahead of it
   std::array<GroundHit, 2 * kMaxMoves> ground_hits_{};
-  std::array<int, kMaxMoves> lead_{};  // the probe ahead of each move's end, or -1
-  std::array<int, kMaxMoves> slid_{};  // the move each slide sweep belongs to
+  std::array<int, kMaxMoves> lead_{};      // the probe ahead of each move's end, or -1
+  std::array<int, kMaxMoves> slid_{};      // the move each slide sweep belongs to
+  std::array<bool, kMaxMoves> climbed_{};  // the sweep met a step's top (phase 2), not a wall
   int64_t rejected_ = 0;
 };
 

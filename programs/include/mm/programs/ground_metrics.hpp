@@ -23,7 +23,7 @@
 // - knee_overextension_frames: frames where either knee (upper leg, lower leg, foot) is within
 //   kStraightKneeDegrees of straight;
 // - wall_depth_cm_max: the deepest any joint is inside a wall (EvaluationFrame::wall_depth,
-//   from the world's sweeps; 0 without a world);
+//   from the world's queries by WallDepthReader; 0 without a world);
 // - stuck_s: time the simulation object was blocked by a wall while the stick pushed at least
 //   kStuckAlongSpeed along the wall and it moved slower than kStuckSpeed: stuck where it could
 //   have slid. A stop at a ledge (no ground ahead, no wall: the mover does not step off) has no
@@ -33,9 +33,11 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
+#include "mm/controller/world.hpp"
 #include "mm/database/database.hpp"
 #include "mm/database/joint_roles.hpp"
 
@@ -94,6 +96,41 @@ class GroundAccumulator {
  private:
   struct State;
   std::unique_ptr<State> state_;
+};
+
+// How deep a pose's joints are inside walls, from the world's queries (positions relative to
+// `origin`, as the queries take them). A joint counts when it is higher than `above` (lower ones
+// meet the ground's slopes and steps, and are the penetration metrics' to judge) and is inside
+// by the lesser of:
+// - how far it is behind the face it is behind: a sphere of kWallProbeRadius swept at the
+//   joint's height from the root's vertical line out to it meets the face; the depth is the
+//   joint's distance behind that face's plane (its contact normal made horizontal), so a joint
+//   on the face reads 0 (a sweep met where it starts, the root's line inside or against a wall,
+//   reads the whole way out to the joint);
+// - how far it is below the top found straight above it: a ground probe from kTopProbeHeight
+//   above the joint, reaching a metre below it. A joint above the surface under it is in no
+//   wall: a foot passing a few millimetres over a box's top edge meets the edge with the sweep
+//   (the box's whole length read as depth, 33 cm) but is above the box.
+// What it cannot see: a solid with no top face (an open mesh: probes find the ground below the
+// joint) reads 0, and under a roof over a box the roof is the "top" and the face's depth stands.
+// The buffers are sized once, for `joints` joints.
+class WallDepthReader {
+ public:
+  static constexpr float kWallProbeRadius = 0.01f;  // m
+  static constexpr float kTopProbeHeight = 100.0f;  // m
+
+  explicit WallDepthReader(size_t joints);
+  // The deepest of `joints` inside a wall (m; 0 when none is); the joint in `deepest` (-1).
+  float read(const WorldQueries& world, const glm::dvec3& origin, const glm::vec3& root,
+             std::span<const glm::vec3> joints, float above, int* deepest = nullptr);
+
+ private:
+  std::vector<ShapeSweep> sweeps_;
+  std::vector<SweepHit> sweep_hits_;
+  std::vector<GroundProbe> probes_;
+  std::vector<GroundHit> probe_hits_;
+  std::vector<float> depth_;  // behind the face, of each joint past one
+  std::vector<int> joint_;    // the joint each query is about
 };
 
 // The database's own geometric skating: every clip that carries none of `excluded_tags` played
