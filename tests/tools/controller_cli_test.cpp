@@ -358,17 +358,21 @@ TEST(ControllerCli, CrowdBenchUnderABudgetReportsTiersAndFrameTimes) {
   EXPECT_EQ(json["tier_cost_us"]["quarter"].get<double>(), 2.0);
   EXPECT_NE(run.output.find("tiers at the end: full 5, half 19"), std::string::npos) << run.output;
 
-  // The default headroom holds back a quarter: 75 us to spend, all at half (72 us), and raising
-  // one to full (+5) would pass it. --budget-only leaves out the full-rate runs.
+  // The default headroom holds back 30 % of 2 x 51 us: 71.4 us to spend. All at half (72 us)
+  // would pass it, so all start at quarter (48 us); three are raised to full (+6 each: 66 us; a
+  // fourth would make 72), then five of the rest to half (+1 each: 71 us). --budget-only leaves
+  // out the full-rate runs.
   const fs::path held_path = dir / "crowd-headroom.json";
   const CommandRun held = run_mm("crowd-bench --db '" + small_database().string() +
-                                 "' --characters 24 --seconds 2 --budget-ms 0.05 --tier-costs-us "
+                                 "' --characters 24 --seconds 2 --budget-ms 0.051 --tier-costs-us "
                                  "8,3,2,0.5 --budget-only --json '" +
                                  held_path.string() + "'");
   ASSERT_EQ(held.exit_code, 0) << held.output;
   const nlohmann::json held_json = nlohmann::json::parse(read_text(held_path));
-  EXPECT_EQ(held_json["budget_headroom"].get<double>(), 0.25);
-  EXPECT_EQ(held_json["tier_counts"]["half"].get<int>(), 24);
+  EXPECT_NEAR(held_json["budget_headroom"].get<double>(), 0.3, 1e-12);
+  EXPECT_EQ(held_json["tier_counts"]["full"].get<int>(), 3);
+  EXPECT_EQ(held_json["tier_counts"]["half"].get<int>(), 5);
+  EXPECT_EQ(held_json["tier_counts"]["quarter"].get<int>(), 16);
   EXPECT_FALSE(held_json.contains("max_characters_60hz_1_thread"));
   EXPECT_EQ(held.output.find("at full rate"), std::string::npos) << held.output;
 
