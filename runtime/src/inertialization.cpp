@@ -118,12 +118,7 @@ void inertialize_update(InertializationOffsets& offsets, const PoseMotion& incom
                         float dt, std::span<Transform> out_local,
                         std::span<glm::vec3> out_velocities,
                         std::span<glm::vec3> out_angular_velocities) {
-  const size_t n = offsets.rotations.size();
-  MM_ASSERT(incoming.local.size() == n && out_local.size() == n);
-  MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
-  MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
-  MM_ASSERT(out_velocities.empty() || out_velocities.size() == n);
-  MM_ASSERT(out_angular_velocities.empty() || out_angular_velocities.size() == n);
+  // The sizes are checked where the step is applied.
   inertialize_update(offsets, incoming, critical_spring_step(halflife, dt), out_local,
                      out_velocities, out_angular_velocities);
 }
