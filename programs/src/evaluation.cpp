@@ -341,9 +341,12 @@ void EvaluationAccumulator::State::measure_pivot(const EvaluationFrame& r, int s
   const int toe = side == 0 ? roles.left_toe : roles.right_toe;
   if (foot < 0 || toe < 0) return;
   const glm::vec3& toe_position = r.joints[static_cast<size_t>(toe)];
-  const float yaw =
-      direction_yaw(toe_position - r.joints[static_cast<size_t>(foot)], pivot_yaw[side]);
-  const bool ok = toe_position.y < kPivotToeHeight && toe_speed < kPivotToeSpeed;
+  const glm::vec3 foot_to_toe = toe_position - r.joints[static_cast<size_t>(foot)];
+  const float yaw = direction_yaw(foot_to_toe, pivot_yaw[side]);
+  const float level = std::hypot(foot_to_toe.x, foot_to_toe.z);
+  const bool flat_enough =
+      level >= std::cos(glm::radians(kPivotMaxFootPitchDegrees)) * glm::length(foot_to_toe);
+  const bool ok = toe_position.y < kPivotToeHeight && toe_speed < kPivotToeSpeed && flat_enough;
   if (ok && pivot_ok[side]) pivot.add(yaw_error_deg(yaw, pivot_yaw[side]) / dt);
   pivot_ok[side] = ok;
   pivot_yaw[side] = yaw;

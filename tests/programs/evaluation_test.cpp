@@ -62,6 +62,9 @@ struct Pose {
   float chest_yaw = 0.0f;  // degrees
   glm::vec3 toe[2] = {{0.1f, 0.1f, 0.15f}, {-0.1f, 0.1f, 0.15f}};
   float foot_yaw[2] = {0.0f, 0.0f};  // degrees: the foot sits behind its toe along this yaw
+  // Degrees: the foot-to-toe segment's pitch down from level (about 18 by default); past 90
+  // the foot is ahead of its toe.
+  float foot_pitch[2] = {18.43f, 18.43f};
   glm::vec3 head{0.0f, 1.6f, 0.0f};
 };
 
@@ -73,8 +76,9 @@ std::vector<glm::vec3> joints_of(const Pose& p) {
   j[kRightUpperArm] = glm::vec3(0.0f, 1.4f, 0.0f) - 0.2f * left_of(p.chest_yaw);
   for (int side = 0; side < 2; ++side) {
     j[kLeftToe + side] = p.toe[side];
-    j[kLeftFoot + side] =
-        p.toe[side] - 0.15f * forward_of(p.foot_yaw[side]) + glm::vec3(0.0f, 0.05f, 0.0f);
+    const float pitch = glm::radians(p.foot_pitch[side]);
+    j[kLeftFoot + side] = p.toe[side] - 0.158f * std::cos(pitch) * forward_of(p.foot_yaw[side]) +
+                          glm::vec3(0.0f, 0.158f * std::sin(pitch), 0.0f);
   }
   j[kHead] = p.head;
   return j;
@@ -215,6 +219,24 @@ TEST(Evaluation, FootPivotIsTheFootToToeYawRateOfALowSlowToe) {
   EXPECT_NEAR(m.foot_pivot_deg_s_mean, 30.0, 0.05);
   // Low and slow on this and the previous frame: from the third frame on, left foot only.
   EXPECT_EQ(m.foot_pivot_frames, frames - 2);
+}
+
+// A foot rising through vertical over a still toe (the end of a push-off): its horizontal part
+// shrinks to nothing and its yaw flips by half a turn, which is no pivot. Only the frames
+// pitched at most kPivotMaxFootPitchDegrees count, and they do not turn.
+TEST(Evaluation, AFootRisingThroughVerticalOverAStillToeIsNoPivot) {
+  FrameFeed run;
+  const int frames = 31;
+  for (int f = 0; f < frames; ++f) {
+    Pose pose;
+    pose.toe[0] = {0.1f, 0.03f, 0.2f};
+    pose.foot_pitch[0] = 20.0f + 3.0f * static_cast<float>(f);  // 20 to 110 degrees
+    run.add(pose);
+  }
+  const EvaluationMetrics m = run.metrics();
+  EXPECT_NEAR(m.foot_pivot_deg_s_mean, 0.0, 1e-3);
+  // Pitches 20, 23, ..., 59 are flat enough (frames 0 to 13), counted from the third frame on.
+  EXPECT_EQ(m.foot_pivot_frames, 12);
 }
 
 TEST(Evaluation, LowestToeHeightIsTheLowestEitherToeReaches) {

@@ -58,7 +58,10 @@
 //   previous frame (so it starts at the third frame), over both feet. The 3-D speed, because a
 //   toe lifting off is not planted: at a run's push-off the foot passes through vertical with
 //   the toe still low, rising fast, and the yaw of its tiny horizontal part spins through half
-//   a turn in a frame or two; foot_pivot_frames
+//   a turn in a frame or two. And the foot pitched at most kPivotMaxFootPitchDegrees on both
+//   frames: a foot standing near vertical on a still toe (the end of a push-off, the data's own
+//   as well as a held toe's) has a horizontal part of a few millimetres whose yaw flips through
+//   half a turn between two frames, a spin nobody sees; foot_pivot_frames
 //   counts the samples (a side without a foot and a toe role gives none);
 // - turning on the spot: an event starts on a frame where the desired speed is below
 //   kStandTurnSpeed now and kStandTurnLookback earlier and the desired facing differs by at
@@ -128,6 +131,8 @@ inline constexpr float kVelocityTolerance = 0.01f;
 // A pivoting toe: below this height (m) and slower than this (m/s).
 inline constexpr float kPivotToeHeight = 0.06f;
 inline constexpr float kPivotToeSpeed = 0.35f;
+// A pivoting foot is pitched at most this far (degrees) from level, foot to toe.
+inline constexpr float kPivotMaxFootPitchDegrees = 60.0f;
 // Turning on the spot: the desired speed below this (m/s) now and kStandTurnLookback (s)
 // earlier, and the desired facing at least kStandTurnAngleDegrees away from then.
 inline constexpr float kStandTurnSpeed = 0.01f;
