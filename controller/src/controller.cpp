@@ -113,9 +113,11 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
 constexpr float kSoftReach = 0.96f;
 constexpr float kMinSoftSpan = 0.01f;
 // The most (radians) the root turns to bring a standing pose's hips onto the facing, and the
-// halflife (s) over which it follows their lasting offset.
+// halflife (s) over which it follows their offset: short beside the adjustment's own halflife,
+// because the two lags add, and a weight shift after a transition inside the idle turns the
+// hips by ten degrees in under half a second.
 constexpr float kMaxHipsAlign = 0.2f;
-constexpr float kHipsAlignHalflife = 0.15f;
+constexpr float kHipsAlignHalflife = 0.05f;
 // The most (radians) a held foot's heel lifts about its toe for a leg that falls short of it.
 constexpr float kMaxHeelRise = 0.5f;
 // Halflife (s) of the easing between keeping the animation's extension (standing) and not.
@@ -1014,8 +1016,9 @@ void Controller::limit_body_turn(float dt) {
 
 // Standing, the idle pose's hips may face a few degrees off its root for seconds (a weight
 // shift), and a turn on the spot would end that far off the facing. The root's facing goal is
-// turned the other way by the hips' lasting offset (followed slowly, so the pose's own sway
-// stays, and bounded), and eases back to none once the character moves.
+// turned the other way by the hips' offset (followed within a few frames, bounded), so the
+// hips keep the facing while the rest of the pose sways, and eases back to none once the
+// character moves.
 void Controller::align_hips(float dt) {
   const float goal =
       stopping_ && body_yaw_known_ ? std::clamp(hips_offset_, -kMaxHipsAlign, kMaxHipsAlign) : 0.0f;
