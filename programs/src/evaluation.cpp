@@ -581,7 +581,8 @@ class WorldReadings {
         r.desired_velocity -
         d.simulation_contact * glm::dot(r.desired_velocity, d.simulation_contact);
     const bool at_wall = d.simulation_blocked && glm::length(d.simulation_contact) > 0.5f;
-    r.stuck = at_wall && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed;
+    r.stuck = at_wall && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed &&
+              can_slide(controller.settings(), d, r.origin, along);
     previous_sim_ = d.simulation_position;
   }
 
@@ -602,6 +603,23 @@ class WorldReadings {
     for (int k = 0; k < 3; ++k) {
       *out[k] = hits[k].hit && std::isfinite(hits[k].point.y) ? hits[k].point.y : d.ground_height;
     }
+  }
+
+  // Whether the capsule, as the mover sweeps it (lifted by the step height), can move along the
+  // wall it is blocked by: pushed into a concave corner, the slide along one wall meets the other
+  // at once, and a character standing there is not stuck where it could have slid. Swept a skin
+  // off the wall, so that the wall it rests against is not met again.
+  bool can_slide(const ControllerSettings& s, const ControllerDebug& d, const glm::dvec3& origin,
+                 const glm::vec3& along) const {
+    constexpr float kSkin = 0.01f;   // m off the wall
+    constexpr float kProbe = 0.05f;  // m along it: half of it free is a slide
+    const glm::vec3 from =
+        d.simulation_position + glm::vec3(0.0f, s.step_height, 0.0f) + d.simulation_contact * kSkin;
+    const ShapeSweep sweep{from, from + glm::normalize(along) * kProbe, s.character_radius,
+                           s.character_height};
+    SweepHit hit;
+    world_->sweep(origin, std::span(&sweep, 1), std::span(&hit, 1));
+    return !hit.hit || !(hit.fraction < 0.5f);
   }
 
   // The deepest any joint higher than a step above the ground is inside a wall

@@ -257,6 +257,25 @@ TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
   EXPECT_EQ(wall->metrics.ground.stuck_s, 0.0);
   EXPECT_LT(wall->metrics.ground.wall_depth_cm_max, 2.0);
 
+  // Pushed diagonally into a concave corner (this wall and one whose face is x = 2): the slide
+  // along either wall meets the other, so the character standing there is not stuck where it
+  // could have slid.
+  AnalyticWorld corner;
+  corner.boxes.push_back(wall_across_z(4.0f));
+  corner.boxes.push_back(AnalyticBox{glm::vec2(2.2f, 0.0f), glm::vec2(0.2f, 30.0f), 0.0f, 3.0f});
+  InputScript into_corner(
+      {ScriptEvent{0.0f, push_toward(45.0f), ""}, ScriptEvent{8.0f, ControllerInput{}, ""}});
+  options.world = &corner;
+  const Result<EvaluationResult> cornered = evaluate_script(shared, into_corner, options);
+  ASSERT_TRUE(cornered.ok()) << cornered.message();
+  EXPECT_EQ(cornered->metrics.ground.stuck_s, 0.0);
+  EXPECT_LT(cornered->metrics.ground.wall_depth_cm_max, 2.0);
+  // Along the z wall alone (no corner), the same push slides: not stuck either.
+  options.world = &walled;
+  const Result<EvaluationResult> along = evaluate_script(shared, into_corner, options);
+  ASSERT_TRUE(along.ok()) << along.message();
+  EXPECT_EQ(along->metrics.ground.stuck_s, 0.0);
+
   // A wall through the character where it stands (farther in than the body is ever moved back
   // from a wall): the depth is seen.
   AnalyticWorld through;

@@ -27,7 +27,8 @@
 // - stuck_s: time the simulation object was blocked by a wall while the stick pushed at least
 //   kStuckAlongSpeed along the wall and it moved slower than kStuckSpeed: stuck where it could
 //   have slid. A stop at a ledge (no ground ahead, no wall: the mover does not step off) has no
-//   wall to slide along and is not counted.
+//   wall to slide along and is not counted, nor is a push into a concave corner, where the
+//   capsule swept along the wall meets another within a few centimetres.
 
 #include <cstddef>
 #include <cstdint>
