@@ -4,6 +4,7 @@
 #include "mm/controller/controller.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 
@@ -740,6 +741,20 @@ Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const 
                                settings_.cubic_playback, settings_.interpolation);
 }
 
+// The database root (joint 0, unmapped) at a playback point: sample_playback's own sample when
+// it was taken there the same way (move_root asks for it in the update that sampled it), else
+// sampled again. sample_database_pose equals sample_database_joint to the bit, so both give the
+// same transform.
+Transform Controller::database_root(const PlaybackPoint& at) const {
+  const RootSample& s = root_sample_;
+  if (s.valid && s.at.frame0 == at.frame0 && s.at.frame1 == at.frame1 &&
+      std::bit_cast<uint32_t>(s.at.weight) == std::bit_cast<uint32_t>(at.weight) &&
+      s.cubic == settings_.cubic_playback && s.method == settings_.interpolation) {
+    return s.root;
+  }
+  return sample_joint(at, 0);
+}
+
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
@@ -754,6 +769,7 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
+  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
   velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
   angular_velocities[0] =
       glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
@@ -1098,7 +1114,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
   const glm::vec3 played_position = position - root_offsets_.positions[0];
   const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
   // The database root relative to the destination: M = inverse(destination) * root(t).
-  const Transform root = sample_joint(playback_point(), 0);
+  const Transform root = database_root(playback_point());
   const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
   const glm::quat relative_rotation = inverse_destination * root.rotation;
   const glm::vec3 relative_position =

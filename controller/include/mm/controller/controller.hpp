@@ -577,6 +577,7 @@ class Controller {
   };
   PlaybackPoint playback_point() const;
   Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
+  Transform database_root(const PlaybackPoint& at) const;
   void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
                        std::span<glm::vec3> angular_velocities, bool body_velocities) const;
   void sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
@@ -675,6 +676,16 @@ class Controller {
   // transition reads them, so each update samples the root's alone and a transition the rest.
   PlaybackPoint sampled_at_;
   bool sampled_body_velocities_ = false;
+  // The database root (unmapped) of sample_playback's last sample, where and how it was taken:
+  // move_root needs that sample again in the same update (database_root).
+  struct RootSample {
+    PlaybackPoint at;
+    bool cubic = false;
+    InterpolationMethod method = InterpolationMethod::Nlerp;
+    Transform root;
+    bool valid = false;
+  };
+  mutable RootSample root_sample_;
   std::vector<Transform> other_;  // the other side of a transition
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;
