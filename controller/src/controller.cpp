@@ -286,6 +286,10 @@ Status Controller::resolve_joints() {
   for (int j = 1; j < db.joint_count(); ++j) {
     if (db.skeleton().parent(j) == 0 && db.skeleton().subtree_size(j) > 1 && j != db.roles().hips) {
       folded_joints_.push_back(j);
+      // Its children, found once here: sample_playback folds it into them in every update.
+      for (int c = j + 1; c < j + db.skeleton().subtree_size(j); ++c) {
+        if (db.skeleton().parent(c) == j) folded_children_.push_back({j, c});
+      }
     }
   }
   return Status::success();
@@ -778,16 +782,12 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   // their children so that every joint below the root is relative to the character: their
   // locals relative to the simulation root differ between takes by whole metres, and offsets
   // between such values would swing the body around during a transition.
-  for (const int j : folded_joints_) {
-    const Transform folded = local[static_cast<size_t>(j)];
-    const int end = j + db.skeleton().subtree_size(j);
-    for (int c = j + 1; c < end; ++c) {
-      if (db.skeleton().parent(c) != j) continue;
-      const size_t k = static_cast<size_t>(c);
-      local[k] = compose(folded, local[k]);
-    }
-    local[static_cast<size_t>(j)] = Transform{};
+  // (A folded joint's children are not folded joints: those hang from the root.)
+  for (const auto& [j, c] : folded_children_) {
+    local[static_cast<size_t>(c)] =
+        compose(local[static_cast<size_t>(j)], local[static_cast<size_t>(c)]);
   }
+  for (const int j : folded_joints_) local[static_cast<size_t>(j)] = Transform{};
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
   local[0].translation =
       map * (local[0].translation - transition_dst_position_) + transition_src_position_;
@@ -814,9 +814,8 @@ void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
     const glm::vec3 v = velocities[static_cast<size_t>(j)];
     const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
-    const int end = j + db.skeleton().subtree_size(j);
-    for (int c = j + 1; c < end; ++c) {
-      if (db.skeleton().parent(c) != j) continue;
+    for (const auto& [f, c] : folded_children_) {
+      if (f != j) continue;
       const size_t k = static_cast<size_t>(c);
       const glm::vec3 offset = folded * sample_joint(at, k).translation;
       velocities[k] = v + glm::cross(w, offset) + folded * velocities[k];

@@ -629,6 +629,7 @@ class Controller {
   std::vector<TrajectoryColumn> trajectory_columns_;
   std::vector<int> leg_joints_[2];  // upper leg, lower leg, foot, toe per side
   std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)
+  std::vector<std::array<int, 2>> folded_children_;  // {folded joint, one of its children}
 
   // Every position below is relative to this world position (local_origin.hpp).
   glm::dvec3 origin_{0.0};
