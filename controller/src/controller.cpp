@@ -500,8 +500,8 @@ void Controller::desired_motion(const ControllerInput& input) {
     warp_facing_ = desired_rotation_;
     warp_facing_reached_ = false;
   }
-  if (clip_ >= 0 && std::abs(wrap_angle(quat_yaw(locals_[0].rotation) -
-                                        quat_yaw(desired_rotation_))) < kWarpFacingReached) {
+  if (clip_ >= 0 && std::abs(wrap_angle(root_yaw_.of(locals_[0].rotation) -
+                                        desired_yaw_.of(desired_rotation_))) < kWarpFacingReached) {
     warp_facing_reached_ = true;
   }
   simulation_goal_rotation_ = warped_facing();
@@ -849,7 +849,9 @@ void Controller::simulate(float dt) {
 // facing then turns at that rate until the spring's own rate falls below it.
 void Controller::limit_turn_rate(const glm::quat& before, float dt) {
   const float max_rate = settings_.simulation_max_turn_rate;
-  const float step = wrap_angle(quat_yaw(sim_rotation_) - quat_yaw(before));
+  // The yaw before first: the last prediction asked for it, the one after is new.
+  const float yaw_before = sim_yaw_.of(before);
+  const float step = wrap_angle(sim_yaw_.of(sim_rotation_) - yaw_before);
   if (std::abs(step) > max_rate * dt) {
     sim_rotation_ = glm::normalize(yaw_rotation(std::copysign(max_rate * dt, step)) * before);
   }
@@ -862,7 +864,7 @@ void Controller::limit_turn_rate(const glm::quat& before, float dt) {
 // deceleration, bounded by the maximum rate, and changes by at most the set acceleration: it
 // eases in, cruises and eases out. A turn that would pass the facing this update lands on it.
 void Controller::stand_turn(float dt) {
-  const float error = wrap_angle(quat_yaw(desired_rotation_) - quat_yaw(sim_rotation_));
+  const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - sim_yaw_.of(sim_rotation_));
   const float acceleration = settings_.stand_turn_acceleration;
   const float stoppable = std::sqrt(2.0f * acceleration * std::abs(error));
   const float goal = std::copysign(std::min(settings_.stand_turn_max_rate, stoppable), error);
@@ -892,7 +894,7 @@ void Controller::predict() {
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
-  const float yaw = quat_yaw(sim_rotation_);
+  const float yaw = sim_yaw_.of(sim_rotation_);
   const float max_rate =
       stopping_ ? settings_.stand_turn_max_rate : settings_.simulation_max_turn_rate;
   for (size_t i = 0; i < n; ++i) {
@@ -922,7 +924,7 @@ void Controller::synchronize(float dt) {
     case SyncMode::SimulationFollowsCharacter:
       sim_position_ =
           glm::vec3(root.translation.x, world_ ? last_root_.y : 0.0f, root.translation.z);
-      sim_rotation_ = yaw_rotation(quat_yaw(root.rotation));
+      sim_rotation_ = yaw_rotation(root_yaw_.of(root.rotation));
       return;
     case SyncMode::CharacterFollowsSimulation:
       break;
@@ -953,9 +955,9 @@ void Controller::synchronize(float dt) {
   if (glm::length(step) > max_step) step *= max_step / glm::length(step);
   glm::vec3 position = root.translation + step;
 
-  const float root_yaw = quat_yaw(root.rotation);
+  const float root_yaw = root_yaw_.of(root.rotation);
   align_hips(dt);
-  float angle = wrap_angle(quat_yaw(sim_rotation_) - hips_align_ - root_yaw) * fraction;
+  float angle = wrap_angle(sim_yaw_.of(sim_rotation_) - hips_align_ - root_yaw) * fraction;
   // At least as fast as the simulation itself turns: held to the character's own turning, a
   // clip that does not turn would leave the root behind a turning simulation until the clamp
   // dragged it.
@@ -986,9 +988,9 @@ void Controller::synchronize(float dt) {
   if (distance > settings_.clamp_max_distance) {
     position = sim_position_ + away * (settings_.clamp_max_distance / distance);
   }
-  const float yaw_error = wrap_angle(yaw - quat_yaw(sim_rotation_));
+  const float yaw_error = wrap_angle(yaw - sim_yaw_.of(sim_rotation_));
   if (std::abs(yaw_error) > settings_.clamp_max_angle) {
-    yaw = quat_yaw(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
+    yaw = sim_yaw_.of(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
   }
   position.y = root.translation.y;
   if (position == root.translation && yaw == root_yaw) return;
@@ -1004,7 +1006,7 @@ float Controller::body_yaw() const {
   const std::span<const int> parents = db_->skeleton().parents();
   const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
   const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
-  return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
+  return pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
 }
 
 // The body turns no faster than body_max_turn_rate: the root takes back what the clip's own
@@ -1024,7 +1026,7 @@ void Controller::limit_body_turn(float dt) {
   }
   body_yaw_ = yaw;
   body_yaw_known_ = true;
-  hips_offset_ = wrap_angle(yaw - quat_yaw(locals_[0].rotation));
+  hips_offset_ = wrap_angle(yaw - root_yaw_.of(locals_[0].rotation));
 }
 
 // Standing, the idle pose's hips may face a few degrees off its root for seconds (a weight
@@ -1051,7 +1053,7 @@ glm::quat Controller::warped_facing() const {
       glm::length(desired_velocity_) < kWarpMinSpeed) {
     return desired_rotation_;
   }
-  const float facing = quat_yaw(desired_rotation_);
+  const float facing = desired_yaw_.of(desired_rotation_);
   const float off = wrap_angle(std::atan2(desired_velocity_.x, desired_velocity_.z) - facing);
   const float warp = std::abs(off) > kWarpMaxTravel ? wrap_angle(off + glm::pi<float>()) : off;
   return yaw_rotation(facing + std::clamp(warp, -limit, limit));
@@ -1076,8 +1078,8 @@ void Controller::turn_chest_to_facing(float dt) {
     const float chest_yaw =
         pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
                  forward_kinematics_position(parents, locals_, roles.right_upper_arm),
-                 quat_yaw(locals_[0].rotation));
-    const float error = wrap_angle(quat_yaw(desired_rotation_) - chest_yaw);
+                 root_yaw_.of(locals_[0].rotation));
+    const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
     // now could pick the other way round from the body's own turn.
     goal = std::abs(error) <= kChestTwistReach ? std::clamp(error, -kMaxChestTwist, kMaxChestTwist)

@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -633,6 +634,27 @@ class Controller {
 
   // Every position below is relative to this world position (local_origin.hpp).
   glm::dvec3 origin_{0.0};
+
+  // quat_yaw of the rotation last asked about, kept: several phases of an update ask for the yaw
+  // of the same rotation (the simulation's, the root's, the desired facing), and comparing the
+  // rotation's bits costs less than the yaw.
+  class YawMemo {
+   public:
+    float of(const glm::quat& q) const {
+      if (!known_ || std::memcmp(&q, &rotation_, sizeof(glm::quat)) != 0) {
+        rotation_ = q;
+        yaw_ = quat_yaw(q);
+        known_ = true;
+      }
+      return yaw_;
+    }
+
+   private:
+    mutable glm::quat rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+    mutable float yaw_ = 0.0f;
+    mutable bool known_ = false;
+  };
+  YawMemo sim_yaw_, root_yaw_, desired_yaw_;
 
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
