@@ -4,6 +4,7 @@
 #include "mm/controller/controller.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 
@@ -287,6 +288,10 @@ Status Controller::resolve_joints() {
   for (int j = 1; j < db.joint_count(); ++j) {
     if (db.skeleton().parent(j) == 0 && db.skeleton().subtree_size(j) > 1 && j != db.roles().hips) {
       folded_joints_.push_back(j);
+      // Its children, found once here: sample_playback folds it into them in every update.
+      for (int c = j + 1; c < j + db.skeleton().subtree_size(j); ++c) {
+        if (db.skeleton().parent(c) == j) folded_children_.push_back({j, c});
+      }
     }
   }
   return Status::success();
@@ -497,8 +502,8 @@ void Controller::desired_motion(const ControllerInput& input) {
     warp_facing_ = desired_rotation_;
     warp_facing_reached_ = false;
   }
-  if (clip_ >= 0 && std::abs(wrap_angle(quat_yaw(locals_[0].rotation) -
-                                        quat_yaw(desired_rotation_))) < kWarpFacingReached) {
+  if (clip_ >= 0 && std::abs(wrap_angle(root_yaw_.of(locals_[0].rotation) -
+                                        desired_yaw_.of(desired_rotation_))) < kWarpFacingReached) {
     warp_facing_reached_ = true;
   }
   simulation_goal_rotation_ = warped_facing();
@@ -742,6 +747,20 @@ Transform Controller::sample_joint(const PlaybackPoint& at, size_t joint) const 
                                settings_.cubic_playback, settings_.interpolation);
 }
 
+// The database root (joint 0, unmapped) at a playback point: sample_playback's own sample when
+// it was taken there the same way (move_root asks for it in the update that sampled it), else
+// sampled again. sample_database_pose equals sample_database_joint to the bit, so both give the
+// same transform.
+Transform Controller::database_root(const PlaybackPoint& at) const {
+  const RootSample& s = root_sample_;
+  if (s.valid && s.at.frame0 == at.frame0 && s.at.frame1 == at.frame1 &&
+      std::bit_cast<uint32_t>(s.at.weight) == std::bit_cast<uint32_t>(at.weight) &&
+      s.cubic == settings_.cubic_playback && s.method == settings_.interpolation) {
+    return s.root;
+  }
+  return sample_joint(at, 0);
+}
+
 // The playing clip at clip_time_, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
@@ -756,6 +775,7 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const size_t k1 = static_cast<size_t>(at.frame1) * joints;
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
+  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
   velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
   angular_velocities[0] =
       glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
@@ -764,16 +784,12 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   // their children so that every joint below the root is relative to the character: their
   // locals relative to the simulation root differ between takes by whole metres, and offsets
   // between such values would swing the body around during a transition.
-  for (const int j : folded_joints_) {
-    const Transform folded = local[static_cast<size_t>(j)];
-    const int end = j + db.skeleton().subtree_size(j);
-    for (int c = j + 1; c < end; ++c) {
-      if (db.skeleton().parent(c) != j) continue;
-      const size_t k = static_cast<size_t>(c);
-      local[k] = compose(folded, local[k]);
-    }
-    local[static_cast<size_t>(j)] = Transform{};
+  // (A folded joint's children are not folded joints: those hang from the root.)
+  for (const auto& [j, c] : folded_children_) {
+    local[static_cast<size_t>(c)] =
+        compose(local[static_cast<size_t>(j)], local[static_cast<size_t>(c)]);
   }
+  for (const int j : folded_joints_) local[static_cast<size_t>(j)] = Transform{};
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
   local[0].translation =
       map * (local[0].translation - transition_dst_position_) + transition_src_position_;
@@ -800,9 +816,8 @@ void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
     const glm::vec3 v = velocities[static_cast<size_t>(j)];
     const glm::vec3 w = angular_velocities[static_cast<size_t>(j)];
-    const int end = j + db.skeleton().subtree_size(j);
-    for (int c = j + 1; c < end; ++c) {
-      if (db.skeleton().parent(c) != j) continue;
+    for (const auto& [f, c] : folded_children_) {
+      if (f != j) continue;
       const size_t k = static_cast<size_t>(c);
       const glm::vec3 offset = folded * sample_joint(at, k).translation;
       velocities[k] = v + glm::cross(w, offset) + folded * velocities[k];
@@ -836,7 +851,9 @@ void Controller::simulate(float dt) {
 // facing then turns at that rate until the spring's own rate falls below it.
 void Controller::limit_turn_rate(const glm::quat& before, float dt) {
   const float max_rate = settings_.simulation_max_turn_rate;
-  const float step = wrap_angle(quat_yaw(sim_rotation_) - quat_yaw(before));
+  // The yaw before first: the last prediction asked for it, the one after is new.
+  const float yaw_before = sim_yaw_.of(before);
+  const float step = wrap_angle(sim_yaw_.of(sim_rotation_) - yaw_before);
   if (std::abs(step) > max_rate * dt) {
     sim_rotation_ = glm::normalize(yaw_rotation(std::copysign(max_rate * dt, step)) * before);
   }
@@ -849,7 +866,7 @@ void Controller::limit_turn_rate(const glm::quat& before, float dt) {
 // deceleration, bounded by the maximum rate, and changes by at most the set acceleration: it
 // eases in, cruises and eases out. A turn that would pass the facing this update lands on it.
 void Controller::stand_turn(float dt) {
-  const float error = wrap_angle(quat_yaw(desired_rotation_) - quat_yaw(sim_rotation_));
+  const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - sim_yaw_.of(sim_rotation_));
   const float acceleration = settings_.stand_turn_acceleration;
   const float stoppable = std::sqrt(2.0f * acceleration * std::abs(error));
   const float goal = std::copysign(std::min(settings_.stand_turn_max_rate, stoppable), error);
@@ -879,7 +896,7 @@ void Controller::predict() {
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
-  const float yaw = quat_yaw(sim_rotation_);
+  const float yaw = sim_yaw_.of(sim_rotation_);
   const float max_rate =
       stopping_ ? settings_.stand_turn_max_rate : settings_.simulation_max_turn_rate;
   for (size_t i = 0; i < n; ++i) {
@@ -909,7 +926,7 @@ void Controller::synchronize(float dt) {
     case SyncMode::SimulationFollowsCharacter:
       sim_position_ =
           glm::vec3(root.translation.x, world_ ? last_root_.y : 0.0f, root.translation.z);
-      sim_rotation_ = yaw_rotation(quat_yaw(root.rotation));
+      sim_rotation_ = yaw_rotation(root_yaw_.of(root.rotation));
       return;
     case SyncMode::CharacterFollowsSimulation:
       break;
@@ -940,9 +957,9 @@ void Controller::synchronize(float dt) {
   if (glm::length(step) > max_step) step *= max_step / glm::length(step);
   glm::vec3 position = root.translation + step;
 
-  const float root_yaw = quat_yaw(root.rotation);
+  const float root_yaw = root_yaw_.of(root.rotation);
   align_hips(dt);
-  float angle = wrap_angle(quat_yaw(sim_rotation_) - hips_align_ - root_yaw) * fraction;
+  float angle = wrap_angle(sim_yaw_.of(sim_rotation_) - hips_align_ - root_yaw) * fraction;
   // At least as fast as the simulation itself turns: held to the character's own turning, a
   // clip that does not turn would leave the root behind a turning simulation until the clamp
   // dragged it.
@@ -973,9 +990,9 @@ void Controller::synchronize(float dt) {
   if (distance > settings_.clamp_max_distance) {
     position = sim_position_ + away * (settings_.clamp_max_distance / distance);
   }
-  const float yaw_error = wrap_angle(yaw - quat_yaw(sim_rotation_));
+  const float yaw_error = wrap_angle(yaw - sim_yaw_.of(sim_rotation_));
   if (std::abs(yaw_error) > settings_.clamp_max_angle) {
-    yaw = quat_yaw(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
+    yaw = sim_yaw_.of(sim_rotation_) + std::copysign(settings_.clamp_max_angle, yaw_error);
   }
   position.y = root.translation.y;
   if (position == root.translation && yaw == root_yaw) return;
@@ -991,7 +1008,7 @@ float Controller::body_yaw() const {
   const std::span<const int> parents = db_->skeleton().parents();
   const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
   const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
-  return pair_yaw(left, right, quat_yaw(locals_[0].rotation));
+  return pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
 }
 
 // The body turns no faster than body_max_turn_rate: the root takes back what the clip's own
@@ -1011,7 +1028,7 @@ void Controller::limit_body_turn(float dt) {
   }
   body_yaw_ = yaw;
   body_yaw_known_ = true;
-  hips_offset_ = wrap_angle(yaw - quat_yaw(locals_[0].rotation));
+  hips_offset_ = wrap_angle(yaw - root_yaw_.of(locals_[0].rotation));
 }
 
 // Standing, the idle pose's hips may face a few degrees off its root for seconds (a weight
@@ -1039,7 +1056,7 @@ glm::quat Controller::warped_facing() const {
       glm::length(desired_velocity_) < kWarpMinSpeed) {
     return desired_rotation_;
   }
-  const float facing = quat_yaw(desired_rotation_);
+  const float facing = desired_yaw_.of(desired_rotation_);
   const float off = wrap_angle(std::atan2(desired_velocity_.x, desired_velocity_.z) - facing);
   const float warp = std::abs(off) > kWarpMaxTravel ? wrap_angle(off + glm::pi<float>()) : off;
   return yaw_rotation(facing + std::clamp(warp, -limit, limit));
@@ -1064,8 +1081,8 @@ void Controller::turn_chest_to_facing(float dt) {
     const float chest_yaw =
         pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
                  forward_kinematics_position(parents, locals_, roles.right_upper_arm),
-                 quat_yaw(locals_[0].rotation));
-    const float error = wrap_angle(quat_yaw(desired_rotation_) - chest_yaw);
+                 root_yaw_.of(locals_[0].rotation));
+    const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
     // now could pick the other way round from the body's own turn.
     goal = std::abs(error) <= kChestTwistReach ? std::clamp(error, -kMaxChestTwist, kMaxChestTwist)
@@ -1101,7 +1118,7 @@ void Controller::move_root(const glm::vec3& position, const glm::quat& rotation)
   const glm::vec3 played_position = position - root_offsets_.positions[0];
   const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
   // The database root relative to the destination: M = inverse(destination) * root(t).
-  const Transform root = sample_joint(playback_point(), 0);
+  const Transform root = database_root(playback_point());
   const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
   const glm::quat relative_rotation = inverse_destination * root.rotation;
   const glm::vec3 relative_position =

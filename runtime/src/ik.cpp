@@ -22,13 +22,16 @@ struct Angle {
   float sin = 0.0f;
 };
 
+// The angle whose cosine and sine are proportional to d and c (c >= 0).
+Angle angle_from(float d, float c) {
+  const float r = std::sqrt(d * d + c * c);
+  return r > 0.0f ? Angle{d / r, c / r} : Angle{};
+}
+
 // The unsigned angle between two vectors (both non-zero), from their dot and cross products:
 // accurate near 0 and pi, where an arccosine of the dot product alone is not.
 Angle angle_between(const glm::vec3& u, const glm::vec3& v) {
-  const float d = glm::dot(u, v);
-  const float c = glm::length(glm::cross(u, v));
-  const float r = std::sqrt(d * d + c * c);
-  return r > 0.0f ? Angle{d / r, c / r} : Angle{};
+  return angle_from(glm::dot(u, v), glm::length(glm::cross(u, v)));
 }
 
 // The interior angle opposite side c of a triangle with sides a, b, c (law of cosines).
@@ -96,7 +99,11 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 a = in.root.translation;
   const glm::vec3 b = in.mid.translation;
   const glm::vec3 c = in.end.translation;
-  const float upper = glm::distance(a, b);
+  // Each length computed once: with errno kept by the library's sqrt, the compiler does not
+  // merge two square roots of the same sum.
+  const glm::vec3 ab = b - a;
+  const glm::vec3 ac = c - a;
+  const float upper = glm::length(ab);  // glm::distance(a, b) is this length
   const float lower = glm::distance(b, c);
   if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
       !finite(in.root.rotation) || !finite(in.mid.rotation) || !finite(in.root_parent_rotation) ||
@@ -114,19 +121,24 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
 
   // The direction to reach along: toward the target, or (target at the hip) the current one.
   glm::vec3 direction = in.target - a;
-  if (!(target_distance > 1e-6f * total)) direction = c - a;
-  if (!(glm::length(direction) > 1e-6f * total)) direction = b - a;
+  float direction_length = target_distance;  // glm::distance(a, target) is this length
+  const float ac_length = glm::length(ac);
+  if (!(target_distance > 1e-6f * total)) {
+    direction = ac;
+    direction_length = ac_length;
+  }
+  if (!(direction_length > 1e-6f * total)) direction = ab;
   direction = glm::normalize(direction);
 
   // 1. Bend about the current bend axis: the knee's interior angle goes to the one that makes
   // the hip-ankle distance `reach`, and the hip turns so the ankle stays on its old line.
-  const glm::vec3 ab = b - a;
-  const glm::vec3 ac = c - a;
   glm::vec3 bend_axis = glm::cross(ac, ab);
+  const float bend_axis_length = glm::length(bend_axis);
   Angle hip_angle_now;
-  if (glm::length(bend_axis) > 1e-6f * upper * glm::length(ac) && glm::length(ac) > 1e-6f * total) {
+  if (bend_axis_length > 1e-6f * upper * ac_length && ac_length > 1e-6f * total) {
     bend_axis = glm::normalize(bend_axis);
-    hip_angle_now = angle_between(ac, ab);
+    // angle_between(ac, ab), its cross product's length already known.
+    hip_angle_now = angle_from(glm::dot(ac, ab), bend_axis_length);
   } else {
     // Straight or folded limb: no plane yet. Bend toward the pole; step 3 settles the twist.
     bend_axis = glm::normalize(glm::cross(ab, perpendicular(ab, in.pole)));

@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -577,6 +578,7 @@ class Controller {
   };
   PlaybackPoint playback_point() const;
   Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
+  Transform database_root(const PlaybackPoint& at) const;
   void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
                        std::span<glm::vec3> angular_velocities, bool body_velocities) const;
   void sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
@@ -628,9 +630,31 @@ class Controller {
   std::vector<TrajectoryColumn> trajectory_columns_;
   std::vector<int> leg_joints_[2];  // upper leg, lower leg, foot, toe per side
   std::vector<int> folded_joints_;  // source roots played as identity (see sample_playback)
+  std::vector<std::array<int, 2>> folded_children_;  // {folded joint, one of its children}
 
   // Every position below is relative to this world position (local_origin.hpp).
   glm::dvec3 origin_{0.0};
+
+  // quat_yaw of the rotation last asked about, kept: several phases of an update ask for the yaw
+  // of the same rotation (the simulation's, the root's, the desired facing), and comparing the
+  // rotation's bits costs less than the yaw.
+  class YawMemo {
+   public:
+    float of(const glm::quat& q) const {
+      if (!known_ || std::memcmp(&q, &rotation_, sizeof(glm::quat)) != 0) {
+        rotation_ = q;
+        yaw_ = quat_yaw(q);
+        known_ = true;
+      }
+      return yaw_;
+    }
+
+   private:
+    mutable glm::quat rotation_{1.0f, 0.0f, 0.0f, 0.0f};
+    mutable float yaw_ = 0.0f;
+    mutable bool known_ = false;
+  };
+  YawMemo sim_yaw_, root_yaw_, desired_yaw_;
 
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
@@ -675,6 +699,16 @@ class Controller {
   // transition reads them, so each update samples the root's alone and a transition the rest.
   PlaybackPoint sampled_at_;
   bool sampled_body_velocities_ = false;
+  // The database root (unmapped) of sample_playback's last sample, where and how it was taken:
+  // move_root needs that sample again in the same update (database_root).
+  struct RootSample {
+    PlaybackPoint at;
+    bool cubic = false;
+    InterpolationMethod method = InterpolationMethod::Nlerp;
+    Transform root;
+    bool valid = false;
+  };
+  mutable RootSample root_sample_;
   std::vector<Transform> other_;  // the other side of a transition
   std::vector<glm::vec3> other_velocities_;
   std::vector<glm::vec3> other_angular_velocities_;
