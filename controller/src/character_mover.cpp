@@ -27,6 +27,13 @@ float safe_fraction(float fraction, float distance, float skin) {
   return distance > 0.0f ? std::max(0.0f, fraction - skin / distance) : 0.0f;
 }
 
+// The horizontal unit direction kLedgeSide off `ahead`, to its left (side -1) or right (+1).
+glm::vec3 side_of(const glm::vec3& ahead, float side) {
+  const float c = std::cos(CharacterMover::kLedgeSide),
+              s = side * std::sin(CharacterMover::kLedgeSide);
+  return glm::vec3(ahead.x * c - ahead.z * s, 0.0f, ahead.x * s + ahead.z * c);
+}
+
 glm::vec3 lift(const CharacterShape& shape) {
   return glm::vec3(0.0f, shape.step_height, 0.0f);
 }
@@ -164,7 +171,11 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
     // the ground ahead of a trajectory sample a metre away, up or down stairs, says nothing.
     lead_[i] = length >= 1e-6f && length <= shape.radius ? static_cast<int>(probes) : -1;
     if (lead_[i] >= 0) {
-      probes_[probes++] = GroundProbe{top + d * (kLedgeLead * shape.radius / length), reach, 0.0f};
+      const glm::vec3 ahead = d / length;
+      probes_[probes++] = GroundProbe{top + ahead * (kLedgeLead * shape.radius), reach, 0.0f};
+      for (const float side : {-1.0f, 1.0f}) {
+        probes_[probes++] = GroundProbe{top + side_of(ahead, side) * shape.radius, reach, 0.0f};
+      }
     }
   }
   std::fill_n(ground_hits_.begin(), probes, GroundHit{});
@@ -175,24 +186,74 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
   for (size_t i = 0, k = 0; i < n; ++i, ++k) {
     GroundHit& hit = ground_hits_[k];
     const bool ground = accept(probes_[k], hit) && hit.hit && hit.walkable;
-    // Measured from the end's own ground, not the start's: a trajectory sample a metre down a
-    // stair is far below the start and on no ledge. A drop up to kStepClearance deeper than a
-    // step is a step: walking back, the probe (which starts that much above the lift) finds the
-    // top the sweep, starting against its edge, does not; off a box exactly step_height high the
-    // floor reads a hair deeper than a step.
-    const float floor = hit.point.y - shape.step_height - kStepClearance;
+    const size_t lead = static_cast<size_t>(lead_[i]);
+    // A drop up to kStepClearance deeper than a step is a step: walking back, the probe (which
+    // starts that much above the lift) finds the top the sweep, starting against its edge, does
+    // not; off a box exactly step_height high the floor reads a hair deeper than a step.
+    const float step_down = shape.step_height + kStepClearance;
     bool ledge = !ground;
     if (lead_[i] >= 0) {
-      GroundHit& ahead = ground_hits_[++k];
-      ledge = ledge || !accept(probes_[k], ahead) || !ahead.hit || ahead.point.y < floor;
+      GroundHit& ahead = ground_hits_[lead];
+      // A probe that fails the checks is no ground here: the move stops rather than step off.
+      ledge = ledge || !accept(probes_[lead], ahead) || drops(hit, ahead, step_down);
+      k += kLeads;
     }
     if (ledge) {
       out[i].position = starts[i];
       out[i].no_ground = true;
-    } else {
-      out[i].position.y = hit.point.y;
-      out[i].ground_normal = hit.normal;
+      continue;
     }
+    out[i].position.y = hit.point.y;
+    out[i].ground_normal = hit.normal;
+    if (lead_[i] >= 0) keep_off_side_edges(starts[i], hit, step_down, lead + 1, out[i]);
+  }
+}
+
+// Whether `lead`, probed beyond `from`, found a drop deeper than a step below it, or no ground.
+// Measured from the end's own ground, not the start's: a trajectory sample a metre down a stair
+// is far below the start and on no ledge.
+bool CharacterMover::drops(const GroundHit& from, const GroundHit& lead, float step_height) {
+  return !lead.hit || lead.point.y < from.point.y - step_height;
+}
+
+// A ledge's edge beside the move's end (a drop deeper than a step a radius out, kLedgeSide
+// either side of ahead), which the move runs along or slants toward, is met like a wall: the part
+// of the step toward it is taken away, and the move is blocked with a normal away from it (the
+// simulation loses its velocity into it). With the probe ahead only, a character circling on a
+// platform kept its centre a few centimetres from the side edge, one foot planted on air. An
+// answer that fails the checks says nothing here: a false edge would bend the path.
+void CharacterMover::keep_off_side_edges(const glm::vec3& start, const GroundHit& ground,
+                                         float step_height, size_t first, MoveResult& out) {
+  glm::vec3 step(out.position.x - start.x, 0.0f, out.position.z - start.z);
+  glm::vec3 away(0.0f);
+  int met = 0, slanting = 0;
+  for (size_t k = first; k < first + 2; ++k) {
+    if (!accept(probes_[k], ground_hits_[k]) || !drops(ground, ground_hits_[k], step_height)) {
+      continue;
+    }
+    const glm::vec3 toward = glm::normalize(
+        glm::vec3(probes_[k].from.x - out.position.x, 0.0f, probes_[k].from.z - out.position.z));
+    away -= toward;
+    const float into = glm::dot(step, toward);
+    if (into > 0.0f) step -= toward * into;
+    slanting += into > 0.0f ? 1 : 0;
+    ++met;
+  }
+  if (met == 0) return;
+  // Toward both (a corner, a beam narrower than the probes): the second cut would lean the step
+  // back toward the first edge.
+  if (slanting == 2) step = glm::vec3(0.0f);
+  const glm::vec3 end(start.x + step.x, 0.0f, start.z + step.z);
+  // On the plane of the ground found at the unbent end: exact on a flat top or an even slope.
+  const glm::vec3& n = ground.normal;
+  out.position = glm::vec3(
+      end.x,
+      ground.point.y - (n.x * (end.x - ground.point.x) + n.z * (end.z - ground.point.z)) / n.y,
+      end.z);
+  if (!out.blocked && glm::length(away) > 1e-3f) {
+    out.blocked = true;
+    out.edge = true;
+    out.normal = glm::normalize(away);
   }
 }
 

@@ -142,6 +142,50 @@ TEST(CharacterMover, AtALedgeDeeperThanAStepItStopsBackFromTheEdge) {
   EXPECT_NEAR(far.position.y, -0.42f, kTolerance);
 }
 
+TEST(CharacterMover, AlongALedgesEdgeItKeepsBackFromItAndKeepsMoving) {
+  // A platform's side edge at x = 1 (a 0.64 m drop beyond). Walking along it, a probe ahead
+  // only let the centre come within centimetres of the edge, a foot planted on air.
+  AnalyticWorld world;
+  world.height = [](double x, double) { return x < 1.0 ? 0.0 : -0.64; };
+  CharacterMover mover;
+  const float keep = shape().radius * std::sin(CharacterMover::kLedgeSide);
+  // Slanting toward the edge: it slides along it, a radius' side probe back.
+  glm::vec3 p(0.5f, 0.0f, 0.0f);
+  for (int step = 0; step < 100; ++step) {
+    const MoveResult m =
+        mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0.02f, 0, 0.05f));
+    ASSERT_FALSE(m.no_ground) << step;
+    p = m.position;
+    ASSERT_LE(p.x, 1.0f - keep + 0.021f) << step;
+  }
+  EXPECT_EQ(p.y, 0.0f);
+  EXPECT_GT(p.z, 0.9f * 100 * 0.05f);  // hardly slowed along the edge
+  // Started too near, running along it: it drifts away from the edge as it goes.
+  p = glm::vec3(0.95f, 0.0f, 0.0f);
+  for (int step = 0; step < 100; ++step) {
+    p = mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0, 0, 0.05f)).position;
+  }
+  EXPECT_LE(p.x, 1.0f - keep + 1e-3f);
+  EXPECT_GT(p.z, 0.5f * 100 * 0.05f);
+}
+
+TEST(CharacterMover, DownSteepStairsNoTreadIsALedge) {
+  // 20 cm risers on 25 cm treads: the probes beside ahead, a radius out, see one riser down.
+  AnalyticWorld world;
+  world.height = [](double, double z) {
+    return z < 0.0 ? 0.0 : -0.2 * (1.0 + std::floor(z / 0.25));
+  };
+  CharacterMover mover;
+  glm::vec3 p(0.0f, 0.0f, -0.505f);  // no end on an edge, where the analytic normal is steep
+  for (int step = 0; step < 100; ++step) {
+    const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0, 0, 0.02f));
+    ASSERT_FALSE(m.blocked || m.no_ground) << step;
+    p = m.position;
+  }
+  EXPECT_NEAR(p.z, 1.495f, 1e-3f);
+  EXPECT_NEAR(p.y, -0.2f * 6.0f, kTolerance);
+}
+
 TEST(CharacterMover, WalksUpAWalkableSlopeButNotASteepOne) {
   AnalyticWorld world;
   const double gentle = std::tan(glm::radians(20.0));
