@@ -71,7 +71,7 @@ void Controller::collide_simulation(const glm::vec3& before) {
   sim_position_ = m.position;
   debug_.simulation_blocked = m.blocked || m.no_ground;
   debug_.simulation_contact = m.normal;
-  edge_normal_ = m.edge ? m.normal : glm::vec3(0.0f);
+  edge_normal_ = m.edge_normal;
   if (m.blocked && glm::length(m.normal) > 0.5f) {
     obstacle_normal_ = m.normal;
     obstacle_point_ = sim_position_;
@@ -93,8 +93,10 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
   std::array<MoveResult, CharacterMover::kMaxMoves> moved;
   const size_t n = positions.size();
   std::fill_n(starts.begin(), n, sim_position_);
-  // At a ledge's edge the samples lose their part toward it, as a wall's sweep slides them: a
-  // sample over the drop would have no ground and fall back to the start (a stop).
+  // Beside a ledge's edge (or stopped at one ahead) the samples lose their part toward it, as the
+  // simulation object's steps do and as a wall's sweep slides them: the search then matches the
+  // slide along the edge the simulation makes (beyond it, a sample found the ground below the
+  // drop, and the search kept walking clips while the simulation stood at the edge).
   if (glm::length(edge_normal_) > 0.5f) {
     for (glm::vec3& p : positions) {
       const float into =
