@@ -27,6 +27,12 @@ float safe_fraction(float fraction, float distance, float skin) {
   return distance > 0.0f ? std::max(0.0f, fraction - skin / distance) : 0.0f;
 }
 
+// The ring's directions (CharacterMover::kEdgeProbes of them, evenly around).
+constexpr float kDiagonal = 0.70710678f;
+constexpr float kRing[CharacterMover::kEdgeProbes][2] = {
+    {1.0f, 0.0f},  {kDiagonal, kDiagonal},   {0.0f, 1.0f},  {-kDiagonal, kDiagonal},
+    {-1.0f, 0.0f}, {-kDiagonal, -kDiagonal}, {0.0f, -1.0f}, {kDiagonal, -kDiagonal}};
+
 glm::vec3 lift(const CharacterShape& shape) {
   return glm::vec3(0.0f, shape.step_height, 0.0f);
 }
@@ -162,9 +168,22 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
     const float length = glm::length(d);
     // Only a step within the capsule's own size (the simulation's and the root's per update):
     // the ground ahead of a trajectory sample a metre away, up or down stairs, says nothing.
-    lead_[i] = length >= 1e-6f && length <= shape.radius ? static_cast<int>(probes) : -1;
+    const bool short_move = length >= 1e-6f && length <= shape.radius;
+    lead_[i] = short_move ? static_cast<int>(probes) : -1;
     if (lead_[i] >= 0) {
       probes_[probes++] = GroundProbe{top + d * (kLedgeLead * shape.radius / length), reach, 0.0f};
+    }
+    ring_[i] = lead_[i] >= 0 ? static_cast<int>(probes) : -1;
+    if (ring_[i] >= 0) {
+      // Inner probes first (halfway out), then the outer ones, in the same directions. Each
+      // starts as much higher as it is out (a 45 degree rise): ground up a flight of stairs,
+      // above the lift, would be no ground to a probe starting inside it, and read as a drop.
+      for (const float out_to : {0.5f * kEdgeRing * shape.radius, kEdgeRing * shape.radius}) {
+        for (const auto& direction : kRing) {
+          const glm::vec3 at = top + glm::vec3(direction[0], 1.0f, direction[1]) * out_to;
+          probes_[probes++] = GroundProbe{at, reach + out_to, 0.0f};
+        }
+      }
     }
   }
   std::fill_n(ground_hits_.begin(), probes, GroundHit{});
@@ -172,27 +191,85 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
     world.probe_ground(origin, std::span(probes_).first(probes),
                        std::span(ground_hits_).first(probes));
   }
-  for (size_t i = 0, k = 0; i < n; ++i, ++k) {
+  for (size_t i = 0, k = 0; i < n; ++i) {
     GroundHit& hit = ground_hits_[k];
     const bool ground = accept(probes_[k], hit) && hit.hit && hit.walkable;
-    // Measured from the end's own ground, not the start's: a trajectory sample a metre down a
-    // stair is far below the start and on no ledge. A drop up to kStepClearance deeper than a
-    // step is a step: walking back, the probe (which starts that much above the lift) finds the
-    // top the sweep, starting against its edge, does not; off a box exactly step_height high the
-    // floor reads a hair deeper than a step.
-    const float floor = hit.point.y - shape.step_height - kStepClearance;
+    k += 1 + (lead_[i] >= 0 ? 1 : 0) + (ring_[i] >= 0 ? 2 * kEdgeProbes : 0);
+    // A drop up to kStepClearance deeper than a step is a step: walking back, the probe (which
+    // starts that much above the lift) finds the top the sweep, starting against its edge, does
+    // not; off a box exactly step_height high the floor reads a hair deeper than a step.
+    const float step_down = shape.step_height + kStepClearance;
     bool ledge = !ground;
-    if (lead_[i] >= 0) {
-      GroundHit& ahead = ground_hits_[++k];
-      ledge = ledge || !accept(probes_[k], ahead) || !ahead.hit || ahead.point.y < floor;
+    if (ground && lead_[i] >= 0) {
+      const size_t lead = static_cast<size_t>(lead_[i]);
+      // A probe that fails the checks is no ground here: the move stops rather than step off.
+      if (!accept(probes_[lead], ground_hits_[lead]) || drops(hit, ground_hits_[lead], step_down)) {
+        ledge = true;
+        glm::vec3 d = goals[i] - starts[i];
+        d.y = 0.0f;
+        out[i].edge_normal = -glm::normalize(d);
+      }
     }
     if (ledge) {
       out[i].position = starts[i];
       out[i].no_ground = true;
-    } else {
-      out[i].position.y = hit.point.y;
-      out[i].ground_normal = hit.normal;
+      continue;
     }
+    out[i].position.y = hit.point.y;
+    out[i].ground_normal = hit.normal;
+    if (ring_[i] >= 0) {
+      keep_off_edges(starts[i], hit, step_down, static_cast<size_t>(ring_[i]), out[i]);
+    }
+  }
+}
+
+// Whether `lead`, probed beyond `from`, found a drop deeper than a step below it, or no ground.
+// Measured from the end's own ground, not the start's: a trajectory sample a metre down a stair
+// is far below the start and on no ledge.
+bool CharacterMover::drops(const GroundHit& from, const GroundHit& lead, float step_down) {
+  return !lead.hit || lead.point.y < from.point.y - step_down;
+}
+
+// A ledge's edge beside the move's end (a drop deeper than a step under a probe of the ring) is
+// met like a wall: the part of the step toward it is taken away, the rest goes on, and a step
+// that had such a part is blocked with the edge's normal (the simulation loses its velocity
+// into it). With the probe ahead only, a character circling on a platform kept its centre a
+// few centimetres from the side edge, one foot planted on air. An answer that fails the checks
+// says nothing here: a false edge would bend the path. Drops on opposite sides (a beam narrower
+// than the ring) give no direction: the probe ahead still stops the move at either side.
+void CharacterMover::keep_off_edges(const glm::vec3& start, const GroundHit& ground,
+                                    float step_down, size_t first, MoveResult& out) {
+  // Each outward direction in two hops, the centre to the inner probe and that to the outer one,
+  // each no longer than a steep stair's tread: down 20 cm risers on 25 cm treads the ground a
+  // ring's radius out is two risers lower, a stair and not a ledge.
+  glm::vec3 toward(0.0f);
+  for (int j = 0; j < kEdgeProbes; ++j) {
+    GroundHit& inner = ground_hits_[first + static_cast<size_t>(j)];
+    GroundHit& outer = ground_hits_[first + static_cast<size_t>(kEdgeProbes + j)];
+    const bool inner_ok = accept(probes_[first + static_cast<size_t>(j)], inner);
+    const bool outer_ok = accept(probes_[first + static_cast<size_t>(kEdgeProbes + j)], outer);
+    const bool drop = (inner_ok && drops(ground, inner, step_down)) ||
+                      (inner_ok && inner.hit && outer_ok && drops(inner, outer, step_down));
+    if (drop) toward += glm::vec3(kRing[j][0], 0.0f, kRing[j][1]);
+  }
+  if (glm::length(toward) < 0.5f) return;
+  const glm::vec3 normal = -glm::normalize(toward);
+  out.edge_normal = normal;
+  glm::vec3 step(out.position.x - start.x, 0.0f, out.position.z - start.z);
+  const float into = -glm::dot(step, normal);
+  if (into <= 0.0f) return;  // along it or away from it: nothing held back
+  step += normal * into;
+  const glm::vec3 end(start.x + step.x, 0.0f, start.z + step.z);
+  // On the plane of the ground found at the unbent end: exact on a flat top or an even slope.
+  const glm::vec3& n = ground.normal;
+  out.position = glm::vec3(
+      end.x,
+      ground.point.y - (n.x * (end.x - ground.point.x) + n.z * (end.z - ground.point.z)) / n.y,
+      end.z);
+  if (!out.blocked) {
+    out.blocked = true;
+    out.edge = true;
+    out.normal = normal;
   }
 }
 

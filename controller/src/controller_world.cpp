@@ -45,7 +45,7 @@ void Controller::set_world(const WorldQueries* world) {
   ground_height_ = ground_velocity_ = 0.0f;
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
-  obstacle_normal_ = glm::vec3(0.0f);
+  obstacle_normal_ = edge_normal_ = glm::vec3(0.0f);
   wall_push_ = wall_push_velocity_ = 0.0f;
   // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
   body_shift_ = glm::vec3(0.0f);
@@ -71,6 +71,7 @@ void Controller::collide_simulation(const glm::vec3& before) {
   sim_position_ = m.position;
   debug_.simulation_blocked = m.blocked || m.no_ground;
   debug_.simulation_contact = m.normal;
+  edge_normal_ = m.edge_normal;
   if (m.blocked && glm::length(m.normal) > 0.5f) {
     obstacle_normal_ = m.normal;
     obstacle_point_ = sim_position_;
@@ -92,6 +93,17 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
   std::array<MoveResult, CharacterMover::kMaxMoves> moved;
   const size_t n = positions.size();
   std::fill_n(starts.begin(), n, sim_position_);
+  // Beside a ledge's edge (or stopped at one ahead) the samples lose their part toward it, as the
+  // simulation object's steps do and as a wall's sweep slides them: the search then matches the
+  // slide along the edge the simulation makes (beyond it, a sample found the ground below the
+  // drop, and the search kept walking clips while the simulation stood at the edge).
+  if (glm::length(edge_normal_) > 0.5f) {
+    for (glm::vec3& p : positions) {
+      const float into =
+          -glm::dot(glm::vec3(p.x - sim_position_.x, 0.0f, p.z - sim_position_.z), edge_normal_);
+      if (into > 0.0f) p += edge_normal_ * into;
+    }
+  }
   mover_.collide(*world_, origin_, character_shape(), std::span(starts).first(n), positions,
                  std::span(moved).first(n));
   for (size_t i = 0; i < n; ++i) positions[i] = moved[i].position;

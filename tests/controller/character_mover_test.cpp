@@ -120,16 +120,16 @@ TEST(CharacterMover, AtALedgeDeeperThanAStepItStopsBackFromTheEdge) {
   bool stopped = false;
   for (int step = 0; step < 100; ++step) {
     const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0, 0, 0.02f));
-    stopped = stopped || m.no_ground;
+    stopped = stopped || (m.blocked && m.edge);
     p = m.position;
   }
   EXPECT_TRUE(stopped);
   EXPECT_EQ(p.y, 0.0f);
-  // Stopped once the ground half a radius ahead fell away: the centre, and with it the feet,
-  // stay back from the edge.
-  const float back = 1.0f - CharacterMover::kLedgeLead * shape().radius;
-  EXPECT_LE(p.z, back);
-  EXPECT_GT(p.z, back - 0.021f);
+  // Held a radius back, where the ring around the capsule first met the drop (the probe ahead,
+  // half a radius out, never did): the centre, and with it the feet, stay back from the edge.
+  const float r = shape().radius;
+  EXPECT_LE(p.z, 1.0f - r);
+  EXPECT_GT(p.z, 1.0f - CharacterMover::kEdgeRing * r - 0.021f);
   // A trajectory sample 0.8 m away, three 14 cm steps down (0.42 m, deeper than a step), is on
   // no ledge: only the ground ahead of a move's end, against the end's own, makes one.
   AnalyticWorld stairs;
@@ -140,6 +140,118 @@ TEST(CharacterMover, AtALedgeDeeperThanAStepItStopsBackFromTheEdge) {
       mover.move(stairs, glm::dvec3(0.0), shape(), glm::vec3(0, 0, -0.1f), glm::vec3(0, 0, 0.7f));
   EXPECT_FALSE(far.no_ground);
   EXPECT_NEAR(far.position.y, -0.42f, kTolerance);
+}
+
+// A platform's side edge at x = 1 (a 0.64 m drop beyond, as the second course's platforms).
+void platform_edge_at_x1(AnalyticWorld& world) {
+  world.height = [](double x, double) { return x < 1.0 ? 0.0 : -0.64; };
+}
+
+TEST(CharacterMover, AlongALedgesEdgeTheCentreStaysARadiusFromIt) {
+  // With the probe ahead only, a move along the edge let the centre come within centimetres of
+  // it, a foot planted on air.
+  AnalyticWorld world;
+  platform_edge_at_x1(world);
+  CharacterMover mover;
+  const float r = shape().radius;
+  // Slanting toward the edge at 22 degrees: it goes on along it, its centre a radius back.
+  glm::vec3 p(0.5f, 0.0f, 0.0f);
+  for (int step = 0; step < 100; ++step) {
+    const MoveResult m =
+        mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0.02f, 0, 0.05f));
+    ASSERT_FALSE(m.no_ground) << step;
+    p = m.position;
+    ASSERT_LE(p.x, 1.0f - r + 1e-4f) << step;
+  }
+  EXPECT_EQ(p.y, 0.0f);
+  EXPECT_NEAR(p.z, 100 * 0.05f, 1e-3f);  // the part along the edge is never held back
+  // Met: blocked by the edge, its normal pointing away from the drop.
+  const MoveResult m =
+      mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0.02f, 0, 0.05f));
+  EXPECT_TRUE(m.blocked && m.edge);
+  EXPECT_NEAR(m.normal.x, -1.0f, kTolerance);
+  EXPECT_NEAR(m.edge_normal.x, -1.0f, kTolerance);
+}
+
+TEST(CharacterMover, SlowlyIntoALedgesEdgeItSlidesAlongIt) {
+  // Probes turned with the move pointed a new way on every update of a slow move, each took
+  // another part of the velocity away, and the character stood at the edge (1.7 s circling
+  // on a platform). The ring is fixed: the slide goes on at the speed along the edge.
+  AnalyticWorld world;
+  platform_edge_at_x1(world);
+  CharacterMover mover;
+  glm::vec3 p(0.75f, 0.0f, 0.0f);
+  for (int step = 0; step < 50; ++step) {
+    const glm::vec3 push =
+        step % 2 == 0 ? glm::vec3(0.004f, 0, 0.001f) : glm::vec3(0.003f, 0, 0.0012f);
+    const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + push);
+    ASSERT_TRUE(m.blocked) << step;
+    ASSERT_NEAR(m.normal.x, -1.0f, kTolerance) << step;
+    ASSERT_NEAR(m.position.z - p.z, push.z, 1e-5f) << step;
+    ASSERT_NEAR(m.position.x, p.x, 1e-5f) << step;
+    p = m.position;
+  }
+}
+
+TEST(CharacterMover, WalkingAwayFromALedgesEdgeIsNeverBlocked) {
+  AnalyticWorld world;
+  platform_edge_at_x1(world);
+  CharacterMover mover;
+  // Started nearer than a radius (stepped there where the drop was lower, or placed; not within
+  // half a radius, where the probe ahead cancels a move toward the edge): every move with no
+  // part toward the edge goes the whole way, and says where the edge is.
+  for (const glm::vec3& away : {glm::vec3(-0.05f, 0, 0), glm::vec3(-0.05f, 0, 0.05f),
+                                glm::vec3(-0.01f, 0, -0.05f), glm::vec3(0, 0, 0.05f)}) {
+    const glm::vec3 p(0.8f, 0.0f, 0.0f);
+    const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + away);
+    EXPECT_FALSE(m.blocked || m.no_ground || m.edge);
+    EXPECT_NEAR(m.position.x, p.x + away.x, 1e-5f);
+    EXPECT_NEAR(m.position.z, p.z + away.z, 1e-5f);
+    EXPECT_NEAR(m.edge_normal.x, -1.0f, kTolerance);
+  }
+  // Toward it from there: held where it is across, the part along goes on.
+  const glm::vec3 p(0.8f, 0.0f, 0.0f);
+  const MoveResult m =
+      mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0.05f, 0, 0.05f));
+  EXPECT_TRUE(m.blocked && m.edge);
+  EXPECT_NEAR(m.position.x, 0.8f, 1e-5f);
+  EXPECT_NEAR(m.position.z, 0.05f, 1e-5f);
+}
+
+TEST(CharacterMover, AFarMoveSeesNoEdgeAndALedgeAheadGivesItsDirection) {
+  AnalyticWorld world;
+  platform_edge_at_x1(world);
+  CharacterMover mover;
+  // A trajectory sample a metre away is judged by its own ground only: no ring around it.
+  const MoveResult far =
+      mover.move(world, glm::dvec3(0.0), shape(), glm::vec3(0, 0, 0), glm::vec3(0.65f, 0, 1.0f));
+  EXPECT_FALSE(far.blocked || far.no_ground);
+  EXPECT_EQ(far.edge_normal, glm::vec3(0.0f));
+  // Straight at the edge from within half a radius: the move is cancelled (no ground ahead),
+  // and the edge faces back along it, for the trajectory.
+  const MoveResult ahead =
+      mover.move(world, glm::dvec3(0.0), shape(), glm::vec3(0.8f, 0, 0), glm::vec3(0.9f, 0, 0));
+  EXPECT_TRUE(ahead.no_ground);
+  EXPECT_NEAR(ahead.edge_normal.x, -1.0f, kTolerance);
+}
+
+TEST(CharacterMover, DownSteepStairsNoTreadIsALedge) {
+  // 20 cm risers on 25 cm treads: the ring's probes, a radius out, see two risers down (40 cm,
+  // deeper than a step), each of their two hops one riser at most.
+  AnalyticWorld world;
+  world.height = [](double, double z) {
+    return z < 0.0 ? 0.0 : -0.2 * (1.0 + std::floor(z / 0.25));
+  };
+  CharacterMover mover;
+  glm::vec3 p(0.0f, 0.0f, -0.505f);  // no end on an edge, where the analytic normal is steep
+  for (int step = 0; step < 100; ++step) {
+    const MoveResult m = mover.move(world, glm::dvec3(0.0), shape(), p, p + glm::vec3(0, 0, 0.02f));
+    ASSERT_FALSE(m.blocked || m.no_ground) << step;
+    ASSERT_EQ(m.edge_normal, glm::vec3(0.0f)) << step;
+    p = m.position;
+  }
+  EXPECT_NEAR(p.z, 1.495f, 1e-3f);
+  EXPECT_NEAR(p.y, -0.2f * 6.0f, kTolerance);
 }
 
 TEST(CharacterMover, WalksUpAWalkableSlopeButNotASteepOne) {

@@ -25,8 +25,17 @@
 //    kLedgeLead of its radius ahead of it, is a ledge too: lowered that far, the lifted capsule
 //    would overlap the edge it left, and a sweep that starts inside geometry sees nothing, so the
 //    next move would walk back through the ledge's side (found strafing off a ramp's side). The
-//    lead keeps the centre, and so the feet, back from the edge. max_step_down is how far the
-//    probe reaches: ground found below a drop it cannot take still tells a ledge from a hole.
+//    lead keeps the centre, and so the feet, back from the edge. A short move (at most a radius)
+//    also probes a ring of kEdgeProbes points around its end, kEdgeRing radii out, each reached
+//    in two hops (a probe halfway out: over two hops no longer than a steep stair's tread, a
+//    stair is no ledge): a drop deeper than a step on either hop is an edge beside the capsule, its
+//    normal the mean of their directions turned away (a ring fixed to the world, not to the move:
+//    probes turned with the move pointed a new way on every update of a slow move, and the velocity
+//    taken into each stalled it). Met like a wall: only the part of the step toward it is taken
+//    away, so a move along it or away from it goes on; a step that had a part toward it is
+//    `blocked`, and every such move reports the edge (`edge_normal`) for the trajectory.
+//    max_step_down is how far the probe reaches: ground found below a drop it cannot take still
+//    tells a ledge from a hole.
 // Each phase is one batched call to the world (all trajectory samples at once). Answers that
 // fail the checks of world.hpp count as no hit and are counted in rejected().
 //
@@ -58,6 +67,11 @@ struct MoveResult {
   glm::vec3 normal{0.0f};    // the (horizontal) normal of the first obstacle met, else zero
   bool blocked = false;      // the sweeps met something
   bool no_ground = false;    // no walkable ground at the end: the move was cancelled
+  bool edge = false;         // blocked by a ledge's edge beside its end (normal: away from it)
+  // The horizontal unit normal (away from the drop) of a ledge's edge within kEdgeRing radii of
+  // a short move's end, whether or not the move went toward it, or of the ledge straight ahead
+  // that cancelled it (no_ground); else zero.
+  glm::vec3 edge_normal{0.0f};
   glm::vec3 ground_normal{0.0f, 1.0f, 0.0f};  // the surface under `position`
 };
 
@@ -78,6 +92,11 @@ class CharacterMover {
   // lift the ground probe starts, and how much deeper than step_height a drop may be and still be
   // a step down.
   static constexpr float kStepClearance = 0.02f;
+  // The ring of probes that finds a ledge's edge beside a short move's end: this many, evenly
+  // around it, this many radii out (1 / cos(180 / kEdgeProbes degrees): an edge between two
+  // probes is met when it comes within a radius of the centre).
+  static constexpr int kEdgeProbes = 8;
+  static constexpr float kEdgeRing = 1.0823922f;
 
   // Moves each start[i] toward goal[i] (y ignored) and writes where it ended to out[i]: three
   // batched calls to the world (sweep, slide, ground), whatever the count (at most kMaxMoves).
@@ -109,12 +128,18 @@ class CharacterMover {
  private:
   bool accept(const ShapeSweep& query, SweepHit& hit);
   bool accept(const GroundProbe& query, GroundHit& hit);
+  void keep_off_edges(const glm::vec3& start, const GroundHit& ground, float step_down,
+                      size_t first, MoveResult& out);
+  static bool drops(const GroundHit& from, const GroundHit& lead, float step_down);
+  static constexpr size_t kLeads = 1 + 2 * kEdgeProbes;  // per short move: ahead, the rings
 
   std::array<ShapeSweep, kMaxMoves> sweeps_{};
   std::array<SweepHit, kMaxMoves> sweep_hits_{};
-  std::array<GroundProbe, 2 * kMaxMoves> probes_{};  // per move: its end, then ahead of it
-  std::array<GroundHit, 2 * kMaxMoves> ground_hits_{};
+  // Per move: its end, then (short moves that go anywhere) ahead of it and the ring.
+  std::array<GroundProbe, (1 + kLeads) * kMaxMoves> probes_{};
+  std::array<GroundHit, (1 + kLeads) * kMaxMoves> ground_hits_{};
   std::array<int, kMaxMoves> lead_{};      // the probe ahead of each move's end, or -1
+  std::array<int, kMaxMoves> ring_{};      // the first probe of the ring around it, or -1
   std::array<int, kMaxMoves> slid_{};      // the move each slide sweep belongs to
   std::array<bool, kMaxMoves> climbed_{};  // the sweep met a step's top (phase 2), not a wall
   int64_t rejected_ = 0;

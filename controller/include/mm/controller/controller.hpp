@@ -797,6 +797,7 @@ class Controller {
   FootPlacement foot_placement_;
   // The wall the simulation object last met (its horizontal normal; zero: none) and where.
   glm::vec3 obstacle_normal_{0.0f};
+  glm::vec3 edge_normal_{0.0f};  // the ledge edge the simulation stands at, or zero
   glm::vec3 obstacle_point_{0.0f};
   // How far (m) the body above the root is moved back from that wall, its rate, and along what.
   float wall_push_ = 0.0f;
