@@ -40,13 +40,12 @@ float usable_length(float blend_time) {
 
 // One joint of extrapolate() below.
 void extrapolate_joint(DeadBlend& blend, size_t i, float keep, float travel) {
-  Transform& s = blend.source[i];
-  s.translation += blend.source_velocities[i] * travel;
-  s.rotation = glm::normalize(
-      quat_from_scaled_angle_axis(blend.source_angular_velocities[i] * travel) * s.rotation);
-  blend.source_velocities[i] = negligible_to_zero(blend.source_velocities[i] * keep);
-  blend.source_angular_velocities[i] =
-      negligible_to_zero(blend.source_angular_velocities[i] * keep);
+  Transform s = blend.source(i);
+  const glm::vec3 v = blend.source_velocity(i);
+  const glm::vec3 w = blend.source_angular_velocity(i);
+  s.translation += v * travel;
+  s.rotation = glm::normalize(quat_from_scaled_angle_axis(w * travel) * s.rotation);
+  blend.set_source(i, s, negligible_to_zero(v * keep), negligible_to_zero(w * keep));
 }
 
 #if defined(__SSE2__)
@@ -148,22 +147,41 @@ struct Lanes {
   return q;
 }
 
-// Joints first .. first + 3 of extrapolate_joint; false (nothing written) when a lane's rotation
-// has no length: the caller then steps them one by one.
-bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
-  Transform* s = &blend.source[first];
-  glm::vec3* velocities = &blend.source_velocities[first];
-  glm::vec3* angular_velocities = &blend.source_angular_velocities[first];
+// A group's rows as registers, and back.
+Quat4 load_rotations(const DeadBlendSourceGroup& g) {
+  return {_mm_load_ps(g.rotation[0]), _mm_load_ps(g.rotation[1]), _mm_load_ps(g.rotation[2]),
+          _mm_load_ps(g.rotation[3])};
+}
+
+void store_rotations(const Quat4& q, DeadBlendSourceGroup& g) {
+  _mm_store_ps(g.rotation[0], q.w);
+  _mm_store_ps(g.rotation[1], q.x);
+  _mm_store_ps(g.rotation[2], q.y);
+  _mm_store_ps(g.rotation[3], q.z);
+}
+
+Vec4x3 load_rows(const float (&rows)[3][4]) {
+  return {_mm_load_ps(rows[0]), _mm_load_ps(rows[1]), _mm_load_ps(rows[2])};
+}
+
+void store_rows(const Vec4x3& v, float (&rows)[3][4]) {
+  _mm_store_ps(rows[0], v.x);
+  _mm_store_ps(rows[1], v.y);
+  _mm_store_ps(rows[2], v.z);
+}
+
+// The four joints of group g of extrapolate_joint; false (nothing written) when a lane's
+// rotation has no length: the caller then steps that group's joints one by one.
+bool extrapolate_x4(DeadBlendSourceGroup& g, float keep, float travel) {
   const __m128 travel4 = c(travel), keep4 = c(keep);
-  const Vec4x3 v = load_vec3s(velocities);
-  const Vec4x3 w = load_vec3s(angular_velocities);
+  const Vec4x3 v = load_rows(g.velocity);
+  const Vec4x3 w = load_rows(g.angular_velocity);
   const Quat4 step = exp_lanes(scale(scale(w, travel4), c(0.5f)));
   __m128 length;
-  const Quat4 rotation = normalize(multiply(step, transform_rotations(s)), length);
+  const Quat4 rotation = normalize(multiply(step, load_rotations(g)), length);
   if (_mm_movemask_ps(_mm_cmpgt_ps(length, _mm_setzero_ps())) != 0xF) return false;
-  const Translations4 t = load_translations(s);
-  store_translations(add(t.t, scale(v, travel4)), t.scale_x, s);
-  store_quats(rotation, &s[0].rotation, sizeof(Transform));
+  store_rows(add(load_rows(g.translation), scale(v, travel4)), g.translation);
+  store_rotations(rotation, g);
   // negligible_to_zero of the decayed velocities.
   const __m128 negligible = c(kSpringNegligible * kSpringNegligible);
   const auto decayed = [&](const Vec4x3& u) {
@@ -171,8 +189,8 @@ bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
     const __m128 zero = _mm_cmplt_ps(dot(k, k), negligible);
     return Vec4x3{_mm_andnot_ps(zero, k.x), _mm_andnot_ps(zero, k.y), _mm_andnot_ps(zero, k.z)};
   };
-  store_vec3s(decayed(v), velocities);
-  store_vec3s(decayed(w), angular_velocities);
+  store_rows(decayed(v), g.velocity);
+  store_rows(decayed(w), g.angular_velocity);
   return true;
 }
 #endif
@@ -183,16 +201,18 @@ bool extrapolate_x4(DeadBlend& blend, size_t first, float keep, float travel) {
 void extrapolate(DeadBlend& blend, float decay, float dt) {
   const float keep = std::exp(-decay * dt);
   const float travel = decay > 0.0f ? (1.0f - keep) / decay : dt;
-  const size_t n = blend.source.size();
-  size_t i = 0;
+  const size_t n = static_cast<size_t>(blend.joints);
 #if defined(__SSE2__)
-  for (; i + 4 <= n; i += 4) {
-    if (!extrapolate_x4(blend, i, keep, travel)) {
-      for (size_t j = i; j < i + 4; ++j) extrapolate_joint(blend, j, keep, travel);
+  // Every group in the lanes, padding included (a joint at rest stays at rest).
+  for (size_t g = 0; g < blend.groups.size(); ++g) {
+    if (!extrapolate_x4(blend.groups[g], keep, travel)) {
+      for (size_t j = 4 * g; j < std::min(n, 4 * g + 4); ++j)
+        extrapolate_joint(blend, j, keep, travel);
     }
   }
+#else
+  for (size_t i = 0; i < n; ++i) extrapolate_joint(blend, i, keep, travel);
 #endif
-  for (; i < n; ++i) extrapolate_joint(blend, i, keep, travel);
 }
 
 // One joint of the blend: rotation exp(w * d) * source with d = log(incoming * source^-1), and
@@ -205,7 +225,7 @@ struct JointBlend {
 
 JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incoming, Weight w,
                        bool with_velocities) {
-  const Transform& s = blend.source[i];
+  const Transform s = blend.source(i);
   const Transform& in = incoming.local[i];
   const glm::vec3 d = quat_to_scaled_angle_axis(in.rotation * glm::conjugate(s.rotation));
   const glm::quat partial = quat_from_scaled_angle_axis(w.value * d);
@@ -214,8 +234,8 @@ JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incom
   out.pose.translation = glm::mix(s.translation, in.translation, w.value);
   out.pose.scale = in.scale;
   if (!with_velocities) return out;
-  const glm::vec3& vs = blend.source_velocities[i];
-  const glm::vec3& ws = blend.source_angular_velocities[i];
+  const glm::vec3 vs = blend.source_velocity(i);
+  const glm::vec3 ws = blend.source_angular_velocity(i);
   const glm::vec3 vi = at_or_zero(incoming.velocities, i);
   const glm::vec3 wi = at_or_zero(incoming.angular_velocities, i);
   out.velocity = glm::mix(vs, vi, w.value) + w.rate * (in.translation - s.translation);
@@ -230,29 +250,49 @@ JointBlend blend_joint(const DeadBlend& blend, size_t i, const PoseMotion& incom
 }
 
 #if defined(__SSE2__)
-// Joints first .. first + 3 of blend_joint without velocities, into out; a lane whose rotation
-// has no length is done by blend_joint itself.
-void blend_x4(const DeadBlend& blend, size_t first, const PoseMotion& incoming, Weight w,
-              std::span<Transform> out) {
-  const Transform* s = &blend.source[first];
-  const Transform* in = &incoming.local[first];
-  const Quat4 source = transform_rotations(s);
+// The four joints of group g of blend_joint without velocities: `in` holds the group's four
+// incoming joints (padding lanes at rest), the results go to out[0 .. count - 1]. A lane whose
+// rotation has no length is done by blend_joint itself.
+void blend_x4(const DeadBlend& blend, size_t g, const Transform* in, const PoseMotion& incoming,
+              Weight w, size_t count, Transform* out) {
+  const DeadBlendSourceGroup& s = blend.groups[g];
+  const Quat4 source = load_rotations(s);
   __m128 length;
   const Vec4x3 d = scaled_angle_axis_lanes(multiply(transform_rotations(in), conjugate(source)));
   const Quat4 partial = exp_lanes(scale(scale(d, c(w.value)), c(0.5f)));
   const Quat4 rotation = normalize(multiply(partial, source), length);
   const int ok = _mm_movemask_ps(_mm_cmpgt_ps(length, _mm_setzero_ps()));
   // glm::mix: source (1 - w) + incoming w; the scale is the incoming one.
-  const Translations4 ts = load_translations(s);
   const Translations4 ti = load_translations(in);
-  const Vec4x3 translation = add(scale(ts.t, c(1.0f - w.value)), scale(ti.t, c(w.value)));
-  Transform* o = &out[first];
+  const Vec4x3 translation =
+      add(scale(load_rows(s.translation), c(1.0f - w.value)), scale(ti.t, c(w.value)));
+  Transform full[4];
+  Transform* o = count == 4 ? out : full;
   store_quats(rotation, &o[0].rotation, sizeof(Transform));
   store_translations(translation, ti.scale_x, o);
-  for (size_t l = 0; l < 4; ++l) {
+  for (size_t l = 0; l < count; ++l) {
     o[l].scale.y = in[l].scale.y;
     o[l].scale.z = in[l].scale.z;
-    if (!(ok & (1 << l))) o[l] = blend_joint(blend, first + l, incoming, w, false).pose;
+    if (!(ok & (1 << l))) o[l] = blend_joint(blend, 4 * g + l, incoming, w, false).pose;
+    if (o != out) out[l] = o[l];
+  }
+}
+
+// The blended pose alone, every group in the lanes; the last group's incoming joints are
+// completed with joints at rest.
+void blend_pose(const DeadBlend& blend, const PoseMotion& incoming, Weight w,
+                std::span<Transform> out) {
+  const size_t n = static_cast<size_t>(blend.joints);
+  for (size_t g = 0; g < blend.groups.size(); ++g) {
+    const size_t first = 4 * g;
+    const size_t count = std::min<size_t>(4, n - first);
+    if (count == 4) {
+      blend_x4(blend, g, &incoming.local[first], incoming, w, 4, &out[first]);
+      continue;
+    }
+    Transform in[4];
+    std::copy_n(&incoming.local[first], count, in);
+    blend_x4(blend, g, in, incoming, w, count, &out[first]);
   }
 }
 #endif
@@ -261,11 +301,45 @@ void blend_x4(const DeadBlend& blend, size_t first, const PoseMotion& incoming, 
 
 void DeadBlend::resize(int joint_count) {
   MM_ASSERT(joint_count >= 0);
-  const size_t n = static_cast<size_t>(joint_count);
-  source.assign(n, Transform{});
-  source_velocities.assign(n, glm::vec3(0.0f));
-  source_angular_velocities.assign(n, glm::vec3(0.0f));
+  joints = joint_count;
+  groups.assign((static_cast<size_t>(joint_count) + 3) / 4, DeadBlendSourceGroup{});
   clear();
+}
+
+Transform DeadBlend::source(size_t j) const {
+  const DeadBlendSourceGroup& g = groups[j / 4];
+  const size_t l = j % 4;
+  Transform t;
+  t.rotation = glm::quat(g.rotation[0][l], g.rotation[1][l], g.rotation[2][l], g.rotation[3][l]);
+  t.translation = glm::vec3(g.translation[0][l], g.translation[1][l], g.translation[2][l]);
+  return t;
+}
+
+glm::vec3 DeadBlend::source_velocity(size_t j) const {
+  const DeadBlendSourceGroup& g = groups[j / 4];
+  const size_t l = j % 4;
+  return glm::vec3(g.velocity[0][l], g.velocity[1][l], g.velocity[2][l]);
+}
+
+glm::vec3 DeadBlend::source_angular_velocity(size_t j) const {
+  const DeadBlendSourceGroup& g = groups[j / 4];
+  const size_t l = j % 4;
+  return glm::vec3(g.angular_velocity[0][l], g.angular_velocity[1][l], g.angular_velocity[2][l]);
+}
+
+void DeadBlend::set_source(size_t j, const Transform& pose, const glm::vec3& velocity,
+                           const glm::vec3& angular_velocity) {
+  DeadBlendSourceGroup& g = groups[j / 4];
+  const size_t l = j % 4;
+  g.rotation[0][l] = pose.rotation.w;
+  g.rotation[1][l] = pose.rotation.x;
+  g.rotation[2][l] = pose.rotation.y;
+  g.rotation[3][l] = pose.rotation.z;
+  for (int k = 0; k < 3; ++k) {
+    g.translation[k][l] = pose.translation[k];
+    g.velocity[k][l] = velocity[k];
+    g.angular_velocity[k][l] = angular_velocity[k];
+  }
 }
 
 void DeadBlend::clear() {
@@ -274,7 +348,7 @@ void DeadBlend::clear() {
 }
 
 void dead_blend_transition(DeadBlend& blend, const PoseMotion& outgoing, float blend_time) {
-  const size_t n = blend.source.size();
+  const size_t n = static_cast<size_t>(blend.joints);
   MM_ASSERT(outgoing.local.size() == n);
   MM_ASSERT(outgoing.velocities.empty() || outgoing.velocities.size() == n);
   MM_ASSERT(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
@@ -282,13 +356,10 @@ void dead_blend_transition(DeadBlend& blend, const PoseMotion& outgoing, float b
   for (size_t i = 0; i < n; ++i) {
     if (w.value < 1.0f) {
       const JointBlend shown = blend_joint(blend, i, outgoing, w, true);
-      blend.source[i] = shown.pose;
-      blend.source_velocities[i] = shown.velocity;
-      blend.source_angular_velocities[i] = shown.angular_velocity;
+      blend.set_source(i, shown.pose, shown.velocity, shown.angular_velocity);
     } else {
-      blend.source[i] = outgoing.local[i];
-      blend.source_velocities[i] = at_or_zero(outgoing.velocities, i);
-      blend.source_angular_velocities[i] = at_or_zero(outgoing.angular_velocities, i);
+      blend.set_source(i, outgoing.local[i], at_or_zero(outgoing.velocities, i),
+                       at_or_zero(outgoing.angular_velocities, i));
     }
   }
   blend.time = 0.0f;
@@ -299,7 +370,7 @@ void dead_blend_update(DeadBlend& blend, const PoseMotion& incoming, float blend
                        float decay_halflife, float dt, std::span<Transform> out_local,
                        std::span<glm::vec3> out_velocities,
                        std::span<glm::vec3> out_angular_velocities) {
-  const size_t n = blend.source.size();
+  const size_t n = static_cast<size_t>(blend.joints);
   MM_ASSERT(incoming.local.size() == n && out_local.size() == n);
   MM_ASSERT(incoming.velocities.empty() || incoming.velocities.size() == n);
   MM_ASSERT(incoming.angular_velocities.empty() || incoming.angular_velocities.size() == n);
@@ -317,14 +388,14 @@ void dead_blend_update(DeadBlend& blend, const PoseMotion& incoming, float blend
     extrapolate(blend, std::isfinite(halflife) ? std::log(2.0f) / halflife : 0.0f, dt);
   }
   const bool with_velocities = !out_velocities.empty() || !out_angular_velocities.empty();
-  size_t i = 0;
 #if defined(__SSE2__)
   // The pose alone: four joints at a time, each lane equal to blend_joint's to the bit.
   if (blend.active && !with_velocities) {
-    for (; i + 4 <= n; i += 4) blend_x4(blend, i, incoming, w, out_local);
+    blend_pose(blend, incoming, w, out_local);
+    return;
   }
 #endif
-  for (; i < n; ++i) {
+  for (size_t i = 0; i < n; ++i) {
     JointBlend out;
     if (blend.active) {
       out = blend_joint(blend, i, incoming, w, with_velocities);

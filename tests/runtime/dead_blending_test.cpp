@@ -204,11 +204,12 @@ TEST(DeadBlending, TheSourceCoastsToRestWithItsVelocitiesExactlyZero) {
     dead_blend_update(blend, still.at(0.0f), 100.0f, kDecay, 1.0f / 60.0f, scratch, {}, {});
   }
   for (int j = 0; j < kJoints; ++j) {
-    EXPECT_EQ(blend.source_velocities[j], glm::vec3(0.0f));
-    EXPECT_EQ(blend.source_angular_velocities[j], glm::vec3(0.0f));
+    EXPECT_EQ(blend.source_velocity(static_cast<size_t>(j)), glm::vec3(0.0f));
+    EXPECT_EQ(blend.source_angular_velocity(static_cast<size_t>(j)), glm::vec3(0.0f));
     // It went no farther than its speed times the decay's mean time (halflife / ln 2).
-    EXPECT_LE(glm::length(blend.source[j].translation - a.local[j].translation),
-              glm::length(a.velocities[j]) * kDecay / std::log(2.0f) + 1e-4f);
+    EXPECT_LE(
+        glm::length(blend.source(static_cast<size_t>(j)).translation - a.local[j].translation),
+        glm::length(a.velocities[j]) * kDecay / std::log(2.0f) + 1e-4f);
   }
 }
 
@@ -232,7 +233,8 @@ TEST(DeadBlending, TheSameSpanOfTimeGivesTheSamePoseHoweverItIsCut) {
 // Without velocities asked for, the pose is computed four joints at a time; each joint equals the
 // one computed with velocities (joint by joint) to the bit, through a whole blend, for joints near
 // their incoming pose (the logarithm's and exponential's series) and far from it (their
-// trigonometric forms), with a joint count that leaves a remainder after the blocks of four.
+// trigonometric forms), with a joint count that leaves a remainder after the blocks of four
+// (its last group is completed with joints at rest in the lanes).
 TEST(DeadBlending, ThePoseAloneEqualsThePoseWithItsVelocitiesToTheBit) {
   constexpr size_t n = 22;
   std::vector<Transform> outgoing(n), incoming(n), pose_alone(n), pose(n);

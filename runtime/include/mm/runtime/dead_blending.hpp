@@ -34,19 +34,38 @@
 
 namespace mm {
 
+// Four joints of a dead blend's source, each component of the four side by side (rows of four
+// floats, one per joint), so that the update's SIMD lanes load and store them without
+// transposing.
+struct DeadBlendSourceGroup {
+  alignas(16) float rotation[4][4] = {{1.0f, 1.0f, 1.0f, 1.0f}};  // w, x, y, z; unit
+  float translation[3][4] = {};                                   // metres
+  float velocity[3][4] = {};                                      // m/s, decaying
+  float angular_velocity[3][4] = {};                              // rad/s, parent frame, decaying
+};
+
 // The state of a dead blend: the extrapolated source and the time since the switch.
 struct DeadBlend {
-  std::vector<Transform> source;
-  std::vector<glm::vec3> source_velocities;          // m/s, decaying
-  std::vector<glm::vec3> source_angular_velocities;  // rad/s, parent frame, decaying
-  float time = 0.0f;                                 // seconds since the switch
-  bool active = false;                               // a blend is running
+  // Joints 4 g .. 4 g + 3 of the source in groups[g]; the lanes past the last joint hold a
+  // joint at rest (identity, no motion), updated with the others and never read out.
+  std::vector<DeadBlendSourceGroup> groups;
+  int joints = 0;
+  float time = 0.0f;    // seconds since the switch
+  bool active = false;  // a blend is running
 
-  // Sizes every array for joint_count joints, with no blend running (allocates: call at setup).
+  // Sizes the source for joint_count joints, with no blend running (allocates: call at setup).
   void resize(int joint_count);
   // Ends any blend (no allocation): the next update outputs the incoming pose.
   void clear();
-  int joint_count() const { return static_cast<int>(source.size()); }
+  int joint_count() const { return joints; }
+
+  // Joint j of the source (its scale is one: the output takes the incoming pose's), and its
+  // decaying velocity and angular velocity.
+  Transform source(size_t j) const;
+  glm::vec3 source_velocity(size_t j) const;
+  glm::vec3 source_angular_velocity(size_t j) const;
+  void set_source(size_t j, const Transform& pose, const glm::vec3& velocity,
+                  const glm::vec3& angular_velocity);
 };
 
 // Starts a blend at the current time. `outgoing` is the animation that was playing, at this
