@@ -413,7 +413,13 @@ void Controller::update(float dt, const ControllerInput& input) {
   desired_motion(input);
   search_timer_ += dt;
   since_transition_ += dt;
-  if (should_search()) search();
+  if (should_search()) {
+    // The last update's prediction heads where the stick pointed then: a search for a changed
+    // stick matched against it would pick a frame for the old request (a walk backwards to
+    // start a run from standing) and keep it until the next search.
+    if (prediction_stale()) predict();
+    search();
+  }
   advance_playback(dt);
   sampled_at_ = playback_point();
   sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, false);
@@ -881,7 +887,15 @@ void Controller::stand_turn(float dt) {
   sim_angular_velocity_ = glm::vec3(0.0f, rate, 0.0f);
 }
 
+bool Controller::prediction_stale() const {
+  return desired_velocity_ != predicted_velocity_goal_ ||
+         simulation_goal_rotation_ != predicted_rotation_goal_ || stopping_ != predicted_stopping_;
+}
+
 void Controller::predict() {
+  predicted_velocity_goal_ = desired_velocity_;
+  predicted_rotation_goal_ = simulation_goal_rotation_;
+  predicted_stopping_ = stopping_;
   const size_t n = trajectory_times_.size();
   std::span<glm::vec3> positions(debug_.predicted_positions, n);
   std::span<glm::quat> rotations(debug_.predicted_rotations, n);

