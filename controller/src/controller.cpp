@@ -663,9 +663,8 @@ void Controller::transition_to(int frame) {
       sample_body_velocities(sampled_at_, sampled_velocities_, sampled_angular_velocities_);
     }
   }
-  const size_t k = static_cast<size_t>(frame) * static_cast<size_t>(db.joint_count());
-  transition_dst_position_ = db.local_positions()[k];
-  transition_dst_rotation_ = db.local_rotations()[k];
+  transition_dst_position_ = db.local_position(frame, 0);
+  transition_dst_rotation_ = db.local_rotation(frame, 0);
   clip_ = clip;
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
   sample_playback(other_, other_velocities_, other_angular_velocities_, true);
@@ -776,15 +775,13 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
                                  bool body_velocities) const {
   const Database& db = *db_;
   const PlaybackPoint at = playback_point();
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t k0 = static_cast<size_t>(at.frame0) * joints;
-  const size_t k1 = static_cast<size_t>(at.frame1) * joints;
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
   root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
-  velocities[0] = glm::mix(db.local_velocities()[k0], db.local_velocities()[k1], at.weight);
-  angular_velocities[0] =
-      glm::mix(db.local_angular_velocities()[k0], db.local_angular_velocities()[k1], at.weight);
+  velocities[0] =
+      glm::mix(db.local_velocity(at.frame0, 0), db.local_velocity(at.frame1, 0), at.weight);
+  angular_velocities[0] = glm::mix(db.local_angular_velocity(at.frame0, 0),
+                                   db.local_angular_velocity(at.frame1, 0), at.weight);
   if (body_velocities) sample_body_velocities(at, velocities, angular_velocities);
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
@@ -809,14 +806,13 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
 void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
                                         std::span<glm::vec3> angular_velocities) const {
   const Database& db = *db_;
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t k0 = static_cast<size_t>(at.frame0) * joints;
-  const size_t k1 = static_cast<size_t>(at.frame1) * joints;
-  for (size_t j = 1; j < joints; ++j) {
-    velocities[j] =
-        glm::mix(db.local_velocities()[k0 + j], db.local_velocities()[k1 + j], at.weight);
-    angular_velocities[j] = glm::mix(db.local_angular_velocities()[k0 + j],
-                                     db.local_angular_velocities()[k1 + j], at.weight);
+  const int joints = db.joint_count();
+  for (int j = 1; j < joints; ++j) {
+    const size_t i = static_cast<size_t>(j);
+    velocities[i] =
+        glm::mix(db.local_velocity(at.frame0, j), db.local_velocity(at.frame1, j), at.weight);
+    angular_velocities[i] = glm::mix(db.local_angular_velocity(at.frame0, j),
+                                     db.local_angular_velocity(at.frame1, j), at.weight);
   }
   for (const int j : folded_joints_) {
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;

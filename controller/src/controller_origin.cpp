@@ -4,6 +4,10 @@
 
 #include <cmath>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "mm/controller/controller.hpp"
 
 namespace mm {
@@ -69,10 +73,27 @@ void Controller::shift_origin(const glm::vec3& shift) {
 // each translation summed in double and rounded once.
 void Controller::publish_world_transforms() {
   if (origin_ == glm::dvec3(0.0)) return;  // global_transforms() shows globals_ itself
+#if defined(__SSE2__)
+  // to_world of every joint, x and y in one pair of doubles: the same conversions and additions
+  // (a float widens exactly, the sum rounds once back to float, to nearest), a joint per pass.
+  const __m128d origin_xy = _mm_set_pd(origin_.y, origin_.x);
+  for (size_t j = 0; j < globals_.size(); ++j) {
+    const Transform& g = globals_[j];
+    Transform& w = world_globals_[j];
+    w.rotation = g.rotation;
+    w.scale = g.scale;
+    const __m128 xy =
+        _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&g.translation.x)));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(&w.translation.x),
+                     _mm_castps_si128(_mm_cvtpd_ps(_mm_add_pd(_mm_cvtps_pd(xy), origin_xy))));
+    w.translation.z = static_cast<float>(origin_.z + static_cast<double>(g.translation.z));
+  }
+#else
   for (size_t j = 0; j < globals_.size(); ++j) {
     world_globals_[j] = globals_[j];
     world_globals_[j].translation = glm::vec3(to_world(origin_, globals_[j].translation));
   }
+#endif
 }
 
 }  // namespace mm

@@ -294,10 +294,7 @@ Database& Database::operator=(Database&& other) noexcept {
   schema_ = std::move(other.schema_);
   // The block moves with its owner, so the views into it stay valid; the source keeps none.
   block_ = std::move(other.block_);
-  local_positions_ = std::exchange(other.local_positions_, {});
-  local_rotations_ = std::exchange(other.local_rotations_, {});
-  local_velocities_ = std::exchange(other.local_velocities_, {});
-  local_angular_velocities_ = std::exchange(other.local_angular_velocities_, {});
+  pose_lanes_ = std::exchange(other.pose_lanes_, {});
   contacts_ = std::exchange(other.contacts_, {});
   features_ = std::exchange(other.features_, {});
   feature_offset_ = std::exchange(other.feature_offset_, {});
@@ -308,18 +305,15 @@ Database& Database::operator=(Database&& other) noexcept {
 }
 
 void Database::allocate(size_t frames, size_t joints, size_t dims) {
-  const size_t samples = frames * joints;
-  // Widest elements first; each array starts on a cache line.
+  const size_t pose_floats = frames * pose_lane_floats(joints);
+  // Each array starts on a cache line.
   size_t bytes = 0;
   const auto place = [&](size_t count, size_t size) {
     const size_t at = bytes;
     bytes = aligned(bytes + count * size);
     return at;
   };
-  const size_t rotations = place(samples, sizeof(glm::quat));
-  const size_t positions = place(samples, sizeof(glm::vec3));
-  const size_t velocities = place(samples, sizeof(glm::vec3));
-  const size_t angular = place(samples, sizeof(glm::vec3));
+  const size_t pose = place(pose_floats, sizeof(float));
   const size_t features = place(frames * dims, sizeof(float));
   const size_t offset = place(dims, sizeof(float));
   const size_t scale = place(dims, sizeof(float));
@@ -333,10 +327,7 @@ void Database::allocate(size_t frames, size_t joints, size_t dims) {
   const auto array = [&]<class T>(size_t at, size_t count, T*) {
     return std::span<T>(reinterpret_cast<T*>(base + at), count);
   };
-  local_rotations_ = array(rotations, samples, static_cast<glm::quat*>(nullptr));
-  local_positions_ = array(positions, samples, static_cast<glm::vec3*>(nullptr));
-  local_velocities_ = array(velocities, samples, static_cast<glm::vec3*>(nullptr));
-  local_angular_velocities_ = array(angular, samples, static_cast<glm::vec3*>(nullptr));
+  pose_lanes_ = array(pose, pose_floats, static_cast<float*>(nullptr));
   features_ = array(features, frames * dims, static_cast<float*>(nullptr));
   feature_offset_ = array(offset, dims, static_cast<float*>(nullptr));
   feature_scale_ = array(scale, dims, static_cast<float*>(nullptr));
@@ -350,14 +341,24 @@ void Database::keep_frames(size_t frames) {
   const size_t joints = static_cast<size_t>(joint_count());
   const size_t dims = static_cast<size_t>(feature_dims());
   frame_count_ = static_cast<int>(frames);
-  local_positions_ = local_positions_.first(frames * joints);
-  local_rotations_ = local_rotations_.first(frames * joints);
-  local_velocities_ = local_velocities_.first(frames * joints);
-  local_angular_velocities_ = local_angular_velocities_.first(frames * joints);
+  pose_lanes_ = pose_lanes_.first(frames * pose_lane_floats(joints));
   features_ = features_.first(frames * dims);
   frame_clip_ = frame_clip_.first(frames);
   contacts_ = contacts_.first(frames * 2);
   searchable_ = searchable_.first(frames);
+}
+
+void Database::lay_out_pose(const PoseFrameView& pose) {
+  const size_t joints = static_cast<size_t>(joint_count());
+  const size_t floats = pose_lane_floats(joints);
+  for (size_t f = 0; f < static_cast<size_t>(frame_count_); ++f) {
+    const size_t k = f * joints;
+    pose_to_lanes(
+        PoseFrameView{pose.rotations.subspan(k, joints), pose.positions.subspan(k, joints),
+                      pose.velocities.subspan(k, joints),
+                      pose.angular_velocities.subspan(k, joints)},
+        pose_lanes_.subspan(f * floats, floats));
+  }
 }
 
 void Database::derive_frame_clip() {
@@ -384,10 +385,8 @@ Result<Database> Database::create(const DatabaseContents& contents) {
   const auto copy = [](const auto& from, auto to) {
     std::copy(from.begin(), from.end(), to.begin());
   };
-  copy(contents.local_positions, db.local_positions_);
-  copy(contents.local_rotations, db.local_rotations_);
-  copy(contents.local_velocities, db.local_velocities_);
-  copy(contents.local_angular_velocities, db.local_angular_velocities_);
+  db.lay_out_pose(PoseFrameView{contents.local_rotations, contents.local_positions,
+                                contents.local_velocities, contents.local_angular_velocities});
   copy(contents.contacts, db.contacts_);
   copy(contents.features, db.features_);
   copy(contents.feature_offset, db.feature_offset_);
@@ -428,11 +427,21 @@ DatabaseContents Database::contents() const {
   out.roles = roles_;
   out.frame_time = frame_time_;
   out.frame_count = frame_count_;
-  out.local_positions.assign(local_positions_.begin(), local_positions_.end());
-  out.local_rotations.assign(local_rotations_.begin(), local_rotations_.end());
-  out.local_velocities.assign(local_velocities_.begin(), local_velocities_.end());
-  out.local_angular_velocities.assign(local_angular_velocities_.begin(),
-                                      local_angular_velocities_.end());
+  const size_t samples = static_cast<size_t>(frame_count_) * static_cast<size_t>(joint_count());
+  out.local_positions.resize(samples);
+  out.local_rotations.resize(samples);
+  out.local_velocities.resize(samples);
+  out.local_angular_velocities.resize(samples);
+  for (int f = 0; f < frame_count_; ++f) {
+    for (int j = 0; j < joint_count(); ++j) {
+      const size_t k =
+          static_cast<size_t>(f) * static_cast<size_t>(joint_count()) + static_cast<size_t>(j);
+      out.local_positions[k] = local_position(f, j);
+      out.local_rotations[k] = local_rotation(f, j);
+      out.local_velocities[k] = local_velocity(f, j);
+      out.local_angular_velocities[k] = local_angular_velocity(f, j);
+    }
+  }
   out.contacts.assign(contacts_.begin(), contacts_.end());
   out.clips = clips_;
   out.tag_names = tag_names_;
@@ -653,19 +662,45 @@ Status check_clips(const DatabaseView& db) {
 
 // Values: the large arrays last, with the vectorized scans.
 // The per-frame joint arrays: finite unit rotations, finite positions and velocities.
+// One pass in index order over values a plain array does not hold (a Database's lanes).
+template <class T, class Bad>
+size_t first_bad_value(const JointValues<T>& values, const Bad& bad) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (bad(values[i])) return i;
+  }
+  return kNotFound;
+}
+
+size_t first_non_unit(const JointValues<glm::quat>& quats) {
+  if (quats.plain().size() == quats.size()) return first_non_unit(quats.plain());
+  return first_bad_value(quats, [](const glm::quat& q) { return !is_unit(&q.x); });
+}
+
+// Of the three floats of each value: the first index (3 * value + component) not finite.
+size_t first_non_finite(const JointValues<glm::vec3>& vectors) {
+  if (vectors.plain().size() == vectors.size()) return first_non_finite(floats_of(vectors.plain()));
+  for (size_t i = 0; i < vectors.size(); ++i) {
+    const glm::vec3 v = vectors[i];
+    for (int c = 0; c < 3; ++c) {
+      if (!std::isfinite(v[c])) return 3 * i + static_cast<size_t>(c);
+    }
+  }
+  return kNotFound;
+}
+
 Status check_joint_values(const DatabaseView& db) {
   if (size_t i = first_non_unit(db.local_rotations); i != kNotFound) {
-    const glm::quat& q = db.local_rotations[i];
+    const glm::quat q = db.local_rotations[i];
     return Error{"database: local_rotations" + frame_joint(db, i) +
                  " is not a finite unit quaternion (squared length " +
                  std::to_string(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w) + ")"};
   }
-  const std::pair<const char*, std::span<const glm::vec3>> vector_arrays[] = {
+  const std::pair<const char*, const JointValues<glm::vec3>&> vector_arrays[] = {
       {"local_positions", db.local_positions},
       {"local_velocities", db.local_velocities},
       {"local_angular_velocities", db.local_angular_velocities}};
   for (const auto& [name, array] : vector_arrays) {
-    if (size_t i = first_non_finite(floats_of(array)); i != kNotFound) {
+    if (size_t i = first_non_finite(array); i != kNotFound) {
       return Error{"database: " + std::string(name) + frame_joint(db, i / 3) + " is not finite"};
     }
   }

@@ -826,31 +826,62 @@ Status decode_rotations(std::span<const std::byte> file, const DatabaseFileInfo&
   return Status::success();
 }
 
-// Positions, rotations and velocities of one clip, straight into the database's arrays.
-// `valid` tells whether they are all what validate() accepts (finite, unit rotations).
+// One clip's pose per joint, as the file stores it and the velocities are derived: a worker's
+// scratch, laid out in the database's lanes once the clip is decoded (the database holds the
+// pose only in the lanes' layout).
+struct ClipPose {
+  std::vector<glm::vec3> positions, velocities, angular_velocities;
+  std::vector<glm::quat> rotations;
+  void reserve(size_t count) {
+    positions.reserve(count);
+    velocities.reserve(count);
+    angular_velocities.reserve(count);
+    rotations.reserve(count);
+  }
+  void resize(size_t count) {
+    positions.resize(count);
+    velocities.resize(count);
+    angular_velocities.resize(count);
+    rotations.resize(count);
+  }
+};
+
+// Positions, rotations and velocities of one clip, decoded into `pose` and laid out in the
+// database's lanes at the clip's frames. `valid` tells whether they are all what validate()
+// accepts (finite, unit rotations).
 Status decode_clip(std::span<const std::byte> file, const DatabaseFileInfo& info,
                    const LoadPlan& plan, size_t c, std::string_view name, LoadTarget& db,
-                   bool& valid) {
+                   ClipPose& pose, bool& valid) {
   const ClipRange& clip = db.clips[c];
   const size_t joints = info.joint_count;
   const size_t frames = static_cast<size_t>(clip.frame_count());
   const size_t first = static_cast<size_t>(clip.start) * joints;
   const size_t count = frames * joints;
+  pose.resize(count);
   const bool positions_finite =
       decode_positions(section_bytes(file, info, DatabaseSection::ConstantPositions).data() +
                            12 * plan.positions.first_constant[c],
                        section_bytes(file, info, DatabaseSection::VaryingPositions).data() +
                            12 * plan.positions.first_varying[c],
                        plan.positions.constant.data() + c * joints, joints, frames,
-                       glm::value_ptr(db.local_positions[first]));
-  glm::quat* rotations = db.local_rotations.data() + first;
+                       glm::value_ptr(pose.positions[0]));
+  glm::quat* rotations = pose.rotations.data();
   if (Status s = decode_rotations(file, info, plan, first, count, name, rotations); !s) return s;
   const bool velocities_finite = compute_local_velocities(
-      std::span(db.local_positions).subspan(first, count), std::span(rotations, count),
-      clip.frame_count(), static_cast<int>(joints), db.frame_time,
-      std::span(db.local_velocities).subspan(first, count),
-      std::span(db.local_angular_velocities).subspan(first, count));
+      std::span(pose.positions).first(count), std::span(rotations, count), clip.frame_count(),
+      static_cast<int>(joints), db.frame_time, std::span(pose.velocities).first(count),
+      std::span(pose.angular_velocities).first(count));
   valid = positions_finite && velocities_finite && detail::rotations_unit(rotations, count);
+  const size_t floats = pose_lane_floats(joints);
+  for (size_t f = 0; f < frames; ++f) {
+    const size_t k = f * joints;
+    pose_to_lanes(
+        PoseFrameView{std::span<const glm::quat>(pose.rotations).subspan(k, joints),
+                      std::span<const glm::vec3>(pose.positions).subspan(k, joints),
+                      std::span<const glm::vec3>(pose.velocities).subspan(k, joints),
+                      std::span<const glm::vec3>(pose.angular_velocities).subspan(k, joints)},
+        db.pose_lanes.subspan((static_cast<size_t>(clip.start) + f) * floats, floats));
+  }
   return Status::success();
 }
 
@@ -871,7 +902,14 @@ DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo&
   constexpr size_t kFirstClipJob = 2;
   std::vector<Status> status(db.clips.size());
   std::vector<uint8_t> valid(db.clips.size(), 0);
-  detail::run_workers(kFirstClipJob + db.clips.size(), threads, [&](int, size_t job) {
+  // Each worker's scratch holds the longest clip, allocated once.
+  size_t longest = 0;
+  for (const ClipRange& clip : db.clips) {
+    longest = std::max(longest, static_cast<size_t>(clip.frame_count()) * info.joint_count);
+  }
+  std::vector<ClipPose> poses(static_cast<size_t>(std::max(threads, 1)));
+  for (ClipPose& pose : poses) pose.reserve(longest);
+  detail::run_workers(kFirstClipJob + db.clips.size(), threads, [&](int worker, size_t job) {
     if (job == 0) {
       out.checksum = database_checksum(file.first(file.size() - kChecksumSize));
     } else if (job == 1) {
@@ -883,7 +921,8 @@ DecodedFile decode_file(std::span<const std::byte> file, const DatabaseFileInfo&
     } else {
       const size_t c = job - kFirstClipJob;
       bool clip_valid = false;
-      status[c] = decode_clip(file, info, plan, c, name, db, clip_valid);
+      status[c] = decode_clip(file, info, plan, c, name, db, poses[static_cast<size_t>(worker)],
+                              clip_valid);
       valid[c] = status[c] && clip_valid;
     }
   });

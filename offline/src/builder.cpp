@@ -272,6 +272,22 @@ struct BuildState {
 
   // Phase 2 on: the database, filled in place.
   Database db = Assembly::empty();
+  // Phases 3a and 3b: the database's pose per joint (frame * joints + joint), as preprocessing
+  // and the idle clip write it; laid out in the database's lanes when final, then freed.
+  std::vector<glm::vec3> pose_positions, pose_velocities, pose_angular_velocities;
+  std::vector<glm::quat> pose_rotations;
+  Assembly::WritablePose pose() {
+    return {pose_positions, pose_rotations, pose_velocities, pose_angular_velocities};
+  }
+  // The database as the build side reads it: its pose from the per-joint arrays above.
+  DatabaseView view() const {
+    DatabaseView v(db);
+    v.local_positions = JointValues<glm::vec3>(pose_positions);
+    v.local_rotations = JointValues<glm::quat>(pose_rotations);
+    v.local_velocities = JointValues<glm::vec3>(pose_velocities);
+    v.local_angular_velocities = JointValues<glm::vec3>(pose_angular_velocities);
+    return v;
+  }
   std::vector<int> bones;       // the joint of every feature channel
   std::vector<int> mirror_map;  // per source joint (only with options.mirror)
   std::vector<ClipJob> jobs;
@@ -604,13 +620,31 @@ void allocate_arrays(BuildState& state) {
   db.frame_count = static_cast<int>(frames);
   Assembly::allocate(state.db, frames);
   Assembly::derive_frame_clip(state.db);
+  const size_t samples = frames * static_cast<size_t>(db.joint_count());
+  state.pose_positions.resize(samples);
+  state.pose_rotations.resize(samples);
+  state.pose_velocities.resize(samples);
+  state.pose_angular_velocities.resize(samples);
+}
+
+// Phase 3c: the pose's frames are final (the idle clip's too, or given back): laid out in the
+// database's lanes, the per-joint arrays freed.
+void lay_out_pose(BuildState& state) {
+  Assembly::lay_out_pose(
+      state.db, PoseFrameView{state.pose_rotations, state.pose_positions, state.pose_velocities,
+                              state.pose_angular_velocities});
+  state.pose_positions = {};
+  state.pose_rotations = {};
+  state.pose_velocities = {};
+  state.pose_angular_velocities = {};
 }
 
 // Phase 3a, parallel over clips: preprocess and extract raw features straight into the
 // database's arrays at each clip's frames.
 Status process_clips(BuildState& state) {
   Assembly::Parts db = Assembly::parts(state.db);
-  const DatabaseFill fill = Assembly::fill(state.db);
+  const Assembly::WritablePose pose = state.pose();
+  const DatabaseFill fill = Assembly::fill(state.db, pose);
   const size_t joints = static_cast<size_t>(db.joint_count());
   std::vector<Status> job_status(state.jobs.size());
   std::vector<std::atomic<int>> jobs_left(state.results.size());
@@ -627,11 +661,10 @@ Status process_clips(BuildState& state) {
       preprocess.root.fixed = (range.tags & state.data_idle_tag) != 0;
       const size_t first = static_cast<size_t>(range.start) * joints;
       const size_t count = static_cast<size_t>(range.frame_count()) * joints;
-      const std::span<glm::vec3> positions = std::span(db.local_positions).subspan(first, count);
-      const std::span<glm::quat> rotations = std::span(db.local_rotations).subspan(first, count);
-      const std::span<glm::vec3> velocities = std::span(db.local_velocities).subspan(first, count);
-      const std::span<glm::vec3> angular =
-          std::span(db.local_angular_velocities).subspan(first, count);
+      const std::span<glm::vec3> positions = pose.positions.subspan(first, count);
+      const std::span<glm::quat> rotations = pose.rotations.subspan(first, count);
+      const std::span<glm::vec3> velocities = pose.velocities.subspan(first, count);
+      const std::span<glm::vec3> angular = pose.angular_velocities.subspan(first, count);
       const ClipMotionOutput out{positions, rotations, velocities, angular,
                                  std::span(db.contacts)
                                      .subspan(static_cast<size_t>(range.start) * 2,
@@ -664,9 +697,9 @@ Status add_idle_clip(BuildState& state) {
   Assembly::Parts db = Assembly::parts(state.db);
   BuildReport& rep = state.rep;
   const ClipRange& idle = db.clips.back();
-  const IdleSourceSearch found = search_idle_source(state.db);
+  const IdleSourceSearch found = search_idle_source(state.view());
   if (found.frame >= 0) {
-    const DatabaseFill fill = Assembly::fill(state.db);
+    const DatabaseFill fill = Assembly::fill(state.db, state.pose());
     fill_idle_clip(fill, idle, found.frame);
     extract_range_features(fill, idle, state.bones, state.scratch[0].features);
     const ClipRange& source = *std::find_if(
@@ -732,7 +765,8 @@ Status normalize_and_check(BuildState& state) {
 // Phase 2 (in input order): refuse failures and foreign skeletons, lay out the clip ranges,
 //   tags and arrays of the database.
 // Phase 3 (parallel over clips): preprocess and extract raw features straight into the
-//   database's arrays at each clip's frames; then the idle clip (one pass in frame order).
+//   database's arrays (the pose per joint beside it) at each clip's frames; then the idle clip
+//   (one pass in frame order); then the pose laid out in the database's lanes.
 // Phase 4: normalization statistics (one pass in frame order), normalization, validation.
 template <class Load>
 Result<Database> build(size_t input_count, const std::vector<std::string>& input_names,
@@ -765,6 +799,7 @@ Result<Database> build(size_t input_count, const std::vector<std::string>& input
   if (state.synthesize_idle) {
     if (Status s = add_idle_clip(state); !s) return Error{s.message()};
   }
+  lay_out_pose(state);
   rep.process_seconds = seconds_since(phase_start);
   phase_start = Clock::now();
 

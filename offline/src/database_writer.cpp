@@ -128,14 +128,15 @@ EncodedRotation encode_rotation(const glm::quat& q) {
 
 // flags[j] = 1 when joint j's local position has the same bits on every frame of the clip
 // (read frame by frame, in memory order).
-void find_constant_columns(std::span<const glm::vec3> positions, size_t joints,
+void find_constant_columns(const JointValues<glm::vec3>& positions, size_t joints,
                            const ClipRange& clip, uint8_t* flags) {
   std::fill(flags, flags + joints, uint8_t{1});
-  const glm::vec3* first = positions.data() + static_cast<size_t>(clip.start) * joints;
+  const size_t first = static_cast<size_t>(clip.start) * joints;
   for (int f = clip.start + 1; f < clip.end; ++f) {
-    const glm::vec3* frame = positions.data() + static_cast<size_t>(f) * joints;
+    const size_t frame = static_cast<size_t>(f) * joints;
     for (size_t j = 0; j < joints; ++j) {
-      flags[j] &= static_cast<uint8_t>(std::memcmp(&frame[j], &first[j], sizeof(glm::vec3)) == 0);
+      const glm::vec3 value = positions[frame + j], first_value = positions[first + j];
+      flags[j] &= static_cast<uint8_t>(std::memcmp(&value, &first_value, sizeof(glm::vec3)) == 0);
     }
   }
 }
@@ -208,10 +209,11 @@ void write_positions(ByteWriter& w, const DatabaseView& db, const PositionLayout
     const uint8_t* flags = layout.constant.data() + c * joints;
     const int last = constant ? clip.start + 1 : clip.end;  // a constant column once
     for (int f = clip.start; f < last; ++f) {
-      const glm::vec3* frame = db.local_positions.data() + static_cast<size_t>(f) * joints;
+      const size_t frame = static_cast<size_t>(f) * joints;
       for (size_t j = 0; j < joints; ++j) {
         if (flags[j] != (constant ? 1 : 0)) continue;
-        std::memcpy(out, glm::value_ptr(frame[j]), 12);
+        const glm::vec3 value = db.local_positions[frame + j];
+        std::memcpy(out, glm::value_ptr(value), 12);
         out += 12;
       }
     }
@@ -220,7 +222,7 @@ void write_positions(ByteWriter& w, const DatabaseView& db, const PositionLayout
 
 // Rotations [begin, end) into their 12 bytes of components and their code byte, the escapes'
 // exact values appended to `exceptions` in sample order.
-void encode_rotations(std::span<const glm::quat> rotations, size_t begin, size_t end,
+void encode_rotations(const JointValues<glm::quat>& rotations, size_t begin, size_t end,
                       std::byte* components, std::byte* codes,
                       std::vector<RotationException>& exceptions) {
   for (size_t i = begin; i < end; ++i) {

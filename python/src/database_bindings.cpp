@@ -2,6 +2,7 @@
 // memory, and its names.
 
 #include <cstddef>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -32,6 +33,21 @@ py::array read_only_view(const T* data, std::vector<py::ssize_t> shape, const py
   return view;
 }
 
+// A read-only array of the values of a database's pose (vec3 or quat, read as GLM stores them:
+// x, y, z[, w]), copied out of the lanes the database keeps them in.
+template <typename T>
+py::array read_only_copy(const JointValues<T>& values, std::vector<py::ssize_t> shape) {
+  constexpr size_t kComponents = sizeof(T) / sizeof(float);
+  py::array_t<float> copy(std::move(shape));
+  float* out = copy.mutable_data();
+  for (size_t k = 0; k < values.size(); ++k) {
+    const T v = values[k];
+    std::memcpy(out + kComponents * k, &v, sizeof v);
+  }
+  copy.attr("setflags")(py::arg("write") = false);
+  return copy;
+}
+
 const Database& db_of(const Handle& handle) {
   return *handle->database;
 }
@@ -47,11 +63,10 @@ void check_frame(const Database& db, int frame) {
 std::vector<Transform> global_pose(const Database& db, int frame) {
   check_frame(db, frame);
   const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t first = static_cast<size_t>(frame) * joints;
   std::vector<Transform> local(joints), global(joints);
   for (size_t j = 0; j < joints; ++j) {
-    local[j].translation = db.local_positions()[first + j];
-    local[j].rotation = db.local_rotations()[first + j];
+    local[j].translation = db.local_position(frame, static_cast<int>(j));
+    local[j].rotation = db.local_rotation(frame, static_cast<int>(j));
   }
   forward_kinematics(db.skeleton().parents(), local, global);
   return global;
@@ -266,19 +281,18 @@ void bind_database(py::module_& m) {
           "local_positions",
           [](const py::object& self) {
             const Database& db = db_of(self.cast<Handle>());
-            return read_only_view(&db.local_positions().data()->x,
-                                  {db.frame_count(), db.joint_count(), 3}, self);
+            return read_only_copy(db.local_positions(), {db.frame_count(), db.joint_count(), 3});
           },
-          "(frames, joints, 3) float32 metres, relative to each joint's parent")
+          "(frames, joints, 3) float32 metres, relative to each joint's parent (a copy: the "
+          "database keeps its pose in groups of four joints)")
       .def_property_readonly(
           "local_rotations",
           [](const py::object& self) {
             const Database& db = db_of(self.cast<Handle>());
-            return read_only_view(&db.local_rotations().data()->x,
-                                  {db.frame_count(), db.joint_count(), 4}, self);
+            return read_only_copy(db.local_rotations(), {db.frame_count(), db.joint_count(), 4});
           },
           "(frames, joints, 4) float32 unit quaternions (x, y, z, w), relative to each joint's "
-          "parent")
+          "parent (a copy: the database keeps its pose in groups of four joints)")
       .def_property_readonly(
           "channels", [](const Handle& h) { return channels_of(db_of(h)); },
           "the feature schema: one dict per channel (name, kind, bone, times, "

@@ -388,22 +388,24 @@ void dead_blend_update(DeadBlend& blend, const PoseMotion& incoming, float blend
     extrapolate(blend, std::isfinite(halflife) ? std::log(2.0f) / halflife : 0.0f, dt);
   }
   const bool with_velocities = !out_velocities.empty() || !out_angular_velocities.empty();
+  if (!blend.active) {
+    // No blend: the incoming motion as it is, copied whole rather than joint by joint.
+    std::copy_n(incoming.local.begin(), n, out_local.begin());
+    for (size_t i = 0; i < out_velocities.size(); ++i)
+      out_velocities[i] = at_or_zero(incoming.velocities, i);
+    for (size_t i = 0; i < out_angular_velocities.size(); ++i)
+      out_angular_velocities[i] = at_or_zero(incoming.angular_velocities, i);
+    return;
+  }
 #if defined(__SSE2__)
   // The pose alone: four joints at a time, each lane equal to blend_joint's to the bit.
-  if (blend.active && !with_velocities) {
+  if (!with_velocities) {
     blend_pose(blend, incoming, w, out_local);
     return;
   }
 #endif
   for (size_t i = 0; i < n; ++i) {
-    JointBlend out;
-    if (blend.active) {
-      out = blend_joint(blend, i, incoming, w, with_velocities);
-    } else {
-      out.pose = incoming.local[i];
-      out.velocity = at_or_zero(incoming.velocities, i);
-      out.angular_velocity = at_or_zero(incoming.angular_velocities, i);
-    }
+    const JointBlend out = blend_joint(blend, i, incoming, w, with_velocities);
     out_local[i] = out.pose;
     if (!out_velocities.empty()) out_velocities[i] = out.velocity;
     if (!out_angular_velocities.empty()) out_angular_velocities[i] = out.angular_velocity;

@@ -12,25 +12,88 @@ namespace mm {
 
 namespace {
 
+// The rows of a group in the lanes' layout (pose_lanes.hpp), each four floats.
+enum LaneRow : size_t {
+  kRotationW = kPoseLaneRotationW,
+  kRotationX = kPoseLaneRotationX,
+  kRotationY = kPoseLaneRotationY,
+  kRotationZ = kPoseLaneRotationZ,
+  kPositionX = kPoseLanePosition,
+  kVelocityX = kPoseLaneVelocity,
+  kAngularVelocityX = kPoseLaneAngularVelocity,
+};
+
+// One joint of a frame: its local transform (unit scale) and velocities.
+struct JointSample {
+  Transform pose;
+  glm::vec3 velocity, angular_velocity;
+};
+
+JointSample joint_of(const PoseFrameView& f, size_t j) {
+  JointSample s;
+  s.pose.rotation = f.rotations[j];
+  s.pose.translation = f.positions[j];
+  s.velocity = f.velocities[j];
+  s.angular_velocity = f.angular_velocities[j];
+  return s;
+}
+
+JointSample joint_of(std::span<const float> f, size_t j) {
+  const float* g = &f[(j / 4) * kPoseLaneGroupFloats + j % 4];
+  const auto row = [&](size_t r) { return g[4 * r]; };
+  const auto vec = [&](size_t r) { return glm::vec3(row(r), row(r + 1), row(r + 2)); };
+  JointSample s;
+  s.pose.rotation = glm::quat(row(kRotationW), row(kRotationX), row(kRotationY), row(kRotationZ));
+  s.pose.translation = vec(kPositionX);
+  s.velocity = vec(kVelocityX);
+  s.angular_velocity = vec(kAngularVelocityX);
+  return s;
+}
+
 // One joint through transform_hermite itself: the reference, and what the lanes do.
-Transform joint_hermite(const PoseFrameView& a, const PoseFrameView& b, float duration, float t,
-                        size_t j) {
-  Transform ta, tb;
-  ta.rotation = a.rotations[j];
-  ta.translation = a.positions[j];
-  tb.rotation = b.rotations[j];
-  tb.translation = b.positions[j];
-  return transform_hermite(ta, a.velocities[j], a.angular_velocities[j], tb, b.velocities[j],
-                           b.angular_velocities[j], duration, t);
+template <class Frame>
+Transform joint_hermite(const Frame& a, const Frame& b, float duration, float t, size_t j) {
+  const JointSample sa = joint_of(a, j), sb = joint_of(b, j);
+  return transform_hermite(sa.pose, sa.velocity, sa.angular_velocity, sb.pose, sb.velocity,
+                           sb.angular_velocity, duration, t);
 }
 
 #if defined(__SSE2__)
 
 using namespace lanes;
 
-// Joints first .. first + 3 into out.
-void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, float t,
-                size_t first, std::span<Transform> out) {
+// Four joints of one frame, one register per component.
+struct Joints4 {
+  Quat4 rotation;
+  Vec4x3 position, velocity, angular_velocity;
+};
+
+// Joints first .. first + 3 as the frame's per-joint arrays store them (transposed).
+Joints4 load_joints(const PoseFrameView& f, size_t first) {
+  return {load_quats(&f.rotations[first]), load_vec3s(&f.positions[first]),
+          load_vec3s(&f.velocities[first]), load_vec3s(&f.angular_velocities[first])};
+}
+
+// One group of the lanes' layout: the registers as stored.
+Joints4 load_joints(const float* g) {
+  const auto row = [&](size_t r) { return _mm_loadu_ps(g + 4 * r); };
+  const auto vec = [&](size_t r) { return Vec4x3{row(r), row(r + 1), row(r + 2)}; };
+  return {{row(kRotationW), row(kRotationX), row(kRotationY), row(kRotationZ)},
+          vec(kPositionX),
+          vec(kVelocityX),
+          vec(kAngularVelocityX)};
+}
+
+// transform_hermite of four joints, lane by lane in its order of operations. `length` is the
+// rotation curve's length before normalizing (a lane at or below 1e-6 needs the scalar fallback).
+struct Hermite4 {
+  Quat4 rotation;
+  Vec4x3 translation;
+  __m128 length;
+};
+
+[[gnu::always_inline]] inline Hermite4 hermite_x4(const Joints4& a, const Joints4& b,
+                                                  float duration, float t) {
   // transform_hermite's basis and tangent scales, in its order of operations.
   const float t2 = t * t;
   const float t3 = t2 * t;
@@ -43,48 +106,48 @@ void hermite_x4(const PoseFrameView& a, const PoseFrameView& b, float duration, 
   const __m128 half_duration = c(0.5f * duration);
 
   // Translation: h00 a + (h10 d) va + h01 b + (h11 d) vb, summed left to right.
-  const Vec4x3 pa = load_vec3s(&a.positions[first]);
-  const Vec4x3 pb = load_vec3s(&b.positions[first]);
-  const Vec4x3 va = load_vec3s(&a.velocities[first]);
-  const Vec4x3 vb = load_vec3s(&b.velocities[first]);
   const auto curve = [&](__m128 p0, __m128 v0, __m128 p1, __m128 v1) {
     return _mm_add_ps(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(h00, p0), _mm_mul_ps(h10d, v0)), _mm_mul_ps(h01, p1)),
         _mm_mul_ps(h11d, v1));
   };
-  __m128 x = curve(pa.x, va.x, pb.x, vb.x);
-  __m128 y = curve(pa.y, va.y, pb.y, vb.y);
-  __m128 z = curve(pa.z, va.z, pb.z, vb.z);
+  Hermite4 out;
+  out.translation = {curve(a.position.x, a.velocity.x, b.position.x, b.velocity.x),
+                     curve(a.position.y, a.velocity.y, b.position.y, b.velocity.y),
+                     curve(a.position.z, a.velocity.z, b.position.z, b.velocity.z)};
 
   // Rotation: b on a's side, the tangents 0.5 d (0, w) q, the curve, normalized.
-  const Quat4 qa = load_quats(&a.rotations[first]);
-  Quat4 qb = load_quats(&b.rotations[first]);
-  const __m128 flip = _mm_and_ps(_mm_cmplt_ps(dot(qa, qb), _mm_setzero_ps()), c(-0.0f));
-  qb = {_mm_xor_ps(qb.w, flip), _mm_xor_ps(qb.x, flip), _mm_xor_ps(qb.y, flip),
-        _mm_xor_ps(qb.z, flip)};
-  const Vec4x3 wa = load_vec3s(&a.angular_velocities[first]);
-  const Vec4x3 wb = load_vec3s(&b.angular_velocities[first]);
+  const Quat4& qa = a.rotation;
+  const Quat4 qb = negate_where(b.rotation, _mm_cmplt_ps(dot(qa, b.rotation), _mm_setzero_ps()));
+  const Vec4x3& wa = a.angular_velocity;
+  const Vec4x3& wb = b.angular_velocity;
   const Quat4 ta = scale(multiply({_mm_setzero_ps(), wa.x, wa.y, wa.z}, qa), half_duration);
   const Quat4 tb = scale(multiply({_mm_setzero_ps(), wb.x, wb.y, wb.z}, qb), half_duration);
   const Quat4 q = add(add(add(scale(qa, h00), scale(ta, h10)), scale(qb, h01)), scale(tb, h11));
-  const __m128 length = _mm_sqrt_ps(dot(q, q));
-  __m128 rw = _mm_div_ps(q.w, length), rx = _mm_div_ps(q.x, length);
-  __m128 ry = _mm_div_ps(q.y, length), rz = _mm_div_ps(q.z, length);
+  out.length = _mm_sqrt_ps(dot(q, q));
+  out.rotation = {_mm_div_ps(q.w, out.length), _mm_div_ps(q.x, out.length),
+                  _mm_div_ps(q.y, out.length), _mm_div_ps(q.z, out.length)};
+  return out;
+}
 
-  // Back to one Transform per joint: the rotation's four floats, then the translation's three
-  // with the scale's first (1) in the fourth, then the scale's other two.
+// Lanes 0 .. count - 1 into out[first + lane] as Transforms: the rotation's four floats, then the
+// translation's three with the scale's first (1) in the fourth, then the scale's other two. A
+// lane whose curve passes through zero (opposite tangents) takes transform_hermite's fallback.
+template <class Frame>
+void store_joints(const Hermite4& h, const Frame& a, const Frame& b, float duration, float t,
+                  size_t first, size_t count, std::span<Transform> out) {
+  __m128 rx = h.rotation.x, ry = h.rotation.y, rz = h.rotation.z, rw = h.rotation.w;
   _MM_TRANSPOSE4_PS(rx, ry, rz, rw);
-  __m128 ones = c(1.0f);
+  __m128 x = h.translation.x, y = h.translation.y, z = h.translation.z, ones = c(1.0f);
   _MM_TRANSPOSE4_PS(x, y, z, ones);
   const __m128 rotations[4] = {rx, ry, rz, rw};
   const __m128 translations[4] = {x, y, z, ones};
-  const int usable = _mm_movemask_ps(_mm_cmpgt_ps(length, c(1e-6f)));
-  for (size_t i = 0; i < 4; ++i) {
+  const int usable = _mm_movemask_ps(_mm_cmpgt_ps(h.length, c(1e-6f)));
+  for (size_t i = 0; i < count; ++i) {
     Transform& o = out[first + i];
     _mm_storeu_ps(&o.rotation.x, rotations[i]);
     _mm_storeu_ps(&o.translation.x, translations[i]);
     o.scale.y = o.scale.z = 1.0f;
-    // A curve through zero (opposite tangents): transform_hermite's fallback for this joint.
     if (!(usable & (1 << i))) o = joint_hermite(a, b, duration, t, first + i);
   }
 }
@@ -104,12 +167,56 @@ void pose_hermite(const PoseFrameView& a, const PoseFrameView& b, float duration
   if (n >= 4) {
     // Blocks of four; the last one ends at the last joint (it may redo joints of the one before,
     // to the same values), so nothing is read past the frames' arrays.
-    for (size_t first = 0; first < n; first += 4)
-      hermite_x4(a, b, duration, t, std::min(first, n - 4), out);
+    for (size_t block = 0; block < n; block += 4) {
+      const size_t first = std::min(block, n - 4);
+      const Hermite4 h = hermite_x4(load_joints(a, first), load_joints(b, first), duration, t);
+      store_joints(h, a, b, duration, t, first, 4, out);
+    }
     return;
   }
 #endif
   for (size_t j = 0; j < n; ++j) out[j] = joint_hermite(a, b, duration, t, j);
+}
+
+void pose_to_lanes(const PoseFrameView& frame, std::span<float> out) {
+  const size_t n = frame.rotations.size();
+  MM_ASSERT(frame.positions.size() == n && frame.velocities.size() == n &&
+            frame.angular_velocities.size() == n && out.size() == pose_lane_floats(n));
+  for (size_t j = 0; j < pose_lane_groups(n) * 4; ++j) {
+    // Padding joints: at rest.
+    const bool real = j < n;
+    const glm::quat q = real ? frame.rotations[j] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+    const glm::vec3 p = real ? frame.positions[j] : glm::vec3(0.0f);
+    const glm::vec3 v = real ? frame.velocities[j] : glm::vec3(0.0f);
+    const glm::vec3 w = real ? frame.angular_velocities[j] : glm::vec3(0.0f);
+    float* g = &out[(j / 4) * kPoseLaneGroupFloats + j % 4];
+    const auto put = [&](size_t row, float value) { g[4 * row] = value; };
+    put(kRotationW, q.w);
+    put(kRotationX, q.x);
+    put(kRotationY, q.y);
+    put(kRotationZ, q.z);
+    for (int k = 0; k < 3; ++k) {
+      put(kPositionX + static_cast<size_t>(k), p[k]);
+      put(kVelocityX + static_cast<size_t>(k), v[k]);
+      put(kAngularVelocityX + static_cast<size_t>(k), w[k]);
+    }
+  }
+}
+
+void pose_hermite(std::span<const float> a, std::span<const float> b, float duration, float t,
+                  std::span<Transform> out) {
+  const size_t n = out.size();
+  MM_ASSERT(a.size() == pose_lane_floats(n) && b.size() == pose_lane_floats(n));
+#if defined(__SSE2__)
+  for (size_t group = 0; group < pose_lane_groups(n); ++group) {
+    const size_t first = group * 4;
+    const size_t at = group * kPoseLaneGroupFloats;
+    const Hermite4 h = hermite_x4(load_joints(&a[at]), load_joints(&b[at]), duration, t);
+    store_joints(h, a, b, duration, t, first, std::min<size_t>(4, n - first), out);
+  }
+#else
+  for (size_t j = 0; j < n; ++j) out[j] = joint_hermite(a, b, duration, t, j);
+#endif
 }
 
 }  // namespace mm

@@ -302,11 +302,10 @@ TEST(DatabaseFile, TheLoadedPerFrameArraysShareOneAllocation) {
     const auto run = [](auto span) {
       return Run{reinterpret_cast<const std::byte*>(span.data()), span.size_bytes()};
     };
-    std::vector<Run> runs = {run(db->local_rotations()),  run(db->local_positions()),
-                             run(db->local_velocities()), run(db->local_angular_velocities()),
-                             run(db->features()),         run(db->feature_offset()),
-                             run(db->feature_scale()),    run(db->frame_clip()),
-                             run(db->contacts()),         run(db->searchable())};
+    std::vector<Run> runs = {run(db->pose_lanes()),     run(db->features()),
+                             run(db->feature_offset()), run(db->feature_scale()),
+                             run(db->frame_clip()),     run(db->contacts()),
+                             run(db->searchable())};
     std::sort(runs.begin(), runs.end(),
               [](const Run& a, const Run& b) { return a.begin < b.begin; });
     for (size_t i = 0; i < runs.size(); ++i) {
@@ -315,6 +314,49 @@ TEST(DatabaseFile, TheLoadedPerFrameArraysShareOneAllocation) {
       const std::byte* previous_end = runs[i - 1].begin + runs[i - 1].bytes;
       EXPECT_GE(runs[i].begin, previous_end) << i;
       EXPECT_LT(runs[i].begin - previous_end, 64) << i;  // no more than the alignment's padding
+    }
+  }
+}
+
+TEST(DatabaseFile, ThePoseIsHeldInGroupsOfFourJoints) {
+  // Loaded or created, frame f's group g, row r, lane l is component r of joint 4 g + l of frame
+  // f, read here from the per-joint arrays it was made from (a lane past the last joint: a joint
+  // at rest), and nothing else is kept of the pose: one frame is 13 rows of 4 floats per group.
+  const DatabaseContents contents = make_contents(300, 7);
+  Result<Database> loaded = deserialize_database(serialize_database(contents), "db");
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  const Database created = Database::create(contents).value();
+  for (const Database* db : std::array<const Database*, 2>{&*loaded, &created}) {
+    const size_t joints = static_cast<size_t>(db->joint_count());
+    const size_t groups = (joints + 3) / 4;
+    ASSERT_EQ(db->pose_lanes().size(), static_cast<size_t>(db->frame_count()) * 52 * groups);
+    for (int f = 0; f < db->frame_count(); ++f) {
+      const std::span<const float> lanes = db->frame_pose_lanes(f);
+      for (size_t j = 0; j < groups * 4; ++j) {
+        const size_t k = static_cast<size_t>(f) * joints + j;
+        const bool real = j < joints;
+        const glm::quat q = real ? contents.local_rotations[k] : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
+        const glm::vec3 p = real ? contents.local_positions[k] : glm::vec3(0.0f);
+        const glm::vec3 v = real ? contents.local_velocities[k] : glm::vec3(0.0f);
+        const glm::vec3 w = real ? contents.local_angular_velocities[k] : glm::vec3(0.0f);
+        const float expected[13] = {q.w, q.x, q.y, q.z, p.x, p.y, p.z,
+                                    v.x, v.y, v.z, w.x, w.y, w.z};
+        for (size_t r = 0; r < 13; ++r) {
+          ASSERT_EQ(lanes[(j / 4) * 52 + 4 * r + j % 4], expected[r])
+              << "frame " << f << " joint " << j << " row " << r;
+        }
+        if (!real) continue;
+        // The per-joint readers give the same values.
+        const int joint = static_cast<int>(j);
+        EXPECT_EQ(db->local_rotation(f, joint), q);
+        EXPECT_EQ(db->local_position(f, joint), p);
+        EXPECT_EQ(db->local_velocity(f, joint), v);
+        EXPECT_EQ(db->local_angular_velocity(f, joint), w);
+        EXPECT_EQ(db->local_rotations()[k], q);
+        EXPECT_EQ(db->local_positions()[k], p);
+        EXPECT_EQ(db->local_velocities()[k], v);
+        EXPECT_EQ(db->local_angular_velocities()[k], w);
+      }
     }
   }
 }
@@ -714,9 +756,10 @@ TEST(DatabaseFile, RotationsRoundTripBitForBitThroughTheirEscapes) {
   Result<Database> loaded = deserialize_database(bytes, "fixture");
   ASSERT_TRUE(loaded.ok()) << loaded.message();
   ASSERT_EQ(loaded->local_rotations().size(), db.local_rotations.size());
-  EXPECT_EQ(std::memcmp(loaded->local_rotations().data(), db.local_rotations.data(),
-                        db.local_rotations.size() * sizeof(glm::quat)),
-            0);
+  for (size_t k = 0; k < db.local_rotations.size(); ++k) {
+    const glm::quat got = loaded->local_rotations()[k];
+    EXPECT_EQ(std::memcmp(&got, &db.local_rotations[k], sizeof(glm::quat)), 0) << k;
+  }
   test::expect_same_database(db, *loaded);
 
   // The exceptions are records {sample, value, 0} in sample order, one per escape code.

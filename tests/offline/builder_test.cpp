@@ -339,17 +339,13 @@ TEST(BuilderThreads, OutputDoesNotDependOnTheThreadCount) {
       EXPECT_EQ(a.clips[c].start, b.clips[c].start);
       EXPECT_EQ(a.clips[c].tags, b.clips[c].tags);
     }
-    EXPECT_EQ(0, std::memcmp(a.local_velocities.data(), b.local_velocities.data(),
-                             a.local_velocities.size() * sizeof(glm::vec3)));
-    EXPECT_EQ(0, std::memcmp(a.local_angular_velocities.data(), b.local_angular_velocities.data(),
-                             a.local_angular_velocities.size() * sizeof(glm::vec3)));
+    // The pose, bit for bit: every frame's lanes (the four quantities of every joint).
+    ASSERT_EQ(dbs[0].pose_lanes().size(), dbs[i].pose_lanes().size());
+    EXPECT_EQ(0, std::memcmp(dbs[0].pose_lanes().data(), dbs[i].pose_lanes().data(),
+                             dbs[0].pose_lanes().size_bytes()));
     EXPECT_TRUE(std::ranges::equal(a.searchable, b.searchable));
     EXPECT_TRUE(std::ranges::equal(a.feature_offset, b.feature_offset));
     EXPECT_EQ(0, std::memcmp(a.features.data(), b.features.data(), a.features.size() * 4));
-    EXPECT_EQ(0, std::memcmp(a.local_positions.data(), b.local_positions.data(),
-                             a.local_positions.size() * sizeof(glm::vec3)));
-    EXPECT_EQ(0, std::memcmp(a.local_rotations.data(), b.local_rotations.data(),
-                             a.local_rotations.size() * sizeof(glm::quat)));
     EXPECT_TRUE(std::ranges::equal(a.contacts, b.contacts));
     EXPECT_TRUE(std::ranges::equal(a.feature_scale, b.feature_scale));
     EXPECT_TRUE(std::ranges::equal(a.tag_names, b.tag_names));

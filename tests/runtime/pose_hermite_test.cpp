@@ -60,5 +60,41 @@ TEST(PoseHermite, EveryJointEqualsTransformHermiteToTheBit) {
   }
 }
 
+// The same from the lanes' layout (pose_to_lanes): every joint, including those of a last group
+// that padding completes, equals transform_hermite's result to the bit.
+TEST(PoseHermite, FromTheLanesLayoutEqualsTransformHermiteToTheBit) {
+  const float duration = 1.0f / 30.0f;
+  for (const size_t joints : {1u, 3u, 4u, 5u, 8u, 23u}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Frame a = random_frame(joints);
+      Frame b = random_frame(joints);
+      b.rotations[0] = -b.rotations[0];
+      std::vector<float> la(pose_lane_floats(joints)), lb(pose_lane_floats(joints));
+      pose_to_lanes(a.view(), la);
+      pose_to_lanes(b.view(), lb);
+      for (const float t : {0.0f, 0.25f, 0.5f, 0.731f, 1.0f}) {
+        // One joint more than the pose, to see that nothing is written past it.
+        std::vector<Transform> out(joints + 1);
+        out[joints].translation = glm::vec3(7.0f);
+        pose_hermite(la, lb, duration, t, std::span(out).first(joints));
+        for (size_t j = 0; j < joints; ++j) {
+          Transform ta, tb;
+          ta.rotation = a.rotations[j];
+          ta.translation = a.positions[j];
+          tb.rotation = b.rotations[j];
+          tb.translation = b.positions[j];
+          const Transform expected =
+              transform_hermite(ta, a.velocities[j], a.angular_velocities[j], tb, b.velocities[j],
+                                b.angular_velocities[j], duration, t);
+          EXPECT_EQ(out[j].rotation, expected.rotation) << joints << " joints, joint " << j;
+          EXPECT_EQ(out[j].translation, expected.translation) << joints << " joints, joint " << j;
+          EXPECT_EQ(out[j].scale, glm::vec3(1.0f));
+        }
+        EXPECT_EQ(out[joints].translation, glm::vec3(7.0f)) << joints << " joints";
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mm

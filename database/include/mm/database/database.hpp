@@ -14,6 +14,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -21,6 +22,7 @@
 
 #include "mm/database/features.hpp"
 #include "mm/database/joint_roles.hpp"
+#include "mm/runtime/pose_lanes.hpp"
 #include "mm/runtime/result.hpp"
 #include "mm/runtime/skeleton.hpp"
 
@@ -79,6 +81,50 @@ struct DatabaseContents {
   int feature_dims() const { return schema.dims(); }
 };
 
+// One per-frame, per-joint quantity of a pose (local positions, rotations, velocities or angular
+// velocities), read by k = frame * joints + joint whichever layout holds it: a plain array (a
+// DatabaseContents, a build being filled) or a Database's frames in the lanes' layout
+// (pose_lanes.hpp). Reading by k divides by the joint count; a per-frame reader of a Database
+// uses its (frame, joint) accessors instead.
+template <class T>
+class JointValues {
+ public:
+  JointValues() = default;
+  JointValues(std::span<const T> values)  // NOLINT: implicit, as a span from a vector
+      : values_(values.data()), size_(values.size()) {}
+  JointValues(const std::vector<T>& values)  // NOLINT
+      : JointValues(std::span<const T>(values)) {}
+  // Row `row` of frames in the lanes' layout of `joints` joints (whole frames).
+  JointValues(std::span<const float> lanes, size_t joints, size_t row)
+      : lanes_(lanes.data()),
+        size_(joints == 0 ? 0 : lanes.size() / pose_lane_floats(joints) * joints),
+        joints_(joints),
+        row_(row) {}
+
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  // The values as one array when a plain array holds them, else empty.
+  std::span<const T> plain() const {
+    return values_ != nullptr ? std::span<const T>(values_, size_) : std::span<const T>();
+  }
+  T operator[](size_t k) const {
+    if (values_ != nullptr) return values_[k];
+    const float* frame = lanes_ + k / joints_ * pose_lane_floats(joints_);
+    if constexpr (std::is_same_v<T, glm::quat>) {
+      return pose_lane_rotation(frame, k % joints_);
+    } else {
+      return pose_lane_vec3(frame, k % joints_, row_);
+    }
+  }
+
+ private:
+  const T* values_ = nullptr;
+  const float* lanes_ = nullptr;
+  size_t size_ = 0;
+  size_t joints_ = 0;
+  size_t row_ = 0;
+};
+
 class Database;
 
 // A read-only view of a database, a Database or a DatabaseContents alike (it converts from
@@ -92,10 +138,10 @@ struct DatabaseView {
   const JointRoleIndices& roles;
   float frame_time;
   int frame_count;
-  std::span<const glm::vec3> local_positions;
-  std::span<const glm::quat> local_rotations;
-  std::span<const glm::vec3> local_velocities;
-  std::span<const glm::vec3> local_angular_velocities;
+  JointValues<glm::vec3> local_positions;
+  JointValues<glm::quat> local_rotations;
+  JointValues<glm::vec3> local_velocities;
+  JointValues<glm::vec3> local_angular_velocities;
   std::span<const uint8_t> contacts;
   std::span<const ClipRange> clips;
   std::span<const std::string> tag_names;
@@ -118,7 +164,8 @@ struct DatabaseView {
 
 // The per-frame arrays of a database being made, writable, with what writing them reads: what
 // the build side's writers (a range's features, the idle clip) take, over a DatabaseContents'
-// vectors (it converts) or over the builder's new database.
+// vectors (it converts) or over the builder's new database (its pose in per-joint arrays until
+// it is laid out in the database's lanes).
 struct DatabaseFill {
   DatabaseFill(DatabaseContents& db);  // NOLINT: implicit, as a span from a vector
   DatabaseFill(const DatabaseView& read, std::span<glm::vec3> local_positions,
@@ -168,11 +215,44 @@ class Database {
   int frame_count() const { return frame_count_; }
   int joint_count() const { return skeleton_.joint_count(); }
 
-  // DatabaseContents' arrays of the same names.
-  std::span<const glm::vec3> local_positions() const { return local_positions_; }
-  std::span<const glm::quat> local_rotations() const { return local_rotations_; }
-  std::span<const glm::vec3> local_velocities() const { return local_velocities_; }
-  std::span<const glm::vec3> local_angular_velocities() const { return local_angular_velocities_; }
+  // The pose: every frame's local rotations, positions, velocities and angular velocities in the
+  // lanes' layout of pose_lanes.hpp (pose_lane_floats(joint_count()) floats a frame), the one
+  // copy the database holds, so that playback loads four joints' components without
+  // transposing them. The file stores them per joint; loading lays them out.
+  std::span<const float> pose_lanes() const { return pose_lanes_; }
+  std::span<const float> frame_pose_lanes(int frame) const {
+    const size_t floats = pose_lane_floats(static_cast<size_t>(joint_count()));
+    return pose_lanes_.subspan(static_cast<size_t>(frame) * floats, floats);
+  }
+  // One joint of one frame.
+  glm::vec3 local_position(int frame, int joint) const {
+    return pose_lane_vec3(frame_pose_lanes(frame).data(), static_cast<size_t>(joint),
+                          kPoseLanePosition);
+  }
+  glm::quat local_rotation(int frame, int joint) const {
+    return pose_lane_rotation(frame_pose_lanes(frame).data(), static_cast<size_t>(joint));
+  }
+  glm::vec3 local_velocity(int frame, int joint) const {
+    return pose_lane_vec3(frame_pose_lanes(frame).data(), static_cast<size_t>(joint),
+                          kPoseLaneVelocity);
+  }
+  glm::vec3 local_angular_velocity(int frame, int joint) const {
+    return pose_lane_vec3(frame_pose_lanes(frame).data(), static_cast<size_t>(joint),
+                          kPoseLaneAngularVelocity);
+  }
+  // DatabaseContents' arrays of the same names, read by k = frame * joints + joint.
+  JointValues<glm::vec3> local_positions() const {
+    return pose_values<glm::vec3>(kPoseLanePosition);
+  }
+  JointValues<glm::quat> local_rotations() const {
+    return pose_values<glm::quat>(kPoseLaneRotationW);
+  }
+  JointValues<glm::vec3> local_velocities() const {
+    return pose_values<glm::vec3>(kPoseLaneVelocity);
+  }
+  JointValues<glm::vec3> local_angular_velocities() const {
+    return pose_values<glm::vec3>(kPoseLaneAngularVelocity);
+  }
   std::span<const uint8_t> contacts() const { return contacts_; }
   std::span<const ClipRange> clips() const { return clips_; }
   std::span<const std::string> tag_names() const { return tag_names_; }
@@ -207,6 +287,13 @@ class Database {
   void keep_frames(size_t frames);
   // Fills frame_clip from the clips (which tile the frames).
   void derive_frame_clip();
+  // The pose given per joint as DatabaseContents holds it (each span: every frame's joints, frame
+  // after frame), laid out in pose_lanes_.
+  void lay_out_pose(const PoseFrameView& pose);
+  template <class T>
+  JointValues<T> pose_values(size_t row) const {
+    return JointValues<T>(pose_lanes_, static_cast<size_t>(joint_count()), row);
+  }
 
   struct FreeBlock {
     void operator()(std::byte* block) const;
@@ -221,10 +308,7 @@ class Database {
   std::vector<std::string> style_names_;
   FeatureSchema schema_;
   std::unique_ptr<std::byte[], FreeBlock> block_;
-  std::span<glm::vec3> local_positions_;
-  std::span<glm::quat> local_rotations_;
-  std::span<glm::vec3> local_velocities_;
-  std::span<glm::vec3> local_angular_velocities_;
+  std::span<float> pose_lanes_;
   std::span<uint8_t> contacts_;
   std::span<float> features_;
   std::span<float> feature_offset_;

@@ -17,18 +17,19 @@ namespace mm {
 // frames differ, else the two-point interpolation `method`.
 inline Transform sample_database_joint(const Database& db, int frame0, int frame1, float weight,
                                        size_t joint, bool cubic, InterpolationMethod method) {
-  const size_t joints = static_cast<size_t>(db.joint_count());
-  const size_t k0 = static_cast<size_t>(frame0) * joints + joint;
-  const size_t k1 = static_cast<size_t>(frame1) * joints + joint;
+  const float* f0 = db.frame_pose_lanes(frame0).data();
+  const float* f1 = db.frame_pose_lanes(frame1).data();
   Transform t0, t1;
-  t0.rotation = db.local_rotations()[k0];
-  t0.translation = db.local_positions()[k0];
-  t1.rotation = db.local_rotations()[k1];
-  t1.translation = db.local_positions()[k1];
+  t0.rotation = pose_lane_rotation(f0, joint);
+  t0.translation = pose_lane_vec3(f0, joint, kPoseLanePosition);
+  t1.rotation = pose_lane_rotation(f1, joint);
+  t1.translation = pose_lane_vec3(f1, joint, kPoseLanePosition);
   if (cubic && frame1 != frame0) {
-    return transform_hermite(t0, db.local_velocities()[k0], db.local_angular_velocities()[k0], t1,
-                             db.local_velocities()[k1], db.local_angular_velocities()[k1],
-                             db.frame_time(), weight);
+    return transform_hermite(t0, pose_lane_vec3(f0, joint, kPoseLaneVelocity),
+                             pose_lane_vec3(f0, joint, kPoseLaneAngularVelocity), t1,
+                             pose_lane_vec3(f1, joint, kPoseLaneVelocity),
+                             pose_lane_vec3(f1, joint, kPoseLaneAngularVelocity), db.frame_time(),
+                             weight);
   }
   return interpolate(t0, t1, weight, method);
 }
@@ -43,13 +44,8 @@ inline void sample_database_pose(const Database& db, int frame0, int frame1, flo
     }
     return;
   }
-  const auto frame = [&](int f) {
-    const size_t k = static_cast<size_t>(f) * joints;
-    return PoseFrameView{
-        db.local_rotations().subspan(k, joints), db.local_positions().subspan(k, joints),
-        db.local_velocities().subspan(k, joints), db.local_angular_velocities().subspan(k, joints)};
-  };
-  pose_hermite(frame(frame0), frame(frame1), db.frame_time(), weight, out.first(joints));
+  pose_hermite(db.frame_pose_lanes(frame0), db.frame_pose_lanes(frame1), db.frame_time(), weight,
+               out.first(joints));
 }
 
 }  // namespace mm

@@ -25,10 +25,7 @@ class DatabaseAssembly {
     std::vector<std::string>& tag_names;
     std::vector<std::string>& style_names;
     FeatureSchema& schema;
-    std::span<glm::vec3>& local_positions;
-    std::span<glm::quat>& local_rotations;
-    std::span<glm::vec3>& local_velocities;
-    std::span<glm::vec3>& local_angular_velocities;
+    std::span<float>& pose_lanes;  // pose_lanes.hpp's layout, frame after frame
     std::span<uint8_t>& contacts;
     std::span<float>& features;
     std::span<float>& feature_offset;
@@ -41,23 +38,9 @@ class DatabaseAssembly {
   // A database with nothing in it, to fill.
   static Database empty() { return Database(); }
   static Parts parts(Database& db) {
-    return {db.skeleton_,
-            db.roles_,
-            db.frame_time_,
-            db.frame_count_,
-            db.clips_,
-            db.tag_names_,
-            db.style_names_,
-            db.schema_,
-            db.local_positions_,
-            db.local_rotations_,
-            db.local_velocities_,
-            db.local_angular_velocities_,
-            db.contacts_,
-            db.features_,
-            db.feature_offset_,
-            db.feature_scale_,
-            db.searchable_};
+    return {db.skeleton_,  db.roles_,          db.frame_time_,    db.frame_count_, db.clips_,
+            db.tag_names_, db.style_names_,    db.schema_,        db.pose_lanes_,  db.contacts_,
+            db.features_,  db.feature_offset_, db.feature_scale_, db.searchable_};
   }
   // The per-frame arrays for `frames` frames of the skeleton's joints and the schema's columns,
   // their values unwritten: the caller writes every one.
@@ -70,10 +53,20 @@ class DatabaseAssembly {
   static void keep_frames(Database& db, size_t frames) { db.keep_frames(frames); }
   // frame_clip from the clips, which must tile the frames.
   static void derive_frame_clip(Database& db) { db.derive_frame_clip(); }
-  // The per-frame arrays, writable, for the build side's writers.
-  static DatabaseFill fill(Database& db) {
-    return DatabaseFill(db, db.local_positions_, db.local_rotations_, db.local_velocities_,
-                        db.local_angular_velocities_, db.contacts_, db.features_, db.searchable_);
+  // The pose, per joint as the build side writes it (`pose`: one value per joint of each of the
+  // database's frames), laid out in the database's lanes.
+  static void lay_out_pose(Database& db, const PoseFrameView& pose) { db.lay_out_pose(pose); }
+  // The per-frame arrays, writable, for the build side's writers: the pose in `pose`'s per-joint
+  // arrays (laid out by lay_out_pose when they are final), the rest in the database.
+  struct WritablePose {
+    std::span<glm::vec3> positions;
+    std::span<glm::quat> rotations;
+    std::span<glm::vec3> velocities;
+    std::span<glm::vec3> angular_velocities;
+  };
+  static DatabaseFill fill(Database& db, const WritablePose& pose) {
+    return DatabaseFill(db, pose.positions, pose.rotations, pose.velocities,
+                        pose.angular_velocities, db.contacts_, db.features_, db.searchable_);
   }
 };
 
