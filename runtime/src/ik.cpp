@@ -160,18 +160,20 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   out.knee_bend = knee_bend;
   out.reached = target_distance >= min_reach && target_distance <= max_reach;
 
-  // Where the three steps below end, written down at once: the knee lies at the hip's new
-  // interior angle from the direction, on the pole's side of it, and the bend axis (ac x ab, whose
-  // sign the bends keep) is direction x that side. The hip's turn takes the knee's direction and
-  // the bend axis to those. Taken where the limb has a plane, the knee leaves the line and the
-  // pole leaves the direction; the steps themselves handle the degenerate cases.
+  // Where the three steps below end, written down at once: the knee bent, the hip-to-ankle line
+  // lies along the direction and the bend axis (ac x ab, whose sign the bends keep: both are
+  // about it and keep the triangle's angles inside (0, pi)) is direction x the pole's side of it,
+  // so the knee is on that side. The hip's turn takes the bent chain's hip-to-ankle line and the
+  // bend axis to those, so the ankle lands on the line to the target whatever the rounding of the
+  // bend (as the swing of step 2 makes it). Taken where the limb has a plane, the knee leaves the
+  // line and the pole leaves the direction; the steps themselves handle the degenerate cases.
   const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
   const float pole_across_length = glm::length(pole_across);
   if (has_plane && hip_angle.sin > 1e-6f && pole_across_length > 1e-6f) {
     const glm::vec3 side = pole_across / pole_across_length;
-    out.hip_turn =
-        turn_between_frames(ab / upper, bend_axis, hip_angle.cos * direction + hip_angle.sin * side,
-                            glm::cross(direction, side));
+    const glm::vec3 bent_ankle = ab + rotate(knee_bend, c - b);
+    out.hip_turn = turn_between_frames(glm::normalize(bent_ankle), bend_axis, direction,
+                                       glm::cross(direction, side));
     return true;
   }
 
