@@ -23,6 +23,14 @@ function(mm_library name)
                                                $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(mm_${name} PRIVATE $<BUILD_INTERFACE:mm_warnings>)
   mm_shared_object_ready(mm_${name})
+  # The game-facing libraries never read errno after a math function (only after system calls,
+  # which -fno-math-errno does not touch). With errno kept, GCC calls the library for every
+  # sqrt/sqrtf whose argument it cannot prove non-negative, behind a branch, and does not merge
+  # two square roots of one value; without it they are the sqrtss/sqrtsd instruction, which is
+  # IEEE-exact, the same bits as the library's.
+  if(arg_COMPONENT STREQUAL "game")
+    target_compile_options(mm_${name} PRIVATE -fno-math-errno)
+  endif()
   install(TARGETS mm_${name} EXPORT ${arg_EXPORT} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           COMPONENT ${arg_COMPONENT})
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}

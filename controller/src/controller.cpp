@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "mm/database/sampling.hpp"
+#include "mm/runtime/atan2_polynomial.hpp"
 #include "mm/runtime/constraints.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
@@ -162,17 +163,25 @@ float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::v
   const glm::vec3 a = ankle - toe, h = hip - toe;
   const float foot = glm::length(a), to_hip = glm::length(h);
   const glm::vec3 normal = glm::cross(a, h);
-  if (foot < 1e-4f || to_hip < 1e-4f || glm::length(normal) < 1e-6f * foot * to_hip) return 0.0f;
-  axis = glm::normalize(normal);
+  const float normal_length = glm::length(normal);
+  if (foot < 1e-4f || to_hip < 1e-4f || normal_length < 1e-6f * foot * to_hip) return 0.0f;
+  axis = normal / normal_length;
   if (glm::length(ankle - hip) <= distance) return 0.0f;
-  const float angle = std::acos(std::clamp(glm::dot(a, h) / (foot * to_hip), -1.0f, 1.0f));
-  // The angle between the two lines at which the ankle is `distance` from the hip (law of
-  // cosines); pointing straight at the hip where even that falls short.
-  const float wanted = std::acos(std::clamp(
-      (foot * foot + to_hip * to_hip - distance * distance) / (2.0f * foot * to_hip), -1.0f, 1.0f));
-  // A turn that would lower the heel (the hip below the foot) is no heel rise.
-  if ((glm::angleAxis(angle - wanted, axis) * a).y <= a.y) return 0.0f;
-  return std::clamp(angle - wanted, 0.0f, kMaxHeelRise);
+  // The angle between the two lines now, as its cosine and sine (dot and cross products), and
+  // the one at which the ankle is `distance` from the hip (law of cosines; pointing straight at
+  // the hip where even that falls short). Only their difference is an angle: one atan2 of the
+  // difference formulas instead of two arccosines.
+  const float scale = 1.0f / (foot * to_hip);
+  const float now_cos = glm::dot(a, h) * scale, now_sin = normal_length * scale;
+  const float wanted_cos = std::clamp(
+      (foot * foot + to_hip * to_hip - distance * distance) * (0.5f * scale), -1.0f, 1.0f);
+  const float wanted_sin = std::sqrt(1.0f - wanted_cos * wanted_cos);
+  const float turn_cos = now_cos * wanted_cos + now_sin * wanted_sin;
+  const float turn_sin = now_sin * wanted_cos - now_cos * wanted_sin;
+  // A turn that would lower the heel (the hip below the foot) is no heel rise: the axis is
+  // perpendicular to a, so a turns to a cos + (axis x a) sin.
+  if (a.y * turn_cos + glm::cross(axis, a).y * turn_sin <= a.y) return 0.0f;
+  return std::clamp(atan2_polynomial(turn_sin, turn_cos), 0.0f, kMaxHeelRise);
 }
 
 // The root (joint 0) and the body (joints 1..) of a pose and its velocities: transitions treat
@@ -1393,7 +1402,7 @@ float Controller::foot_heading(int side) const {
   const std::vector<int>& leg = leg_joints_[side];
   const glm::vec3 along = globals_[static_cast<size_t>(leg[3])].translation -
                           globals_[static_cast<size_t>(leg[2])].translation;
-  return std::atan2(along.x, along.z);
+  return atan2_polynomial(along.x, along.z);
 }
 
 // Two-bone IK of one leg toward a toe target, the foot turned to its held heading, then the

@@ -85,6 +85,15 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
   return v + ((uv * q.w) + uuv) * 2.0f;
 }
 
+// The rotation that takes the orthonormal pair (u, n) to the orthonormal pair (u2, n2) (and so
+// u x n to u2 x n2): the product of the two frames' matrices, one transposed, as a quaternion.
+glm::quat turn_between_frames(const glm::vec3& u, const glm::vec3& n, const glm::vec3& u2,
+                              const glm::vec3& n2) {
+  const glm::mat3 from(u, n, glm::cross(u, n));
+  const glm::mat3 to(u2, n2, glm::cross(u2, n2));
+  return glm::quat_cast(to * glm::transpose(from));
+}
+
 // The solve as two turns: the hip's (bend, swing, twist: every joint of the chain turns by it)
 // and the knee's bend (about the same axis as the hip's bend, so the two commute and the knee's
 // new local rotation is its bend seen from the hip, whatever the swing and the twist).
@@ -135,8 +144,9 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   glm::vec3 bend_axis = glm::cross(ac, ab);
   const float bend_axis_length = glm::length(bend_axis);
   Angle hip_angle_now;
-  if (bend_axis_length > 1e-6f * upper * ac_length && ac_length > 1e-6f * total) {
-    bend_axis = glm::normalize(bend_axis);
+  const bool has_plane = bend_axis_length > 1e-6f * upper * ac_length && ac_length > 1e-6f * total;
+  if (has_plane) {
+    bend_axis /= bend_axis_length;
     // angle_between(ac, ab), its cross product's length already known.
     hip_angle_now = angle_from(glm::dot(ac, ab), bend_axis_length);
   } else {
@@ -144,10 +154,30 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
     bend_axis = glm::normalize(glm::cross(ab, perpendicular(ab, in.pole)));
   }
   const Angle knee_angle_now = angle_between(a - b, c - b);
-  const glm::quat hip_bend =
-      rotation_about(triangle_angle(upper, reach, lower), hip_angle_now, bend_axis);
+  const Angle hip_angle = triangle_angle(upper, reach, lower);
   const glm::quat knee_bend =
       rotation_about(triangle_angle(upper, lower, reach), knee_angle_now, bend_axis);
+  out.knee_bend = knee_bend;
+  out.reached = target_distance >= min_reach && target_distance <= max_reach;
+
+  // Where the three steps below end, written down at once: the knee bent, the hip-to-ankle line
+  // lies along the direction and the bend axis (ac x ab, whose sign the bends keep: both are
+  // about it and keep the triangle's angles inside (0, pi)) is direction x the pole's side of it,
+  // so the knee is on that side. The hip's turn takes the bent chain's hip-to-ankle line and the
+  // bend axis to those, so the ankle lands on the line to the target whatever the rounding of the
+  // bend (as the swing of step 2 makes it). Taken where the limb has a plane, the knee leaves the
+  // line and the pole leaves the direction; the steps themselves handle the degenerate cases.
+  const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
+  const float pole_across_length = glm::length(pole_across);
+  if (has_plane && hip_angle.sin > 1e-6f && pole_across_length > 1e-6f) {
+    const glm::vec3 side = pole_across / pole_across_length;
+    const glm::vec3 bent_ankle = ab + rotate(knee_bend, c - b);
+    out.hip_turn = turn_between_frames(glm::normalize(bent_ankle), bend_axis, direction,
+                                       glm::cross(direction, side));
+    return true;
+  }
+
+  const glm::quat hip_bend = rotation_about(hip_angle, hip_angle_now, bend_axis);
 
   const glm::vec3 knee = rotate(hip_bend, ab);  // from the hip
   const glm::vec3 ankle = knee + rotate(knee_bend, rotate(hip_bend, c - b));
@@ -159,8 +189,7 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 knee_offset = rotate(swing, knee);
   glm::quat turn = swing;
   const glm::vec3 knee_across = knee_offset - glm::dot(knee_offset, direction) * direction;
-  const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
-  if (glm::length(knee_across) > 1e-6f * upper && glm::length(pole_across) > 1e-6f) {
+  if (glm::length(knee_across) > 1e-6f * upper && pole_across_length > 1e-6f) {
     // The signed angle from the knee's side to the pole's about the direction, its sine the
     // cross product's part along the direction.
     const float cosine = glm::dot(knee_across, pole_across);
@@ -170,8 +199,6 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
       turn = mul(rotation_about(Angle{cosine / r, sine / r}, Angle{}, direction), swing);
   }
   out.hip_turn = mul(turn, hip_bend);
-  out.knee_bend = knee_bend;
-  out.reached = target_distance >= min_reach && target_distance <= max_reach;
   return true;
 }
 
