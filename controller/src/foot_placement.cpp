@@ -75,6 +75,12 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     Foot& foot = feet_[side];
     follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
     follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
+    // The ground under heel and toe now is a floor the spring never lags under. Across a step
+    // the look-ahead sees the tread first, but a toe swinging over a tread's front corner toward
+    // its side (circling onto stairs, the look-ahead already beside them) reaches the tread the
+    // update it is over it, and the spring left it inside the tread's side (up to 3.9 cm).
+    foot.ground.heel = std::max(foot.ground.heel, probe_grounds_[slot(side, kHeel)].y);
+    foot.ground.toe = std::max(foot.ground.toe, probe_grounds_[slot(side, kToe)].y);
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.

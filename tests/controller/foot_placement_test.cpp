@@ -202,6 +202,36 @@ TEST(FootPlacement, AToeSwingingAcrossTheBodysPathRisesBeforeTheRiserItHeadsFor)
   EXPECT_GT(p.ground(0).toe, 0.15f);
 }
 
+// Circling onto stairs, a toe swung over a tread's front corner toward the stairs' side: its
+// look-ahead and the body's were already beside the stairs, and the toe was over the tread
+// before anything saw it (the first course, circle from x = 7 at 1/60 s: 3.9 cm inside the
+// second tread). The ground under heel and toe now is a floor the spring never lags under.
+TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
+  AnalyticWorld world;
+  // A tread 0.17 m high for x < 1 and z > 0.3: its front face at z = 0.3, its side at x = 1.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 1.3f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(0.85f, 0.05f, 0.0f),
+                                   standing_leg(0.5f, -0.5f, 0.0f)};
+  legs[0].planted = legs[0].near_ground = false;
+  p.reset(0.0f);
+  const FootPlacementSettings settings;
+  const glm::vec3 velocity(1.6f, 0.0f, 1.6f);  // diagonally across the tread's corner
+  int over = 0;
+  for (int f = 0; f < 10; ++f) {
+    legs[0].toe += velocity * kDt;
+    legs[0].ankle += velocity * kDt;
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, velocity, kDt);
+    const float under_toe = static_cast<float>(world.surface(legs[0].toe.x, legs[0].toe.z));
+    const float under_heel = static_cast<float>(world.surface(legs[0].ankle.x, legs[0].ankle.z));
+    over += under_toe > 0.0f;
+    EXPECT_GE(p.ground(0).toe, under_toe) << f;
+    EXPECT_GE(p.ground(0).heel, under_heel) << f;
+  }
+  EXPECT_GE(over, 2);  // the toe did cross the tread
+}
+
 TEST(FootPlacement, AProbeThatMissesFallsBackToTheBodysGround) {
   AnalyticWorld world;
   world.height = [](double, double) { return -5.0; };  // far below any probe's reach
