@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <span>
 #include <vector>
 
 #include "mm/runtime/interpolation.hpp"
@@ -29,6 +30,25 @@ Frame random_frame(size_t joints) {
   return f;
 }
 
+// Every joint of `out` (the first a.rotations.size()) equals transform_hermite's result to the bit.
+void expect_transform_hermite(const Frame& a, const Frame& b, float duration, float t,
+                              std::span<const Transform> out) {
+  const size_t joints = a.rotations.size();
+  for (size_t j = 0; j < joints; ++j) {
+    Transform ta, tb;
+    ta.rotation = a.rotations[j];
+    ta.translation = a.positions[j];
+    tb.rotation = b.rotations[j];
+    tb.translation = b.positions[j];
+    const Transform expected =
+        transform_hermite(ta, a.velocities[j], a.angular_velocities[j], tb, b.velocities[j],
+                          b.angular_velocities[j], duration, t);
+    EXPECT_EQ(out[j].rotation, expected.rotation) << joints << " joints, joint " << j;
+    EXPECT_EQ(out[j].translation, expected.translation) << joints << " joints, joint " << j;
+    EXPECT_EQ(out[j].scale, glm::vec3(1.0f));
+  }
+}
+
 // Joint counts below, at and above one block of four, and the Bandai skeleton's 23 (whose last
 // block overlaps the one before); times at both frames and between, including a far rotation
 // (b on the other side of a).
@@ -42,19 +62,7 @@ TEST(PoseHermite, EveryJointEqualsTransformHermiteToTheBit) {
       for (const float t : {0.0f, 0.25f, 0.5f, 0.731f, 1.0f}) {
         std::vector<Transform> out(joints);
         pose_hermite(a.view(), b.view(), duration, t, out);
-        for (size_t j = 0; j < joints; ++j) {
-          Transform ta, tb;
-          ta.rotation = a.rotations[j];
-          ta.translation = a.positions[j];
-          tb.rotation = b.rotations[j];
-          tb.translation = b.positions[j];
-          const Transform expected =
-              transform_hermite(ta, a.velocities[j], a.angular_velocities[j], tb, b.velocities[j],
-                                b.angular_velocities[j], duration, t);
-          EXPECT_EQ(out[j].rotation, expected.rotation) << joints << " joints, joint " << j;
-          EXPECT_EQ(out[j].translation, expected.translation) << joints << " joints, joint " << j;
-          EXPECT_EQ(out[j].scale, glm::vec3(1.0f));
-        }
+        expect_transform_hermite(a, b, duration, t, out);
       }
     }
   }
@@ -77,19 +85,7 @@ TEST(PoseHermite, FromTheLanesLayoutEqualsTransformHermiteToTheBit) {
         std::vector<Transform> out(joints + 1);
         out[joints].translation = glm::vec3(7.0f);
         pose_hermite(la, lb, duration, t, std::span(out).first(joints));
-        for (size_t j = 0; j < joints; ++j) {
-          Transform ta, tb;
-          ta.rotation = a.rotations[j];
-          ta.translation = a.positions[j];
-          tb.rotation = b.rotations[j];
-          tb.translation = b.positions[j];
-          const Transform expected =
-              transform_hermite(ta, a.velocities[j], a.angular_velocities[j], tb, b.velocities[j],
-                                b.angular_velocities[j], duration, t);
-          EXPECT_EQ(out[j].rotation, expected.rotation) << joints << " joints, joint " << j;
-          EXPECT_EQ(out[j].translation, expected.translation) << joints << " joints, joint " << j;
-          EXPECT_EQ(out[j].scale, glm::vec3(1.0f));
-        }
+        expect_transform_hermite(a, b, duration, t, out);
         EXPECT_EQ(out[joints].translation, glm::vec3(7.0f)) << joints << " joints";
       }
     }
