@@ -410,6 +410,19 @@ void Controller::place_feet(float dt) {
     p.near_ground =
         p.planted || p.toe.y - ground_height_ - shared_->lowest_foot_end(side) < kNearGroundHeight;
   }
+  // A toe a wall keeps out (keep_toe_off_wall) is probed where it is kept, not where the
+  // animation would put it past the wall: held on a ledge's top while the animation swings it
+  // out over the drop, the ground found out there (the body's, a step lower) lowered it into the
+  // ledge's edge.
+  find_walls(legs);
+  for (int side = 0; side < 2; ++side) {
+    PlacementLeg& p = legs[static_cast<size_t>(side)];
+    glm::vec3 kept = p.toe;
+    keep_toe_off_wall(side, kept);
+    const glm::vec3 moved(kept.x - p.toe.x, 0.0f, kept.z - p.toe.z);
+    p.toe += moved;
+    p.ankle += moved;
+  }
   FootPlacementSettings placement;
   placement.max_pelvis_drop = settings_.max_pelvis_drop;
   placement.pelvis_drop_halflife = settings_.pelvis_drop_halflife;
@@ -418,7 +431,6 @@ void Controller::place_feet(float dt) {
   placement.max_step_down = settings_.max_step_down;
   foot_placement_.update(*world_, origin_, mover_, placement, legs, ground_height_, sim_velocity_,
                          dt);
-  find_walls(legs);
   debug_.world_rejected = mover_.rejected();
   const float drop = foot_placement_.pelvis_drop();
   for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation.y -= drop;
