@@ -4,6 +4,7 @@
 #include "mm/programs/evaluation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -212,6 +213,7 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   GroundFrame ground;
   ground.joints = frame.joints;
   std::copy(std::begin(frame.toe_ground), std::end(frame.toe_ground), ground.toe_ground);
+  std::copy(std::begin(frame.toe_support), std::end(frame.toe_support), ground.toe_support);
   ground.hips_ground = frame.hips_ground;
   std::copy(std::begin(frame.contact), std::end(frame.contact), ground.contact);
   ground.wall_depth = frame.wall_depth;
@@ -499,6 +501,7 @@ std::string csv_header(const Database& db) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
   h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
+  h.append(",toe_support_l,toe_support_r");
   return h;
 }
 
@@ -521,6 +524,9 @@ std::string csv_row(const EvaluationFrame& r) {
   std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%d,%d,%d", r.toe_ground[0],
                 r.toe_ground[1], r.hips_ground, r.wall_depth, r.stuck ? 1 : 0, r.locked[0] ? 1 : 0,
                 r.locked[1] ? 1 : 0);
+  row += buffer;
+  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f", std::max(r.toe_ground[0], r.toe_support[0]),
+                std::max(r.toe_ground[1], r.toe_support[1]));
   row += buffer;
   return row;
 }
@@ -569,6 +575,8 @@ class WorldReadings {
       : world_(world), roles_(roles), walls_(joints) {
     toes_[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
     toes_[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+    heels_[0] = roles.left_foot >= 0 ? roles.left_foot : toes_[0];
+    heels_[1] = roles.right_foot >= 0 ? roles.right_foot : toes_[1];
   }
 
   void read(const Controller& controller, float dt, EvaluationFrame& r) {
@@ -588,20 +596,36 @@ class WorldReadings {
 
  private:
   // The toes' and hips' ground, probed from a metre above them (a joint with no ground under it
-  // within 3 m takes the ground under the root).
+  // within 3 m takes the ground under the root), and the ground under each foot from its toe to
+  // its heel, for the ground the foot rests on (foot_support_height). One call.
   void read_ground(const ControllerDebug& d, EvaluationFrame& r) {
-    const int joints[3] = {toes_[0], toes_[1], roles_.hips};
-    GroundProbe probes[3];
-    GroundHit hits[3];
-    for (int k = 0; k < 3; ++k) {
-      const glm::vec3 p =
-          joints[k] >= 0 ? r.joints[static_cast<size_t>(joints[k])] : r.root_position;
-      probes[k] = GroundProbe{p + glm::vec3(0.0f, 1.0f, 0.0f), 3.0f, 0.0f};
+    constexpr int kJoints = 3, kAlong = kFootSupportSamples;
+    const int joints[kJoints] = {toes_[0], toes_[1], roles_.hips};
+    std::array<GroundProbe, kJoints + 2 * kAlong> probes;
+    std::array<GroundHit, kJoints + 2 * kAlong> hits;
+    const auto joint = [&](int j) {
+      return j >= 0 ? r.joints[static_cast<size_t>(j)] : r.root_position;
+    };
+    const auto from_above = [](const glm::vec3& p) {
+      return GroundProbe{p + glm::vec3(0.0f, 1.0f, 0.0f), 3.0f, 0.0f};
+    };
+    for (int k = 0; k < kJoints; ++k) probes[k] = from_above(joint(joints[k]));
+    for (int side = 0; side < 2; ++side) {
+      const glm::vec3 toe = joint(toes_[side]), heel = joint(heels_[side]);
+      for (int k = 0; k < kAlong; ++k) {
+        const float along = static_cast<float>(k + 1) / kAlong;
+        probes[kJoints + side * kAlong + k] = from_above(glm::mix(toe, heel, along));
+      }
     }
     world_->probe_ground(r.origin, probes, hits);
-    float* out[3] = {&r.toe_ground[0], &r.toe_ground[1], &r.hips_ground};
-    for (int k = 0; k < 3; ++k) {
+    float* out[kJoints] = {&r.toe_ground[0], &r.toe_ground[1], &r.hips_ground};
+    for (int k = 0; k < kJoints; ++k) {
       *out[k] = hits[k].hit && std::isfinite(hits[k].point.y) ? hits[k].point.y : d.ground_height;
+    }
+    for (int side = 0; side < 2; ++side) {
+      r.toe_support[side] = foot_support_height(
+          r.toe_ground[side], hits[side], std::span(hits).subspan(kJoints + side * kAlong, kAlong),
+          joint(toes_[side]).y);
     }
   }
 
@@ -633,6 +657,7 @@ class WorldReadings {
   const WorldQueries* world_;
   JointRoleIndices roles_;
   int toes_[2] = {-1, -1};
+  int heels_[2] = {-1, -1};  // the feet (ankles), or the toes where a side has none
   WallDepthReader walls_;
   glm::vec3 previous_sim_{0.0f};
 };

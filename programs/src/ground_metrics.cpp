@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "mm/database/sampling.hpp"
+#include "mm/runtime/finite.hpp"
 #include "mm/runtime/float_to_integer.hpp"
 #include "mm/runtime/pose.hpp"
 #include "statistics.hpp"
@@ -47,6 +48,25 @@ double knee_bend_deg(const glm::vec3& hip, const glm::vec3& knee, const glm::vec
 }
 
 }  // namespace
+
+float foot_support_height(float toe_ground, const GroundHit& under,
+                          std::span<const GroundHit> along, float toe_y) {
+  const bool plane =
+      under.hit && finite(under.point) && finite(under.normal) && under.normal.y > 0.1f;
+  const glm::vec3 n = plane ? under.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+  const glm::vec3 at = plane ? under.point : glm::vec3(0.0f, toe_ground, 0.0f);
+  float support = toe_ground;
+  for (const GroundHit& hit : along) {
+    if (!hit.hit || !finite(hit.point)) continue;
+    const glm::vec3 d = hit.point - at;
+    // Without the plane's point (a miss under the toe) only the height counts: level ground.
+    const float on_plane = plane ? at.y - (n.x * d.x + n.z * d.z) / n.y : toe_ground;
+    if (hit.point.y > on_plane + kFootEdgeRise && hit.point.y <= toe_y) {
+      support = std::max(support, hit.point.y);
+    }
+  }
+  return support;
+}
 
 struct GroundAccumulator::State {
   JointRoleIndices roles;
@@ -97,7 +117,10 @@ void GroundAccumulator::add(const GroundFrame& r) {
     lowest = std::min(lowest, height);
     s.penetration.add(100.0 * std::max(0.0f, -height));
     s.penetration_max = std::max(s.penetration_max, 100.0 * std::max(0.0f, -height));
-    if (r.contact[side]) s.floating.add(100.0 * std::max(0.0f, height));
+    if (r.contact[side]) {
+      const float support = std::max(r.toe_ground[side], r.toe_support[side]);
+      s.floating.add(100.0 * std::max(0.0f, toe.y - support));
+    }
     if (s.frames > 0) s.plant.add(side, height, horizontal_speed(toe, s.previous_toes[side], s.dt));
     s.previous_toes[side] = toe;
   }

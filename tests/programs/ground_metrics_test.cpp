@@ -79,6 +79,57 @@ TEST(GroundMetrics, ClearancePenetrationAndFloatAreAgainstTheGroundUnderEachToe)
   EXPECT_NEAR(m.foot_float_cm_mean, 5.0, 1e-3);
 }
 
+// A planted toe's float is against the ground its foot rests on (toe_support), when that is
+// higher than the ground under the toe; penetration and clearance stay against the toe's own.
+TEST(GroundMetrics, FloatIsAgainstTheGroundTheFootRestsOn) {
+  GroundAccumulator a(roles(), kDt);
+  const std::vector<glm::vec3> joints = pose(0.0f, 0.24f);
+  GroundFrame frame;
+  frame.joints = joints;
+  frame.toe_ground[0] = frame.toe_ground[1] = 0.0f;  // the floor, a tread's edge beside it
+  frame.toe_support[0] = 0.2f;                       // the left foot rests on the tread
+  frame.contact[0] = frame.contact[1] = true;
+  a.add(frame);
+  const GroundMetrics m = a.metrics();
+  EXPECT_NEAR(m.foot_float_cm_mean, (4.0 + 24.0) / 2.0, 1e-3);
+  EXPECT_NEAR(m.toe_clearance_cm_min, 24.0, 1e-3);
+}
+
+GroundHit ground_at(float x, float y, float z, const glm::vec3& normal = {0.0f, 1.0f, 0.0f}) {
+  return GroundHit{true, glm::vec3(x, y, z), normal, true};
+}
+
+// The ground a foot rests on: an edge under the foot that the toe is above, never the slope it
+// stands on, never ground above the toe, never a miss or garbage.
+TEST(GroundMetrics, AFootRestsOnAnEdgeUnderItNotOnItsSlope) {
+  const GroundHit floor = ground_at(0.0f, 0.0f, 0.0f);
+  // Toe 1 cm past a 20 cm tread's edge (z < 0.01 is the tread), the heel on the tread.
+  const GroundHit on_tread[4] = {ground_at(0.0f, 0.2f, 0.03f), ground_at(0.0f, 0.2f, 0.07f),
+                                 ground_at(0.0f, 0.2f, 0.11f), ground_at(0.0f, 0.2f, 0.15f)};
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, floor, on_tread, 0.24f), 0.2f);
+  // The same foot with its toe down on the floor (below the tread): the floor.
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, floor, on_tread, 0.04f), 0.0f);
+  // The whole foot over the floor: the floor.
+  const GroundHit on_floor[4] = {ground_at(0.0f, 0.0f, -0.03f), ground_at(0.0f, 0.0f, -0.07f),
+                                 ground_at(0.0f, 0.0f, -0.11f), ground_at(0.0f, 0.0f, -0.15f)};
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, floor, on_floor, 0.24f), 0.0f);
+  // Down a 30 degree slope (the heel uphill, +z rising): the slope is no edge.
+  const float rise = std::tan(glm::radians(30.0f));
+  const glm::vec3 n = glm::normalize(glm::vec3(0.0f, 1.0f, -rise));
+  const GroundHit on_slope[4] = {
+      ground_at(0.0f, 0.04f * rise, 0.04f, n), ground_at(0.0f, 0.08f * rise, 0.08f, n),
+      ground_at(0.0f, 0.12f * rise, 0.12f, n), ground_at(0.0f, 0.16f * rise, 0.16f, n)};
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, ground_at(0.0f, 0.0f, 0.0f, n), on_slope, 0.2f), 0.0f);
+  // Misses and garbage along the foot are ignored; a miss under the toe is level ground there.
+  GroundHit garbage[4] = {GroundHit{}, ground_at(0.0f, NAN, 0.1f), ground_at(0.0f, 0.1f, INFINITY),
+                          GroundHit{}};
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, floor, garbage, 0.24f), 0.0f);
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, GroundHit{}, on_tread, 0.24f), 0.2f);
+  GroundHit bad_normal = floor;
+  bad_normal.normal = glm::vec3(NAN);
+  EXPECT_FLOAT_EQ(foot_support_height(0.0f, bad_normal, on_tread, 0.24f), 0.2f);
+}
+
 TEST(GroundMetrics, HipsHeightAboveTheirGroundAndVerticalAcceleration) {
   GroundAccumulator a(roles(), kDt);
   // The hips 0.9 m above a ground rising 1 cm a frame, accelerating upward at 2 m/s^2 on top.

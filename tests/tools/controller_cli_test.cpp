@@ -169,6 +169,7 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
         "_z");
   }
   header.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
+  header.append(",toe_support_l,toe_support_r");
   std::istringstream lines(dumps[0]);
   std::string first;
   std::getline(lines, first);

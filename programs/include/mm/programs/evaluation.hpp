@@ -237,6 +237,7 @@ struct EvaluationFrame {
   // deepest a joint is inside a wall (m) and whether the simulation object was stuck
   // (ground_metrics.hpp; from the world, else 0 and false).
   float toe_ground[2] = {0.0f, 0.0f};
+  float toe_support[2] = {-kNoSupport, -kNoSupport};  // foot_support_height, ground_metrics.hpp
   float hips_ground = 0.0f;
   float wall_depth = 0.0f;
   bool stuck = false;

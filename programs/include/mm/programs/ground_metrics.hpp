@@ -15,8 +15,10 @@
 //   rank percentile);
 // - foot_penetration_cm_mean / _max: how deep a toe is below its ground (0 when above), over
 //   every frame and both toes (PhysDiff's penetration);
-// - foot_float_cm_mean: the height above its ground of a toe whose contact label is on
-//   (PhysDiff's float: a planted foot hovering);
+// - foot_float_cm_mean: the height of a toe whose contact label is on above the ground its foot
+//   rests on (PhysDiff's float: a planted foot hovering): the ground under the toe, or an edge
+//   under the foot that the toe is above (foot_support_height: a foot held level on a tread,
+//   its toe a centimetre past the tread's edge, rests on the tread, not on the floor below);
 // - hips_height_cm_mean / _std: the hips' height above the ground under them;
 //   hips_vertical_accel_p99_m_s2: the p99 of the hips' vertical acceleration (second
 //   differences of their height above the world's y = 0);
@@ -32,6 +34,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -49,6 +52,12 @@ inline constexpr float kGeomPlantedSpeed = 0.35f;   // m/s, horizontal
 inline constexpr float kStraightKneeDegrees = 1.0f;
 inline constexpr float kStuckAlongSpeed = 0.2f;  // m/s of desired velocity along the obstacle
 inline constexpr float kStuckSpeed = 0.05f;      // m/s
+// Ground under a foot this much higher than the plane of the surface under its toe is an edge
+// the foot may rest on (m); the foot is probed at kFootSupportSamples points from the toe to the
+// heel (the ankle), evenly, the heel last.
+inline constexpr float kFootEdgeRise = 0.01f;
+inline constexpr int kFootSupportSamples = 4;
+inline constexpr float kNoSupport = std::numeric_limits<float>::infinity();
 
 struct GroundMetrics {
   double foot_skate_geom_cm_s_mean = 0.0;
@@ -72,11 +81,24 @@ struct GroundMetrics {
 struct GroundFrame {
   std::span<const glm::vec3> joints;
   float toe_ground[2] = {0.0f, 0.0f};  // left, right
+  // The ground each foot rests on near its toe (foot_support_height); lower than toe_ground
+  // (as by default) counts as toe_ground.
+  float toe_support[2] = {-kNoSupport, -kNoSupport};
   float hips_ground = 0.0f;
   bool contact[2] = {false, false};
   float wall_depth = 0.0f;  // m
   bool stuck = false;
 };
+
+// The height of the ground a foot rests on near its toe (foot_float_cm_mean): `toe_ground`, the
+// ground under the toe (with `under`, the probe's answer there, whose normal gives the surface's
+// plane; a miss is level), raised to the highest of `along` (the answers under the foot from toe
+// to heel) that stands more than kFootEdgeRise above that plane and no higher than `toe_y`, the
+// toe joint's height: an edge the foot can rest on. The slope the foot stands on is no edge, nor
+// is ground above the toe (the toe is down on the lower side of a step). Misses and non-finite
+// answers are ignored.
+float foot_support_height(float toe_ground, const GroundHit& under,
+                          std::span<const GroundHit> along, float toe_y);
 
 class GroundAccumulator {
  public:
