@@ -7,6 +7,7 @@
 # the ground, a joint 2 cm in a wall, skating over the data's, planted toes floating more than
 # 1.5 cm higher than on flat ground).
 #   scripts/offlane.sh DB OUT_DIR [DT...]        (mm from build/release, or $MM)
+# Its lines, saved to a file, sum into docs/world.md's table rows: scripts/offlane_summary.py FILE.
 # Another course: COURSE (the .glb), LANES (the lanes' x, from the course's table in
 # docs/world-levels.md), START_Z (where the lanes start), SCRIPTS (names in scripts/input/), e.g.
 #   COURSE=data/levels/course2.glb START_Z=2 \
