@@ -961,7 +961,7 @@ void Controller::synchronize(float dt) {
     if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
     const float max_step = max_speed * dt;
     if (glm::length(step) > max_step) step *= max_step / glm::length(step);
-    sim_position_ += step;
+    sim_position_ += without_slide_back(step, dt);
   }
   // Pull the character toward the simulation, no faster than a share of its own motion.
   const glm::vec3 velocity = displayed_velocity_;

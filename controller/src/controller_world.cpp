@@ -25,6 +25,9 @@ constexpr float kSlideFacingShare = 0.3f;
 // The simulation object is still beside the wall it last met while no farther from it than
 // this (m).
 constexpr float kBesideObstacle = 0.05f;
+// The most of the simulation object's slide along a wall (share) its yield toward the character
+// may take back in an update.
+constexpr float kMaxSlideBack = 0.5f;
 // Halflife (s) of the body's return from a wall it was kept out of.
 constexpr float kWallPushHalflife = 0.15f;
 // The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
@@ -321,6 +324,22 @@ bool Controller::wall_beside(glm::vec3& point, glm::vec3& normal) const {
   normal = glm::normalize(n);
   point = obstacle_point_ - normal * settings_.character_radius;
   return true;
+}
+
+// The simulation object's yield toward the character (synchronize), its part back along the wall
+// the object slides along at most half the slide: the clip played does not slide, and given back
+// to the character whole each update, the object stood still beside the wall where it could
+// have slid.
+glm::vec3 Controller::without_slide_back(const glm::vec3& step, float dt) const {
+  glm::vec3 point, normal;
+  if (!wall_beside(point, normal)) return step;
+  const glm::vec3 slide = (sim_velocity_ - normal * glm::dot(sim_velocity_, normal)) * dt;
+  const float slide_length = glm::length(slide);
+  if (slide_length <= 0.0f) return step;
+  const glm::vec3 direction = slide / slide_length;
+  const float back = -glm::dot(step, direction);
+  const float allowed = kMaxSlideBack * slide_length;
+  return back > allowed ? step + direction * (back - allowed) : step;
 }
 
 // Walls near the feet and the arms: a small sphere swept from the root's vertical line out to

@@ -546,6 +546,7 @@ class Controller {
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
+  glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
   void face_along_obstacle();
   void desired_motion(const ControllerInput& input);
