@@ -1107,7 +1107,7 @@ void Controller::turn_chest_to_facing(float dt) {
     goal = std::abs(error) <= kChestTwistReach ? std::clamp(error, -kMaxChestTwist, kMaxChestTwist)
                                                : 0.0f;
   }
-  critical_spring_update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
+  chest_twist_spring_.update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
   const bool both = roles.spine >= 0 && roles.chest >= 0;
   for (const int joint : {roles.spine, roles.chest}) {
     if (joint < 0) continue;
@@ -1289,8 +1289,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   // The release's first update holds the toe where it was: its offset starts decaying from
   // rest on the next.
   if (!released) {
-    critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
-                           settings_.foot_lock_release_halflife, dt);
+    critical_spring_apply(
+        f.offset, f.offset_velocity, glm::vec3(0.0f),
+        foot_springs_[side].offset.step(settings_.foot_lock_release_halflife, dt));
   }
   glm::vec3 target = on_ground;
   // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting
@@ -1311,7 +1312,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   const float to_go =
       std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
   const float lift_goal = f.stepping ? std::min(kStepHeight, kStepLift * to_go) : 0.0f;
-  critical_spring_update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
+  foot_springs_[side].lift.update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
   target.y += f.lift;
   if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset &&
       std::abs(f.heading_offset) < kRelockHeading) {
@@ -1393,8 +1394,8 @@ void Controller::hold_heading(int side, float dt) {
     return;
   }
   f.heading_held = false;
-  critical_spring_update(f.heading_offset, f.heading_offset_velocity, 0.0f,
-                         settings_.foot_lock_release_halflife, dt);
+  foot_springs_[side].heading.update(f.heading_offset, f.heading_offset_velocity, 0.0f,
+                                     settings_.foot_lock_release_halflife, dt);
 }
 
 // The animated foot's heading: the yaw of its foot-to-toe line (radians).
@@ -1519,8 +1520,8 @@ void Controller::restore_leg_lengths(int side) {
 void Controller::ease_heel_down(int side, float dt) {
   FootLock& f = feet_[side];
   if (f.heel_rise <= 0.0f) return;
-  critical_spring_update(f.heel_rise, f.heel_rise_velocity, 0.0f,
-                         settings_.foot_lock_release_halflife, dt);
+  foot_springs_[side].heel.update(f.heel_rise, f.heel_rise_velocity, 0.0f,
+                                  settings_.foot_lock_release_halflife, dt);
   if (f.heel_rise < 1e-4f) f.heel_rise = f.heel_rise_velocity = 0.0f;
 }
 

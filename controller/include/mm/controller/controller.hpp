@@ -623,6 +623,14 @@ class Controller {
   // an inertialized body's) offsets, the simulation's rotation.
   CriticalSpringStepCache offset_step_;
   CriticalSpringStepCache sim_rotation_step_;
+  // The same for the springs the feet and the chest run every update, per foot: the release
+  // offset, the step's lift, the heading offset, the heel's rise; and the chest's twist.
+  struct FootSprings {
+    CriticalSpringStepCache offset;
+    CriticalSpringScalarCache lift, heading, heel;
+  };
+  FootSprings foot_springs_[2];
+  CriticalSpringScalarCache chest_twist_spring_;
   struct TrajectoryColumn {
     int column = 0;      // first column in the feature row
     int time_index = 0;  // index into trajectory_times_
