@@ -1024,9 +1024,8 @@ void Controller::synchronize(float dt) {
 // The body's facing in the displayed pose: the yaw across the upper legs (pair_yaw), from the
 // local pose before forward kinematics.
 float Controller::body_yaw() const {
-  const std::span<const int> parents = db_->skeleton().parents();
-  const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
-  const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
+  const auto [left, right] = forward_kinematics_positions(db_->skeleton().parents(), locals_,
+                                                          leg_joints_[0][0], leg_joints_[1][0]);
   return pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
 }
 
@@ -1097,10 +1096,9 @@ void Controller::turn_chest_to_facing(float dt) {
   const std::span<const int> parents = db_->skeleton().parents();
   float goal = 0.0f;
   if (strafing_) {
-    const float chest_yaw =
-        pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
-                 forward_kinematics_position(parents, locals_, roles.right_upper_arm),
-                 root_yaw_.of(locals_[0].rotation));
+    const auto [left, right] =
+        forward_kinematics_positions(parents, locals_, roles.left_upper_arm, roles.right_upper_arm);
+    const float chest_yaw = pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
     const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
     // now could pick the other way round from the body's own turn.
