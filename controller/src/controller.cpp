@@ -204,6 +204,18 @@ float pull_fraction(float halflife, float dt) {
 
 }  // namespace
 
+float Controller::PullFractionCache::of(float halflife, float dt) {
+  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
+  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
+  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
+    fraction_ = pull_fraction(halflife, dt);
+    halflife_bits_ = h;
+    dt_bits_ = t;
+    known_ = true;
+  }
+  return fraction_;
+}
+
 std::string_view sync_mode_name(SyncMode mode) {
   switch (mode) {
     case SyncMode::CharacterFollowsSimulation:
@@ -955,7 +967,7 @@ void Controller::synchronize(float dt) {
   if (settings_.simulation_yield_halflife > 0.0f) {
     glm::vec3 toward = root.translation - sim_position_;
     toward.y = 0.0f;
-    glm::vec3 step = toward * pull_fraction(settings_.simulation_yield_halflife, dt);
+    glm::vec3 step = toward * yield_pull_.of(settings_.simulation_yield_halflife, dt);
     const float own_speed = std::hypot(displayed_velocity_.x, displayed_velocity_.z);
     float max_speed = settings_.simulation_yield_max_velocity_ratio * own_speed;
     if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
@@ -967,7 +979,7 @@ void Controller::synchronize(float dt) {
   const glm::vec3 velocity = displayed_velocity_;
   const float speed = std::sqrt(velocity.x * velocity.x + velocity.z * velocity.z);
   const float turn_rate = std::abs(displayed_angular_velocity_.y);
-  const float fraction = pull_fraction(settings_.adjustment_halflife, dt);
+  const float fraction = adjustment_pull_.of(settings_.adjustment_halflife, dt);
 
   glm::vec3 error = sim_position_ - root.translation;
   error.y = 0.0f;
@@ -1057,7 +1069,7 @@ void Controller::limit_body_turn(float dt) {
 void Controller::align_hips(float dt) {
   const float goal =
       stopping_ && body_yaw_known_ ? std::clamp(hips_offset_, -kMaxHipsAlign, kMaxHipsAlign) : 0.0f;
-  hips_align_ += (goal - hips_align_) * pull_fraction(kHipsAlignHalflife, dt);
+  hips_align_ += (goal - hips_align_) * hips_align_pull_.of(kHipsAlignHalflife, dt);
 }
 
 // Orientation warping. The data has no side steps: strafing, the simulation (and with it the
@@ -1195,8 +1207,8 @@ void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
   const bool settling = on_idle_clip();
-  standing_reach_ +=
-      ((settling ? 1.0f : 0.0f) - standing_reach_) * pull_fraction(kStandingReachHalflife, dt);
+  standing_reach_ += ((settling ? 1.0f : 0.0f) - standing_reach_) *
+                     standing_reach_pull_.of(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
     const int effector = leg_end(side);
     const glm::vec3 animated = globals_[static_cast<size_t>(effector)].translation;
@@ -1345,7 +1357,7 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
     f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
     // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
     // jitter over a few milliseconds is no sweep.
-    f.speed += (speed - f.speed) * pull_fraction(kSweepHalflife, dt);
+    f.speed += (speed - f.speed) * sweep_pull_.of(kSweepHalflife, dt);
   }
   f.animated = on_ground;
   f.has_animated = true;
