@@ -84,8 +84,9 @@ Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   return scale(scale(v, _mm_div_ps(atan_x_over_x, a.w)), c(2.0f));
 }
 
-// atan2_polynomial(y, x) lane by lane, for lanes whose larger magnitude is positive and finite
-// (`ok`); the others are the library's in the scalar function.
+// atan2_polynomial(y, x) lane by lane (its coefficients, atan2_polynomial.hpp, in its order), for
+// lanes whose larger magnitude is positive and finite (`ok`); the others are the library's in the
+// scalar function. DeadBlending's tests hold the lanes to the scalar blend's bits.
 __m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
   const __m128 sign = c(-0.0f);
   const __m128 ax = _mm_andnot_ps(sign, x);
