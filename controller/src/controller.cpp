@@ -204,6 +204,18 @@ float pull_fraction(float halflife, float dt) {
 
 }  // namespace
 
+float Controller::PullFractionCache::of(float halflife, float dt) {
+  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
+  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
+  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
+    fraction_ = pull_fraction(halflife, dt);
+    halflife_bits_ = h;
+    dt_bits_ = t;
+    known_ = true;
+  }
+  return fraction_;
+}
+
 std::string_view sync_mode_name(SyncMode mode) {
   switch (mode) {
     case SyncMode::CharacterFollowsSimulation:
@@ -955,7 +967,7 @@ void Controller::synchronize(float dt) {
   if (settings_.simulation_yield_halflife > 0.0f) {
     glm::vec3 toward = root.translation - sim_position_;
     toward.y = 0.0f;
-    glm::vec3 step = toward * pull_fraction(settings_.simulation_yield_halflife, dt);
+    glm::vec3 step = toward * yield_pull_.of(settings_.simulation_yield_halflife, dt);
     const float own_speed = std::hypot(displayed_velocity_.x, displayed_velocity_.z);
     float max_speed = settings_.simulation_yield_max_velocity_ratio * own_speed;
     if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
@@ -967,7 +979,7 @@ void Controller::synchronize(float dt) {
   const glm::vec3 velocity = displayed_velocity_;
   const float speed = std::sqrt(velocity.x * velocity.x + velocity.z * velocity.z);
   const float turn_rate = std::abs(displayed_angular_velocity_.y);
-  const float fraction = pull_fraction(settings_.adjustment_halflife, dt);
+  const float fraction = adjustment_pull_.of(settings_.adjustment_halflife, dt);
 
   glm::vec3 error = sim_position_ - root.translation;
   error.y = 0.0f;
@@ -1024,9 +1036,8 @@ void Controller::synchronize(float dt) {
 // The body's facing in the displayed pose: the yaw across the upper legs (pair_yaw), from the
 // local pose before forward kinematics.
 float Controller::body_yaw() const {
-  const std::span<const int> parents = db_->skeleton().parents();
-  const glm::vec3 left = forward_kinematics_position(parents, locals_, leg_joints_[0][0]);
-  const glm::vec3 right = forward_kinematics_position(parents, locals_, leg_joints_[1][0]);
+  const auto [left, right] = forward_kinematics_positions(db_->skeleton().parents(), locals_,
+                                                          leg_joints_[0][0], leg_joints_[1][0]);
   return pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
 }
 
@@ -1058,7 +1069,7 @@ void Controller::limit_body_turn(float dt) {
 void Controller::align_hips(float dt) {
   const float goal =
       stopping_ && body_yaw_known_ ? std::clamp(hips_offset_, -kMaxHipsAlign, kMaxHipsAlign) : 0.0f;
-  hips_align_ += (goal - hips_align_) * pull_fraction(kHipsAlignHalflife, dt);
+  hips_align_ += (goal - hips_align_) * hips_align_pull_.of(kHipsAlignHalflife, dt);
 }
 
 // Orientation warping. The data has no side steps: strafing, the simulation (and with it the
@@ -1097,17 +1108,16 @@ void Controller::turn_chest_to_facing(float dt) {
   const std::span<const int> parents = db_->skeleton().parents();
   float goal = 0.0f;
   if (strafing_) {
-    const float chest_yaw =
-        pair_yaw(forward_kinematics_position(parents, locals_, roles.left_upper_arm),
-                 forward_kinematics_position(parents, locals_, roles.right_upper_arm),
-                 root_yaw_.of(locals_[0].rotation));
+    const auto [left, right] =
+        forward_kinematics_positions(parents, locals_, roles.left_upper_arm, roles.right_upper_arm);
+    const float chest_yaw = pair_yaw(left, right, root_yaw_.of(locals_[0].rotation));
     const float error = wrap_angle(desired_yaw_.of(desired_rotation_) - chest_yaw);
     // Farther off, the body is still coming round (a strafe that flips the facing): twisting
     // now could pick the other way round from the body's own turn.
     goal = std::abs(error) <= kChestTwistReach ? std::clamp(error, -kMaxChestTwist, kMaxChestTwist)
                                                : 0.0f;
   }
-  critical_spring_update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
+  chest_twist_spring_.update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
   const bool both = roles.spine >= 0 && roles.chest >= 0;
   for (const int joint : {roles.spine, roles.chest}) {
     if (joint < 0) continue;
@@ -1197,8 +1207,8 @@ void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
   const bool settling = on_idle_clip();
-  standing_reach_ +=
-      ((settling ? 1.0f : 0.0f) - standing_reach_) * pull_fraction(kStandingReachHalflife, dt);
+  standing_reach_ += ((settling ? 1.0f : 0.0f) - standing_reach_) *
+                     standing_reach_pull_.of(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
     const int effector = leg_end(side);
     const glm::vec3 animated = globals_[static_cast<size_t>(effector)].translation;
@@ -1289,8 +1299,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   // The release's first update holds the toe where it was: its offset starts decaying from
   // rest on the next.
   if (!released) {
-    critical_spring_update(f.offset, f.offset_velocity, glm::vec3(0.0f),
-                           settings_.foot_lock_release_halflife, dt);
+    critical_spring_apply(
+        f.offset, f.offset_velocity, glm::vec3(0.0f),
+        foot_springs_[side].offset.step(settings_.foot_lock_release_halflife, dt));
   }
   glm::vec3 target = on_ground;
   // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting
@@ -1311,7 +1322,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   const float to_go =
       std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
   const float lift_goal = f.stepping ? std::min(kStepHeight, kStepLift * to_go) : 0.0f;
-  critical_spring_update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
+  foot_springs_[side].lift.update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
   target.y += f.lift;
   if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset &&
       std::abs(f.heading_offset) < kRelockHeading) {
@@ -1346,7 +1357,7 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
     f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
     // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
     // jitter over a few milliseconds is no sweep.
-    f.speed += (speed - f.speed) * pull_fraction(kSweepHalflife, dt);
+    f.speed += (speed - f.speed) * sweep_pull_.of(kSweepHalflife, dt);
   }
   f.animated = on_ground;
   f.has_animated = true;
@@ -1393,8 +1404,8 @@ void Controller::hold_heading(int side, float dt) {
     return;
   }
   f.heading_held = false;
-  critical_spring_update(f.heading_offset, f.heading_offset_velocity, 0.0f,
-                         settings_.foot_lock_release_halflife, dt);
+  foot_springs_[side].heading.update(f.heading_offset, f.heading_offset_velocity, 0.0f,
+                                     settings_.foot_lock_release_halflife, dt);
 }
 
 // The animated foot's heading: the yaw of its foot-to-toe line (radians).
@@ -1519,8 +1530,8 @@ void Controller::restore_leg_lengths(int side) {
 void Controller::ease_heel_down(int side, float dt) {
   FootLock& f = feet_[side];
   if (f.heel_rise <= 0.0f) return;
-  critical_spring_update(f.heel_rise, f.heel_rise_velocity, 0.0f,
-                         settings_.foot_lock_release_halflife, dt);
+  foot_springs_[side].heel.update(f.heel_rise, f.heel_rise_velocity, 0.0f,
+                                  settings_.foot_lock_release_halflife, dt);
   if (f.heel_rise < 1e-4f) f.heel_rise = f.heel_rise_velocity = 0.0f;
 }
 

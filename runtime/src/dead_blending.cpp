@@ -1,6 +1,7 @@
 #include "mm/runtime/dead_blending.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include "mm/runtime/assert.hpp"
 
@@ -83,11 +84,49 @@ Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   return scale(scale(v, _mm_div_ps(atan_x_over_x, a.w)), c(2.0f));
 }
 
-// The lanes outside a series (`ok` clear) are redone by the scalar function: a joint far from
-// its incoming pose (or turning fast) costs its logarithm's or exponential's general branch in
-// that lane alone, while the rest of its arithmetic stays in the lanes. Lane by lane each
-// result equals the scalar quat_to_scaled_angle_axis' and quat_exp's to the bit. The redoing is
-// out of line so that the lanes' common path keeps its registers.
+// atan2_polynomial(y, x) lane by lane (its coefficients, atan2_polynomial.hpp, in its order), for
+// lanes whose larger magnitude is positive and finite (`ok`); the others are the library's in the
+// scalar function. DeadBlending's tests hold the lanes to the scalar blend's bits.
+__m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
+  const __m128 sign = c(-0.0f);
+  const __m128 ax = _mm_andnot_ps(sign, x);
+  const __m128 ay = _mm_andnot_ps(sign, y);
+  const __m128 x_larger = _mm_cmpgt_ps(ax, ay);
+  const auto select = [](__m128 mask, __m128 a, __m128 b) {
+    return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+  };
+  const __m128 largest = select(x_larger, ax, ay);
+  ok = _mm_and_ps(_mm_cmpgt_ps(largest, _mm_setzero_ps()), _mm_cmple_ps(largest, c(FLT_MAX)));
+  const __m128 t = _mm_div_ps(select(x_larger, ay, ax), largest);
+  const __m128 s = mul(t, t);
+  __m128 p = c(2.456725342e-03f);
+  for (const float k : {-1.440136135e-02f, 3.978123143e-02f, -7.234857976e-02f, 1.049894616e-01f,
+                        -1.416122913e-01f, 1.998590678e-01f, -3.333259821e-01f, 9.999998808e-01f}) {
+    p = add(mul(p, s), c(k));  // p * s - k' is p * s + (-k'): the same rounding
+  }
+  __m128 angle = mul(t, p);
+  angle = select(_mm_cmpgt_ps(ay, ax), sub(c(1.57079637f), angle), angle);
+  angle = select(_mm_cmplt_ps(x, _mm_setzero_ps()), sub(c(3.14159274f), angle), angle);
+  return _mm_or_ps(_mm_andnot_ps(sign, angle), _mm_and_ps(sign, y));
+}
+
+// quat_to_scaled_angle_axis through quat_log's general branch (atan2_polynomial), lane by lane;
+// `ok` marks the lanes it covers (not a zero vector part, nor the library's atan2).
+Vec4x3 scaled_angle_axis_general(const Quat4& q, __m128& ok) {
+  const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
+  const Vec4x3 v{a.x, a.y, a.z};
+  const __m128 s = _mm_sqrt_ps(dot(v, v));
+  __m128 atan_ok;
+  const __m128 angle = atan2_polynomial_lanes(s, a.w, atan_ok);
+  ok = _mm_and_ps(_mm_cmpge_ps(s, c(1e-30f)), atan_ok);
+  return scale(scale(v, _mm_div_ps(angle, s)), c(2.0f));
+}
+
+// The lanes outside a series (`ok` clear) take the logarithm's general branch in the lanes too;
+// only a lane outside both (a vector part of zero length, or a quaternion that is not finite)
+// and the exponential's lanes outside its series are redone by the scalar function. Lane by lane
+// each result equals the scalar quat_to_scaled_angle_axis' and quat_exp's to the bit. The redoing
+// is out of line so that the lanes' common path keeps its registers.
 struct Lanes {
   alignas(16) float w[4], x[4], y[4], z[4];
 };
@@ -114,8 +153,18 @@ struct Lanes {
 [[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_lanes(const Quat4& q) {
   __m128 ok;
   Vec4x3 d = scaled_angle_axis_series(q, ok);
-  const int inside = _mm_movemask_ps(ok);
-  if (inside != 0xF) scaled_angle_axis_outside(q, inside, d);
+  int inside = _mm_movemask_ps(ok);
+  if (inside != 0xF) {
+    __m128 general_ok;
+    const Vec4x3 g = scaled_angle_axis_general(q, general_ok);
+    const __m128 take = _mm_andnot_ps(ok, general_ok);
+    const auto pick = [&](__m128 a, __m128 b) {
+      return _mm_or_ps(_mm_and_ps(take, a), _mm_andnot_ps(take, b));
+    };
+    d = {pick(g.x, d.x), pick(g.y, d.y), pick(g.z, d.z)};
+    inside |= _mm_movemask_ps(take);
+    if (inside != 0xF) scaled_angle_axis_outside(q, inside, d);
+  }
   return d;
 }
 

@@ -102,25 +102,6 @@ Transforms4 gather(const Transform* a, const Transform* b, const Transform* c, c
   return {{q3, q0, q1, q2}, {t0, t1, t2}, {s1, s2, s3}};
 }
 
-// GLM's cross product.
-Vec4x3 cross(const Vec4x3& x, const Vec4x3& y) {
-  return {sub(mul(x.y, y.z), mul(y.y, x.z)), sub(mul(x.z, y.x), mul(y.z, x.x)),
-          sub(mul(x.x, y.y), mul(y.x, x.y))};
-}
-
-// Component by component.
-Vec4x3 times(const Vec4x3& a, const Vec4x3& b) {
-  return {mul(a.x, b.x), mul(a.y, b.y), mul(a.z, b.z)};
-}
-
-// GLM's quaternion times vector: v + ((uv w) + uuv) 2 with uv = q.xyz x v, uuv = q.xyz x uv.
-Vec4x3 rotate(const Quat4& q, const Vec4x3& v) {
-  const Vec4x3 u{q.x, q.y, q.z};
-  const Vec4x3 uv = cross(u, v);
-  const Vec4x3 uuv = cross(u, uv);
-  return add(v, scale(add(scale(uv, q.w), uuv), c(2.0f)));
-}
-
 template <bool kUnitScale>
 void compose_block(std::span<const int> parents, std::span<const Transform> local,
                    std::span<Transform> global, const std::array<int, 4>& joints) {

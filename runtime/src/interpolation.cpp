@@ -247,21 +247,6 @@ Transform interpolate(const Transform& a, const Transform& b, float t, Interpola
   return transform_nlerp(a, b, t);
 }
 
-float quat_yaw(const glm::quat& q) {
-  // The x and z of q * (0, 0, 1), GLM's rotation written out for that vector (the same
-  // expression for any q, unit or not): two products and a sum each instead of two cross
-  // products of a general vector.
-  const float x = 2.0f * (q.w * q.y + q.x * q.z);
-  const float z = 1.0f - 2.0f * (q.x * q.x + q.y * q.y);
-  return atan2_polynomial(x, z);
-}
-
-float wrap_angle(float angle) {
-  float a = std::fmod(angle + glm::pi<float>(), glm::two_pi<float>());
-  if (a < 0.0f) a += glm::two_pi<float>();
-  return a - glm::pi<float>();
-}
-
 Transform transform_hermite(const Transform& a, const glm::vec3& a_velocity,
                             const glm::vec3& a_angular_velocity, const Transform& b,
                             const glm::vec3& b_velocity, const glm::vec3& b_angular_velocity,

@@ -138,6 +138,25 @@ inline Vec4x3 add(const Vec4x3& a, const Vec4x3& b) {
   return {_mm_add_ps(a.x, b.x), _mm_add_ps(a.y, b.y), _mm_add_ps(a.z, b.z)};
 }
 
+// GLM's cross product.
+inline Vec4x3 cross(const Vec4x3& x, const Vec4x3& y) {
+  return {sub(mul(x.y, y.z), mul(y.y, x.z)), sub(mul(x.z, y.x), mul(y.z, x.x)),
+          sub(mul(x.x, y.y), mul(y.x, x.y))};
+}
+
+// Component by component.
+inline Vec4x3 times(const Vec4x3& a, const Vec4x3& b) {
+  return {mul(a.x, b.x), mul(a.y, b.y), mul(a.z, b.z)};
+}
+
+// GLM's quaternion times vector: v + ((uv w) + uuv) 2 with uv = q.xyz x v, uuv = q.xyz x uv.
+inline Vec4x3 rotate(const Quat4& q, const Vec4x3& v) {
+  const Vec4x3 u{q.x, q.y, q.z};
+  const Vec4x3 uv = cross(u, v);
+  const Vec4x3 uuv = cross(u, uv);
+  return add(v, scale(add(scale(uv, q.w), uuv), c(2.0f)));
+}
+
 // The sign bits of the lanes in `mask` flipped: -q there (exact), q elsewhere.
 inline Quat4 negate_where(const Quat4& q, __m128 mask) {
   const __m128 flip = _mm_and_ps(mask, _mm_set1_ps(-0.0f));

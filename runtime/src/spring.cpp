@@ -100,6 +100,14 @@ void apply_character(glm::vec3& x, glm::vec3& v, glm::vec3& a, const glm::vec3& 
   a = settled(scaled(c.e, a) - scaled(c.e * c.w * c.t, j1));
 }
 
+// critical_spring_update's step of a scalar spring, in double.
+void apply_scalar(float& x, float& v, float goal, const SpringCoefficients& c) {
+  const double j0 = static_cast<double>(x) - goal;
+  const double v0 = v;
+  x = static_cast<float>(goal + settled(c.xx * j0 + c.xv * v0));
+  v = static_cast<float>(settled(c.vx * j0 + c.vv * v0));
+}
+
 bool usable(float halflife, float dt) {
   return std::isfinite(halflife) && std::isfinite(dt);
 }
@@ -134,11 +142,24 @@ float halflife_to_stiffness(float halflife) {
 
 void critical_spring_update(float& x, float& v, float goal, float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
-  const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
-  const double j0 = static_cast<double>(x) - goal;
-  const double v0 = v;
-  x = static_cast<float>(goal + settled(c.xx * j0 + c.xv * v0));
-  v = static_cast<float>(settled(c.vx * j0 + c.vv * v0));
+  apply_scalar(x, v, goal, spring_coefficients(angular_frequency(halflife), dt));
+}
+
+void CriticalSpringScalarCache::update(float& x, float& v, float goal, float halflife, float dt) {
+  if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
+  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
+  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
+  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
+    const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
+    xx_ = c.xx;
+    xv_ = c.xv;
+    vx_ = c.vx;
+    vv_ = c.vv;
+    halflife_bits_ = h;
+    dt_bits_ = t;
+    known_ = true;
+  }
+  apply_scalar(x, v, goal, {xx_, xv_, vx_, vv_});
 }
 
 void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,

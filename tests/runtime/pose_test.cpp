@@ -146,6 +146,27 @@ TEST(ForwardKinematics, PositionAndRotationWalksEqualTheFullWalkExactly) {
   }
 }
 
+// The two-joint walk gives each joint's own walk to the bit, for every pair of joints (siblings,
+// a joint and its ancestor, the same joint twice, chains that meet only at the root).
+TEST(ForwardKinematics, ThePairWalkEqualsTwoPositionWalksExactly) {
+  Branching s;
+  for (size_t j = 0; j < s.local.size(); ++j) {
+    s.local[j].scale = glm::vec3(1.0f + 0.1f * static_cast<float>(j), 0.9f, 1.1f);
+  }
+  const int n = static_cast<int>(s.parents.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = 0; b < n; ++b) {
+      const auto both = forward_kinematics_positions(s.parents, s.local, a, b);
+      const glm::vec3 pa = forward_kinematics_position(s.parents, s.local, a);
+      const glm::vec3 pb = forward_kinematics_position(s.parents, s.local, b);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_EQ(both[0][k], pa[k]) << a << " " << b;
+        EXPECT_EQ(both[1][k], pb[k]) << a << " " << b;
+      }
+    }
+  }
+}
+
 TEST(ForwardKinematics, BoneLengthsOfRootIsItsTranslationLength) {
   const std::vector<int> parents{-1, 0};
   std::vector<Transform> local{at(3, 4, 0), at(0, 0, 2)};

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -562,6 +563,31 @@ TEST(CriticalSpringStepCache, EqualsTheStepOfTheHalflifeAndDtAskedAndFollowsChan
     EXPECT_EQ(got.xv, expected.xv);
     EXPECT_EQ(got.vx, expected.vx);
     EXPECT_EQ(got.vv, expected.vv);
+  }
+}
+
+// A scalar spring through its cache moves as critical_spring_update moves it, to the bit, also
+// when the halflife or dt changes between calls (or makes the step a no-op).
+TEST(CriticalSpringScalarCache, EqualsCriticalSpringUpdateAndFollowsChanges) {
+  CriticalSpringScalarCache cache;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::array<std::array<float, 3>, 10> asked = {{{0.1f, 1.0f / 60.0f, 1.0f},
+                                                       {0.1f, 1.0f / 60.0f, 1.0f},
+                                                       {0.1f, 1.0f / 30.0f, -2.0f},
+                                                       {0.2f, 1.0f / 30.0f, -2.0f},
+                                                       {0.2f, 1.0f / 30.0f, nan},
+                                                       {0.2f, 0.0f, 0.5f},
+                                                       {nan, 1.0f / 30.0f, 0.5f},
+                                                       {0.2f, 1.0f / 30.0f, 0.5f},
+                                                       {0.0f, 1.0f / 144.0f, 3.0f},
+                                                       {0.0f, 1.0f / 144.0f, 3.0f}}};
+  float x = 0.3f, v = -1.5f, expected_x = x, expected_v = v;
+  for (const auto& [halflife, dt, goal] : asked) {
+    SCOPED_TRACE(testing::Message() << "halflife " << halflife << ", dt " << dt);
+    critical_spring_update(expected_x, expected_v, goal, halflife, dt);
+    cache.update(x, v, goal, halflife, dt);
+    EXPECT_EQ(std::bit_cast<uint32_t>(x), std::bit_cast<uint32_t>(expected_x));
+    EXPECT_EQ(std::bit_cast<uint32_t>(v), std::bit_cast<uint32_t>(expected_v));
   }
 }
 

@@ -624,6 +624,27 @@ class Controller {
   // an inertialized body's) offsets, the simulation's rotation.
   CriticalSpringStepCache offset_step_;
   CriticalSpringStepCache sim_rotation_step_;
+  // The same for the springs the feet and the chest run every update, per foot: the release
+  // offset, the step's lift, the heading offset, the heel's rise; and the chest's twist.
+  struct FootSprings {
+    CriticalSpringStepCache offset;
+    CriticalSpringScalarCache lift, heading, heel;
+  };
+  FootSprings foot_springs_[2];
+  CriticalSpringScalarCache chest_twist_spring_;
+  // pull_fraction (controller.cpp) of one pull, kept while its halflife and dt stay the same (bit
+  // for bit): its exp2 is then computed once, not every update.
+  class PullFractionCache {
+   public:
+    float of(float halflife, float dt);
+
+   private:
+    std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
+    bool known_ = false;
+    float fraction_ = 0.0f;
+  };
+  PullFractionCache yield_pull_, adjustment_pull_, hips_align_pull_, standing_reach_pull_,
+      sweep_pull_;
   struct TrajectoryColumn {
     int column = 0;      // first column in the feature row
     int time_index = 0;  // index into trajectory_times_

@@ -15,8 +15,12 @@
 // t = 0 and t = 1 up to float rounding, never divide by a near-zero angle (limits are used
 // instead), and return unit quaternions.
 
+#include <cmath>
 #include <span>
 
+#include <glm/gtc/constants.hpp>
+
+#include "mm/runtime/atan2_polynomial.hpp"
 #include "mm/runtime/transform.hpp"
 
 namespace mm {
@@ -45,11 +49,27 @@ glm::quat quat_from_scaled_angle_axis(const glm::vec3& scaled_angle_axis);
 float quat_angle_between(const glm::quat& a, const glm::quat& b);
 
 // The heading of a rotation: the yaw (radians, about +Y) of where it takes the forward axis +Z,
-// atan2(forward.x, forward.z). A forward axis along +Y or -Y gives 0.
-float quat_yaw(const glm::quat& q);
+// atan2(forward.x, forward.z). A forward axis along +Y or -Y gives 0. Inline: the controller
+// takes several an update.
+inline float quat_yaw(const glm::quat& q) {
+  // The x and z of q * (0, 0, 1), GLM's rotation written out for that vector (the same
+  // expression for any q, unit or not): two products and a sum each instead of two cross
+  // products of a general vector.
+  const float x = 2.0f * (q.w * q.y + q.x * q.z);
+  const float z = 1.0f - 2.0f * (q.x * q.x + q.y * q.y);
+  return atan2_polynomial(x, z);
+}
 
 // The angle in [-pi, pi) equal to `angle` modulo 2 pi (a non-finite angle stays non-finite).
-float wrap_angle(float angle);
+// Inline, and the library's fmod only for an angle more than a turn off: fmod is exact and
+// returns its argument unchanged when that is less than the divisor in magnitude, which nearly
+// every call's is (a difference of two wrapped angles), so both paths give the same bits.
+inline float wrap_angle(float angle) {
+  float a = angle + glm::pi<float>();
+  if (!(std::abs(a) < glm::two_pi<float>())) a = std::fmod(a, glm::two_pi<float>());
+  if (a < 0.0f) a += glm::two_pi<float>();
+  return a - glm::pi<float>();
+}
 
 // The shortest rotation taking direction `from` to direction `to` (neither needs unit length).
 // Opposite directions give a half turn about an axis perpendicular to `from`; a zero vector

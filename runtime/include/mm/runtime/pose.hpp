@@ -3,6 +3,7 @@
 // Forward kinematics turns them into global (model-space) transforms. Functions take spans so
 // callers own the memory; none of them allocates.
 
+#include <array>
 #include <span>
 
 #include "mm/runtime/skeleton.hpp"
@@ -25,6 +26,12 @@ Transform forward_kinematics_joint(std::span<const int> parents, std::span<const
 // rotation below them).
 glm::vec3 forward_kinematics_position(std::span<const int> parents,
                                       std::span<const Transform> local, int joint);
+// forward_kinematics_position of two joints, each to the bit, in one walk where their chains
+// meet: from the joint both descend from (the hips, for the upper legs), their two positions
+// go up the rest of the chain together, in SSE lanes.
+std::array<glm::vec3, 2> forward_kinematics_positions(std::span<const int> parents,
+                                                      std::span<const Transform> local, int a,
+                                                      int b);
 // forward_kinematics_joint(...).rotation, to the bit, without the chain's translations.
 glm::quat forward_kinematics_rotation(std::span<const int> parents,
                                       std::span<const Transform> local, int joint);

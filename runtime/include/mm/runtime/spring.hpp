@@ -71,6 +71,20 @@ float halflife_to_stiffness(float halflife);
 // Advances a scalar spring (position x, velocity v) toward goal by dt seconds, exactly.
 void critical_spring_update(float& x, float& v, float goal, float halflife, float dt);
 
+// critical_spring_update of a scalar spring, to the bit, with the step's coefficients kept: at
+// a fixed update rate and halflife every update takes the same step, whose exponential is then
+// computed once. They are computed again whenever the halflife or dt differs from the last
+// call's (bit for bit). One cache per spring that has its own halflife.
+class CriticalSpringScalarCache {
+ public:
+  void update(float& x, float& v, float goal, float halflife, float dt);
+
+ private:
+  std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
+  bool known_ = false;
+  double xx_ = 1.0, xv_ = 0.0, vx_ = 0.0, vv_ = 1.0;  // as critical_spring_update computes them
+};
+
 // Advances a 3D spring toward goal by dt seconds, exactly (each axis is independent).
 void critical_spring_update(glm::vec3& x, glm::vec3& v, const glm::vec3& goal, float halflife,
                             float dt);
