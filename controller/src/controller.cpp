@@ -205,14 +205,7 @@ float pull_fraction(float halflife, float dt) {
 }  // namespace
 
 float Controller::PullFractionCache::of(float halflife, float dt) {
-  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
-  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
-  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
-    fraction_ = pull_fraction(halflife, dt);
-    halflife_bits_ = h;
-    dt_bits_ = t;
-    known_ = true;
-  }
+  if (key_.changed(halflife, dt)) fraction_ = pull_fraction(halflife, dt);
   return fraction_;
 }
 

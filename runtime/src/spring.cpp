@@ -147,17 +147,12 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
 
 void CriticalSpringScalarCache::update(float& x, float& v, float goal, float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
-  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
-  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
-  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
+  if (key_.changed(halflife, dt)) {
     const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
     xx_ = c.xx;
     xv_ = c.xv;
     vx_ = c.vx;
     vv_ = c.vv;
-    halflife_bits_ = h;
-    dt_bits_ = t;
-    known_ = true;
   }
   apply_scalar(x, v, goal, {xx_, xv_, vx_, vv_});
 }
@@ -203,14 +198,7 @@ void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, co
 }
 
 const CriticalSpringStep& CriticalSpringStepCache::step(float halflife, float dt) {
-  const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
-  const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
-  if (!known_ || h != halflife_bits_ || t != dt_bits_) {
-    step_ = critical_spring_step(halflife, dt);
-    halflife_bits_ = h;
-    dt_bits_ = t;
-    known_ = true;
-  }
+  if (key_.changed(halflife, dt)) step_ = critical_spring_step(halflife, dt);
   return step_;
 }
 

@@ -639,8 +639,7 @@ class Controller {
     float of(float halflife, float dt);
 
    private:
-    std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
-    bool known_ = false;
+    SpringStepKey key_;
     float fraction_ = 0.0f;
   };
   PullFractionCache yield_pull_, adjustment_pull_, hips_align_pull_, standing_reach_pull_,

@@ -32,6 +32,7 @@
 //   with a non-finite goal or halflife give the current state at every time.
 // Nothing here allocates.
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -71,6 +72,26 @@ float halflife_to_stiffness(float halflife);
 // Advances a scalar spring (position x, velocity v) toward goal by dt seconds, exactly.
 void critical_spring_update(float& x, float& v, float goal, float halflife, float dt);
 
+// The halflife and dt a cached spring step was computed for, compared bit for bit: the caches
+// below recompute only when either changes, so their result is the uncached one to the bit.
+class SpringStepKey {
+ public:
+  // Whether (halflife, dt) differs from the last call's (always on the first); remembers it.
+  bool changed(float halflife, float dt) {
+    const std::uint32_t h = std::bit_cast<std::uint32_t>(halflife);
+    const std::uint32_t t = std::bit_cast<std::uint32_t>(dt);
+    if (known_ && h == halflife_bits_ && t == dt_bits_) return false;
+    halflife_bits_ = h;
+    dt_bits_ = t;
+    known_ = true;
+    return true;
+  }
+
+ private:
+  std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
+  bool known_ = false;
+};
+
 // critical_spring_update of a scalar spring, to the bit, with the step's coefficients kept: at
 // a fixed update rate and halflife every update takes the same step, whose exponential is then
 // computed once. They are computed again whenever the halflife or dt differs from the last
@@ -80,8 +101,7 @@ class CriticalSpringScalarCache {
   void update(float& x, float& v, float goal, float halflife, float dt);
 
  private:
-  std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
-  bool known_ = false;
+  SpringStepKey key_;
   double xx_ = 1.0, xv_ = 0.0, vx_ = 0.0, vv_ = 1.0;  // as critical_spring_update computes them
 };
 
@@ -113,8 +133,7 @@ class CriticalSpringStepCache {
   const CriticalSpringStep& step(float halflife, float dt);
 
  private:
-  std::uint32_t halflife_bits_ = 0, dt_bits_ = 0;
-  bool known_ = false;
+  SpringStepKey key_;
   CriticalSpringStep step_;
 };
 
