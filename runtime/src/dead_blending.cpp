@@ -4,7 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include "mm/runtime/assert.hpp"
-
+#include "mm/runtime/atan2_polynomial.hpp"
 #include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/spring.hpp"
 #include "quat_lanes.hpp"
@@ -84,7 +84,7 @@ Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   return scale(scale(v, _mm_div_ps(atan_x_over_x, a.w)), c(2.0f));
 }
 
-// atan2_polynomial(y, x) lane by lane (its coefficients, atan2_polynomial.hpp, in its order), for
+// atan2_polynomial(y, x) lane by lane (its coefficients, kAtanFit, in its order), for
 // lanes whose larger magnitude is positive and finite (`ok`); the others are the library's in the
 // scalar function. DeadBlending's tests hold the lanes to the scalar blend's bits.
 __m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
@@ -99,14 +99,11 @@ __m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
   ok = _mm_and_ps(_mm_cmpgt_ps(largest, _mm_setzero_ps()), _mm_cmple_ps(largest, c(FLT_MAX)));
   const __m128 t = _mm_div_ps(select(x_larger, ay, ax), largest);
   const __m128 s = mul(t, t);
-  __m128 p = c(2.456725342e-03f);
-  for (const float k : {-1.440136135e-02f, 3.978123143e-02f, -7.234857976e-02f, 1.049894616e-01f,
-                        -1.416122913e-01f, 1.998590678e-01f, -3.333259821e-01f, 9.999998808e-01f}) {
-    p = add(mul(p, s), c(k));  // p * s - k' is p * s + (-k'): the same rounding
-  }
+  __m128 p = c(kAtanFit[0]);
+  for (int k = 1; k < 9; ++k) p = add(mul(p, s), c(kAtanFit[k]));
   __m128 angle = mul(t, p);
-  angle = select(_mm_cmpgt_ps(ay, ax), sub(c(1.57079637f), angle), angle);
-  angle = select(_mm_cmplt_ps(x, _mm_setzero_ps()), sub(c(3.14159274f), angle), angle);
+  angle = select(_mm_cmpgt_ps(ay, ax), sub(c(kAtanHalfPi), angle), angle);
+  angle = select(_mm_cmplt_ps(x, _mm_setzero_ps()), sub(c(kAtanPi), angle), angle);
   return _mm_or_ps(_mm_andnot_ps(sign, angle), _mm_and_ps(sign, y));
 }
 

@@ -13,6 +13,14 @@
 
 namespace mm {
 
+// The fit p of atan(t) / t, highest degree first (Horner's order), and the octant's constants as
+// floats: the scalar function and the dead blend's lanes (dead_blending.cpp) share them.
+inline constexpr float kAtanFit[9] = {2.456725342e-03f,  -1.440136135e-02f, 3.978123143e-02f,
+                                      -7.234857976e-02f, 1.049894616e-01f,  -1.416122913e-01f,
+                                      1.998590678e-01f,  -3.333259821e-01f, 9.999998808e-01f};
+inline constexpr float kAtanHalfPi = 1.57079637f;
+inline constexpr float kAtanPi = 3.14159274f;
+
 inline float atan2_polynomial(float y, float x) {
   const float ax = std::abs(x);
   const float ay = std::abs(y);
@@ -21,18 +29,11 @@ inline float atan2_polynomial(float y, float x) {
   if (!(largest > 0.0f && largest <= FLT_MAX)) return std::atan2(y, x);
   const float t = (ax > ay ? ay : ax) / largest;
   const float s = t * t;
-  float p = 2.456725342e-03f;
-  p = p * s - 1.440136135e-02f;
-  p = p * s + 3.978123143e-02f;
-  p = p * s - 7.234857976e-02f;
-  p = p * s + 1.049894616e-01f;
-  p = p * s - 1.416122913e-01f;
-  p = p * s + 1.998590678e-01f;
-  p = p * s - 3.333259821e-01f;
-  p = p * s + 9.999998808e-01f;
+  float p = kAtanFit[0];
+  for (int k = 1; k < 9; ++k) p = p * s + kAtanFit[k];
   float angle = t * p;
-  if (ay > ax) angle = 1.57079637f - angle;
-  if (x < 0.0f) angle = 3.14159274f - angle;
+  if (ay > ax) angle = kAtanHalfPi - angle;
+  if (x < 0.0f) angle = kAtanPi - angle;
   return std::copysign(angle, y);
 }
 
