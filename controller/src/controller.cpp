@@ -915,8 +915,8 @@ void Controller::predict() {
   rotation_springs_.prepare_critical(settings_.simulation_rotation_halflife, trajectory_times_);
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
                            desired_velocity_, position_springs_);
-  critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
-                          simulation_goal_rotation_, rotation_springs_);
+  rotation_prediction_.predict(rotations, sim_rotation_, sim_angular_velocity_,
+                               simulation_goal_rotation_, rotation_springs_);
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.

@@ -620,6 +620,7 @@ class Controller {
   // The prediction's spring coefficients at those times, kept while the halflives stay.
   SpringPredictionTable position_springs_;
   SpringPredictionTable rotation_springs_;
+  RotationPredictionCache rotation_prediction_;  // the rotations predicted from the table
   // The per-update steps of the springs whose halflife and dt rarely change: the root's (and
   // an inertialized body's) offsets, the simulation's rotation.
   CriticalSpringStepCache offset_step_;
