@@ -1112,12 +1112,14 @@ void Controller::turn_chest_to_facing(float dt) {
   }
   chest_twist_spring_.update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
   const bool both = roles.spine >= 0 && roles.chest >= 0;
+  // One turn for both joints: the twist does not change between them, and taken inside the loop
+  // its sine and cosine were computed again after each parent walk.
+  const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
   for (const int joint : {roles.spine, roles.chest}) {
     if (joint < 0) continue;
     // A turn about the world's vertical, expressed in the joint's parent frame.
     const glm::quat parent =
         forward_kinematics_rotation(parents, locals_, db_->skeleton().parent(joint));
-    const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
     Transform& local = locals_[static_cast<size_t>(joint)];
     local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
   }
