@@ -1202,6 +1202,7 @@ void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
   const bool settling = on_idle_clip();
+  playing_leg_ends_known_ = false;
   standing_reach_ += ((settling ? 1.0f : 0.0f) - standing_reach_) *
                      standing_reach_pull_.of(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
@@ -1267,7 +1268,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     // into it has got to: waiting for the blend, the steps came late, long after the stop.
     glm::vec3 settle_drag = drag;
     if (settling) {
-      settle_drag = playing_position(leg_end(side)) - f.position;
+      settle_drag = playing_leg_end(side) - f.position;
       settle_drag.y = 0.0f;
     }
     const bool settle =
@@ -1359,12 +1360,20 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
   return f.low_and_slow;
 }
 
-// Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
-// displayed root.
-glm::vec3 Controller::playing_position(int joint) const {
-  // Only the position: the chain's rotations and scales are not needed for it.
-  const glm::vec3 played = forward_kinematics_position(db_->skeleton().parents(), sampled_, joint);
-  return transform_point(compose(locals_[0], inverse(sampled_[0])), played);
+// Where the playing clip itself (sampled_, not the transition into it) puts a leg's end, under
+// the displayed root. Both ends are walked when the first is asked for (reset by foot_lock each
+// update): feet settling together ask for both, and the two chains share the walk from the hips
+// up (forward_kinematics_positions, each position to the bit of its own walk). Neither sampled_
+// nor the root's local changes during the foot lock.
+glm::vec3 Controller::playing_leg_end(int side) {
+  if (!playing_leg_ends_known_) {
+    const auto [left, right] =
+        forward_kinematics_positions(db_->skeleton().parents(), sampled_, leg_end(0), leg_end(1));
+    const Transform to_displayed = compose(locals_[0], inverse(sampled_[0]));
+    playing_leg_ends_ = {transform_point(to_displayed, left), transform_point(to_displayed, right)};
+    playing_leg_ends_known_ = true;
+  }
+  return playing_leg_ends_[static_cast<size_t>(side)];
 }
 
 // The end joint of a leg: its toe, or its foot when it has none.
