@@ -915,8 +915,11 @@ void Controller::predict() {
   rotation_springs_.prepare_critical(settings_.simulation_rotation_halflife, trajectory_times_);
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
                            desired_velocity_, position_springs_);
-  rotation_prediction_.predict(rotations, sim_rotation_, sim_angular_velocity_,
-                               simulation_goal_rotation_, rotation_springs_);
+  // The predicted yaws change only with the prediction (kept while the facing is held).
+  if (rotation_prediction_.predict(rotations, sim_rotation_, sim_angular_velocity_,
+                                   simulation_goal_rotation_, rotation_springs_)) {
+    for (size_t i = 0; i < n; ++i) predicted_yaws_[i] = quat_yaw(rotations[i]);
+  }
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
@@ -925,7 +928,7 @@ void Controller::predict() {
       stopping_ ? settings_.stand_turn_max_rate : settings_.simulation_max_turn_rate;
   for (size_t i = 0; i < n; ++i) {
     const float reach = max_rate * std::max(0.0f, trajectory_times_[i]);
-    const float turn = wrap_angle(quat_yaw(rotations[i]) - yaw);
+    const float turn = wrap_angle(predicted_yaws_[i] - yaw);
     if (std::abs(turn) > reach) {
       rotations[i] = glm::normalize(yaw_rotation(std::copysign(reach, turn)) * sim_rotation_);
     }

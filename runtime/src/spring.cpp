@@ -283,7 +283,7 @@ bool same_bits(const T& a, const T& b) {
 
 }  // namespace
 
-void RotationPredictionCache::predict(std::span<glm::quat> rotations, const glm::quat& rotation,
+bool RotationPredictionCache::predict(std::span<glm::quat> rotations, const glm::quat& rotation,
                                       const glm::vec3& angular_velocity, const glm::quat& goal,
                                       const SpringPredictionTable& table) {
   MM_ASSERT(table.prepared && table.count <= SpringPredictionTable::kMaxTimes);
@@ -306,6 +306,7 @@ void RotationPredictionCache::predict(std::span<glm::quat> rotations, const glm:
     std::memcpy(times_, table.times, sizeof(times_));
   }
   std::copy_n(rotations_, table.count, rotations.begin());
+  return !same;
 }
 
 void spring_character_update(glm::vec3& position, glm::vec3& velocity, glm::vec3& acceleration,

@@ -627,7 +627,8 @@ TEST(RotationPredictionCache, EqualsThePredictionFromTheTableAndFollowsChanges) 
     table.prepare_critical(a.halflife, *a.at);
     std::array<glm::quat, 3> expected{}, kept{};
     critical_spring_predict(expected, {}, a.rotation, a.rate, a.goal, table);
-    cache.predict(kept, a.rotation, a.rate, a.goal, table);
+    // Made again on every call but the repeats of the one before.
+    EXPECT_EQ(cache.predict(kept, a.rotation, a.rate, a.goal, table), k != 1 && k != 8) << k;
     for (size_t i = 0; i < times.size(); ++i) {
       EXPECT_EQ(std::memcmp(&kept[i], &expected[i], sizeof(glm::quat)), 0) << k << " " << i;
     }

@@ -621,6 +621,7 @@ class Controller {
   SpringPredictionTable position_springs_;
   SpringPredictionTable rotation_springs_;
   RotationPredictionCache rotation_prediction_;  // the rotations predicted from the table
+  float predicted_yaws_[SpringPredictionTable::kMaxTimes] = {};  // quat_yaw of each of them
   // The per-update steps of the springs whose halflife and dt rarely change: the root's (and
   // an inertialized body's) offsets, the simulation's rotation.
   CriticalSpringStepCache offset_step_;

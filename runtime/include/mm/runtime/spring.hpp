@@ -212,8 +212,9 @@ void critical_spring_predict(std::span<glm::quat> rotations,
 // bit, so the result is always the function's to the bit.
 class RotationPredictionCache {
  public:
-  // rotations.size() must be table.count.
-  void predict(std::span<glm::quat> rotations, const glm::quat& rotation,
+  // rotations.size() must be table.count. Returns whether the prediction was made again (false:
+  // the same rotations as the last call's).
+  bool predict(std::span<glm::quat> rotations, const glm::quat& rotation,
                const glm::vec3& angular_velocity, const glm::quat& goal,
                const SpringPredictionTable& table);
 
