@@ -915,8 +915,11 @@ void Controller::predict() {
   rotation_springs_.prepare_critical(settings_.simulation_rotation_halflife, trajectory_times_);
   spring_character_predict(positions, {}, {}, sim_position_, sim_velocity_, sim_acceleration_,
                            desired_velocity_, position_springs_);
-  critical_spring_predict(rotations, {}, sim_rotation_, sim_angular_velocity_,
-                          simulation_goal_rotation_, rotation_springs_);
+  // The predicted yaws change only with the prediction (kept while the facing is held).
+  if (rotation_prediction_.predict(rotations, sim_rotation_, sim_angular_velocity_,
+                                   simulation_goal_rotation_, rotation_springs_)) {
+    for (size_t i = 0; i < n; ++i) predicted_yaws_[i] = quat_yaw(rotations[i]);
+  }
   if (world_) collide_trajectory(positions);
   // The turn-rate limit as update applies it, closely enough for the query: no farther from
   // today's facing than the fastest turn reaches in the time.
@@ -925,7 +928,7 @@ void Controller::predict() {
       stopping_ ? settings_.stand_turn_max_rate : settings_.simulation_max_turn_rate;
   for (size_t i = 0; i < n; ++i) {
     const float reach = max_rate * std::max(0.0f, trajectory_times_[i]);
-    const float turn = wrap_angle(quat_yaw(rotations[i]) - yaw);
+    const float turn = wrap_angle(predicted_yaws_[i] - yaw);
     if (std::abs(turn) > reach) {
       rotations[i] = glm::normalize(yaw_rotation(std::copysign(reach, turn)) * sim_rotation_);
     }
@@ -1112,12 +1115,14 @@ void Controller::turn_chest_to_facing(float dt) {
   }
   chest_twist_spring_.update(chest_twist_, chest_twist_velocity_, goal, kChestTwistHalflife, dt);
   const bool both = roles.spine >= 0 && roles.chest >= 0;
+  // One turn for both joints: the twist does not change between them, and taken inside the loop
+  // its sine and cosine were computed again after each parent walk.
+  const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
   for (const int joint : {roles.spine, roles.chest}) {
     if (joint < 0) continue;
     // A turn about the world's vertical, expressed in the joint's parent frame.
     const glm::quat parent =
         forward_kinematics_rotation(parents, locals_, db_->skeleton().parent(joint));
-    const glm::quat turn = yaw_rotation(both ? 0.5f * chest_twist_ : chest_twist_);
     Transform& local = locals_[static_cast<size_t>(joint)];
     local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
   }
@@ -1200,6 +1205,7 @@ void Controller::foot_lock(float dt) {
   // Standing on the idle clip, feet still held where the last steps left them take a step
   // each, one at a time, into the idle pose.
   const bool settling = on_idle_clip();
+  playing_leg_ends_known_ = false;
   standing_reach_ += ((settling ? 1.0f : 0.0f) - standing_reach_) *
                      standing_reach_pull_.of(kStandingReachHalflife, dt);
   for (int side = 0; side < 2; ++side) {
@@ -1265,7 +1271,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     // into it has got to: waiting for the blend, the steps came late, long after the stop.
     glm::vec3 settle_drag = drag;
     if (settling) {
-      settle_drag = playing_position(leg_end(side)) - f.position;
+      settle_drag = playing_leg_end(side) - f.position;
       settle_drag.y = 0.0f;
     }
     const bool settle =
@@ -1357,12 +1363,20 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
   return f.low_and_slow;
 }
 
-// Where the playing clip itself (sampled_, not the transition into it) puts a joint, under the
-// displayed root.
-glm::vec3 Controller::playing_position(int joint) const {
-  // Only the position: the chain's rotations and scales are not needed for it.
-  const glm::vec3 played = forward_kinematics_position(db_->skeleton().parents(), sampled_, joint);
-  return transform_point(compose(locals_[0], inverse(sampled_[0])), played);
+// Where the playing clip itself (sampled_, not the transition into it) puts a leg's end, under
+// the displayed root. Both ends are walked when the first is asked for (reset by foot_lock each
+// update): feet settling together ask for both, and the two chains share the walk from the hips
+// up (forward_kinematics_positions, each position to the bit of its own walk). Neither sampled_
+// nor the root's local changes during the foot lock.
+glm::vec3 Controller::playing_leg_end(int side) {
+  if (!playing_leg_ends_known_) {
+    const auto [left, right] =
+        forward_kinematics_positions(db_->skeleton().parents(), sampled_, leg_end(0), leg_end(1));
+    const Transform to_displayed = compose(locals_[0], inverse(sampled_[0]));
+    playing_leg_ends_ = {transform_point(to_displayed, left), transform_point(to_displayed, right)};
+    playing_leg_ends_known_ = true;
+  }
+  return playing_leg_ends_[static_cast<size_t>(side)];
 }
 
 // The end joint of a leg: its toe, or its foot when it has none.

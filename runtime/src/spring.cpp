@@ -273,6 +273,42 @@ void critical_spring_predict(std::span<glm::quat> rotations,
   }
 }
 
+namespace {
+
+// Whether a and b hold the same bits (a NaN equals itself, 0 and -0 differ).
+template <typename T>
+bool same_bits(const T& a, const T& b) {
+  return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+}  // namespace
+
+bool RotationPredictionCache::predict(std::span<glm::quat> rotations, const glm::quat& rotation,
+                                      const glm::vec3& angular_velocity, const glm::quat& goal,
+                                      const SpringPredictionTable& table) {
+  MM_ASSERT(table.prepared && table.count <= SpringPredictionTable::kMaxTimes);
+  MM_ASSERT(rotations.size() == table.count);
+  // The times past count are compared too (the table keeps them): stricter, never stale.
+  const bool same = known_ && same_bits(rotation, rotation_) && same_bits(goal, goal_) &&
+                    same_bits(angular_velocity, angular_velocity_) && table.kind == kind_ &&
+                    table.count == count_ && same_bits(table.halflife, halflife_) &&
+                    same_bits(table.times, times_);
+  if (!same) {
+    critical_spring_predict(std::span<glm::quat>(rotations_, table.count), {}, rotation,
+                            angular_velocity, goal, table);
+    known_ = true;
+    rotation_ = rotation;
+    goal_ = goal;
+    angular_velocity_ = angular_velocity;
+    kind_ = table.kind;
+    count_ = table.count;
+    halflife_ = table.halflife;
+    std::memcpy(times_, table.times, sizeof(times_));
+  }
+  std::copy_n(rotations_, table.count, rotations.begin());
+  return !same;
+}
+
 void spring_character_update(glm::vec3& position, glm::vec3& velocity, glm::vec3& acceleration,
                              const glm::vec3& desired_velocity, float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !finite(desired_velocity)) return;

@@ -3,6 +3,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -588,6 +589,54 @@ TEST(CriticalSpringScalarCache, EqualsCriticalSpringUpdateAndFollowsChanges) {
     cache.update(x, v, goal, halflife, dt);
     EXPECT_EQ(std::bit_cast<uint32_t>(x), std::bit_cast<uint32_t>(expected_x));
     EXPECT_EQ(std::bit_cast<uint32_t>(v), std::bit_cast<uint32_t>(expected_v));
+  }
+}
+
+// The kept prediction is critical_spring_predict's from the table, to the bit: asked again with
+// the same arguments, and after each of the rotation, the rate, the goal, the halflife and the
+// times changes (and changes back).
+TEST(RotationPredictionCache, EqualsThePredictionFromTheTableAndFollowsChanges) {
+  const std::array<float, 3> times{0.2f, 0.4f, 0.6f};
+  const std::array<float, 3> later{0.2f, 0.4f, 0.7f};
+  const glm::quat q = glm::angleAxis(0.4f, glm::vec3(0, 1, 0));
+  const glm::quat turned = glm::angleAxis(0.5f, glm::vec3(0, 1, 0));
+  const glm::quat goal = glm::angleAxis(-1.3f, glm::vec3(0, 1, 0));
+  const glm::quat other_goal = glm::angleAxis(1.1f, glm::vec3(1, 0, 0));
+  const glm::vec3 w(0.0f, 0.8f, 0.0f), still(0.0f);
+  struct Asked {
+    glm::quat rotation;
+    glm::vec3 rate;
+    glm::quat goal;
+    float halflife;
+    const std::array<float, 3>* at;
+  };
+  const std::array<Asked, 9> asked = {{{q, w, goal, 0.3f, &times},
+                                       {q, w, goal, 0.3f, &times},
+                                       {turned, w, goal, 0.3f, &times},
+                                       {turned, still, goal, 0.3f, &times},
+                                       {turned, still, other_goal, 0.3f, &times},
+                                       {turned, still, other_goal, 0.12f, &times},
+                                       {turned, still, other_goal, 0.12f, &later},
+                                       {q, w, goal, 0.3f, &times},
+                                       {q, w, goal, 0.3f, &times}}};
+  RotationPredictionCache cache;
+  SpringPredictionTable table;
+  std::array<glm::quat, 3> previous{};
+  for (size_t k = 0; k < asked.size(); ++k) {
+    const Asked& a = asked[k];
+    table.prepare_critical(a.halflife, *a.at);
+    std::array<glm::quat, 3> expected{}, kept{};
+    critical_spring_predict(expected, {}, a.rotation, a.rate, a.goal, table);
+    // Made again on every call but the repeats of the one before.
+    EXPECT_EQ(cache.predict(kept, a.rotation, a.rate, a.goal, table), k != 1 && k != 8) << k;
+    for (size_t i = 0; i < times.size(); ++i) {
+      EXPECT_EQ(std::memcmp(&kept[i], &expected[i], sizeof(glm::quat)), 0) << k << " " << i;
+    }
+    // Every change of an argument changes the prediction, so a stale one would be seen.
+    if (k > 0 && k != 1 && k != 8) {
+      EXPECT_NE(kept, previous) << k;
+    }
+    previous = kept;
   }
 }
 

@@ -595,7 +595,7 @@ class Controller {
   bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
   bool contact_label_holds(int side) const;
   void hold_heading(int side, float dt);
-  glm::vec3 playing_position(int joint) const;
+  glm::vec3 playing_leg_end(int side);
   int leg_end(int side) const;
   bool in_early_blend() const;
   float foot_heading(int side) const;
@@ -620,6 +620,8 @@ class Controller {
   // The prediction's spring coefficients at those times, kept while the halflives stay.
   SpringPredictionTable position_springs_;
   SpringPredictionTable rotation_springs_;
+  RotationPredictionCache rotation_prediction_;  // the rotations predicted from the table
+  float predicted_yaws_[SpringPredictionTable::kMaxTimes] = {};  // quat_yaw of each of them
   // The per-update steps of the springs whose halflife and dt rarely change: the root's (and
   // an inertialized body's) offsets, the simulation's rotation.
   CriticalSpringStepCache offset_step_;
@@ -790,6 +792,9 @@ class Controller {
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
   float standing_reach_ = 0.0f;
+  // Where the playing clip puts each leg's end this update (playing_leg_end), once known.
+  std::array<glm::vec3, 2> playing_leg_ends_{};
+  bool playing_leg_ends_known_ = false;
   // The body's facing after the last update (see body_max_turn_rate), unknown after a placement.
   float body_yaw_ = 0.0f;
   bool body_yaw_known_ = false;

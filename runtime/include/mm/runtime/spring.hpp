@@ -205,6 +205,31 @@ void critical_spring_predict(std::span<glm::quat> rotations,
                              const glm::vec3& angular_velocity, const glm::quat& goal,
                              const SpringPredictionTable& table);
 
+// critical_spring_predict of the rotations alone from a prepared table, with its last result
+// kept: a settled rotation spring (a facing held while walking straight or standing) predicts
+// from the same rotation, rate and goal update after update. The prediction is made again
+// whenever any of them, or the table's halflife or times, differs from the last call's bit for
+// bit, so the result is always the function's to the bit.
+class RotationPredictionCache {
+ public:
+  // rotations.size() must be table.count. Returns whether the prediction was made again (false:
+  // the same rotations as the last call's).
+  bool predict(std::span<glm::quat> rotations, const glm::quat& rotation,
+               const glm::vec3& angular_velocity, const glm::quat& goal,
+               const SpringPredictionTable& table);
+
+ private:
+  // The last call's arguments (compared bit for bit) and the table's key.
+  bool known_ = false;
+  glm::quat rotation_{1.0f, 0.0f, 0.0f, 0.0f}, goal_{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 angular_velocity_{0.0f};
+  int kind_ = 0;
+  size_t count_ = 0;
+  float halflife_ = 0.0f;
+  float times_[SpringPredictionTable::kMaxTimes] = {};
+  glm::quat rotations_[SpringPredictionTable::kMaxTimes] = {};
+};
+
 // spring_character_predict with the table prepared (prepare_character) for its halflife and
 // times.
 void spring_character_predict(std::span<glm::vec3> positions, std::span<glm::vec3> velocities,
