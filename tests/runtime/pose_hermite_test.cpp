@@ -49,47 +49,51 @@ void expect_transform_hermite(const Frame& a, const Frame& b, float duration, fl
   }
 }
 
-// Joint counts below, at and above one block of four, and the Bandai skeleton's 23 (whose last
-// block overlaps the one before); times at both frames and between, including a far rotation
-// (b on the other side of a).
-TEST(PoseHermite, EveryJointEqualsTransformHermiteToTheBit) {
-  const float duration = 1.0f / 30.0f;
+constexpr float kDuration = 1.0f / 30.0f;
+// Times at both frames and between.
+constexpr float kTimes[] = {0.0f, 0.25f, 0.5f, 0.731f, 1.0f};
+
+// `check(a, b, joints)` for 20 random frame pairs at each joint count below, at and above one
+// block of four, and the Bandai skeleton's 23 (whose last block overlaps the one before), b's
+// first rotation on the other side of a's (a far rotation).
+template <class Check>
+void for_each_pose_pair(Check check) {
   for (const size_t joints : {1u, 3u, 4u, 5u, 8u, 23u}) {
     for (int trial = 0; trial < 20; ++trial) {
       const Frame a = random_frame(joints);
       Frame b = random_frame(joints);
       b.rotations[0] = -b.rotations[0];
-      for (const float t : {0.0f, 0.25f, 0.5f, 0.731f, 1.0f}) {
-        std::vector<Transform> out(joints);
-        pose_hermite(a.view(), b.view(), duration, t, out);
-        expect_transform_hermite(a, b, duration, t, out);
-      }
+      check(a, b, joints);
     }
   }
+}
+
+TEST(PoseHermite, EveryJointEqualsTransformHermiteToTheBit) {
+  for_each_pose_pair([](const Frame& a, const Frame& b, size_t joints) {
+    for (const float t : kTimes) {
+      std::vector<Transform> out(joints);
+      pose_hermite(a.view(), b.view(), kDuration, t, out);
+      expect_transform_hermite(a, b, kDuration, t, out);
+    }
+  });
 }
 
 // The same from the lanes' layout (pose_to_lanes): every joint, including those of a last group
 // that padding completes, equals transform_hermite's result to the bit.
 TEST(PoseHermite, FromTheLanesLayoutEqualsTransformHermiteToTheBit) {
-  const float duration = 1.0f / 30.0f;
-  for (const size_t joints : {1u, 3u, 4u, 5u, 8u, 23u}) {
-    for (int trial = 0; trial < 20; ++trial) {
-      const Frame a = random_frame(joints);
-      Frame b = random_frame(joints);
-      b.rotations[0] = -b.rotations[0];
-      std::vector<float> la(pose_lane_floats(joints)), lb(pose_lane_floats(joints));
-      pose_to_lanes(a.view(), la);
-      pose_to_lanes(b.view(), lb);
-      for (const float t : {0.0f, 0.25f, 0.5f, 0.731f, 1.0f}) {
-        // One joint more than the pose, to see that nothing is written past it.
-        std::vector<Transform> out(joints + 1);
-        out[joints].translation = glm::vec3(7.0f);
-        pose_hermite(la, lb, duration, t, std::span(out).first(joints));
-        expect_transform_hermite(a, b, duration, t, out);
-        EXPECT_EQ(out[joints].translation, glm::vec3(7.0f)) << joints << " joints";
-      }
+  for_each_pose_pair([](const Frame& a, const Frame& b, size_t joints) {
+    std::vector<float> la(pose_lane_floats(joints)), lb(pose_lane_floats(joints));
+    pose_to_lanes(a.view(), la);
+    pose_to_lanes(b.view(), lb);
+    for (const float t : kTimes) {
+      // One joint more than the pose, to see that nothing is written past it.
+      std::vector<Transform> out(joints + 1);
+      out[joints].translation = glm::vec3(7.0f);
+      pose_hermite(la, lb, kDuration, t, std::span(out).first(joints));
+      expect_transform_hermite(a, b, kDuration, t, out);
+      EXPECT_EQ(out[joints].translation, glm::vec3(7.0f)) << joints << " joints";
     }
-  }
+  });
 }
 
 }  // namespace
