@@ -57,6 +57,8 @@ constexpr float kLiftHalflife = 0.06f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
 // foot) steps rather than being dragged: past full length, since soft reach still bends it.
 constexpr float kStepReach = 1.03f;
+// It steps only if the animated toe on its ground is at least this much nearer the hip (m).
+constexpr float kStepReachGain = 0.02f;
 // An animated toe lower than this above its ground (m) and horizontally slower than this (m/s)
 // is planted, whatever its label says: the skating metric's rule (ground_metrics.hpp).
 constexpr float kPlantedHeight = 0.06f;
@@ -1278,12 +1280,17 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
         settling && !feet_[1 - side].stepping &&
         (glm::length(settle_drag) > kSettleDistance || std::abs(f.heading_offset) > kSettleHeading);
     // Beyond the leg's reach (softened, see soft_reach) the held toe would be dragged along the
-    // ground anyway.
+    // ground anyway; but not where the animated toe on its ground is hardly nearer (downhill on
+    // a slope, the pelvis dropped as far as it goes): the step would land as far out of reach,
+    // and the foot, released and locked again over and over, shuffled where it stood.
     const std::vector<int>& leg = leg_joints_[side];
     const glm::vec3 ankle = globals_[static_cast<size_t>(leg[2])].translation;
     const glm::vec3 hip = globals_[static_cast<size_t>(leg[0])].translation;
-    const bool out_of_reach = glm::length(f.position - (animated + body_shift_ - ankle) - hip) >
-                              kStepReach * leg_length(side);
+    const glm::vec3 toe_from_ankle = animated + body_shift_ - ankle;
+    const float held_reach = glm::length(f.position - toe_from_ankle - hip);
+    const bool out_of_reach =
+        held_reach > kStepReach * leg_length(side) &&
+        held_reach > glm::length(on_ground - toe_from_ankle - hip) + kStepReachGain;
     const bool dragged = glm::length(drag) > settings_.foot_unlock_radius || out_of_reach;
     if (!contact || dragged || settle) {
       // A foot that has to move while its frame says "contact" steps there rather than slides.
