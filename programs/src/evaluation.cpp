@@ -596,10 +596,10 @@ class WorldReadings {
 
  private:
   // The toes' and hips' ground, probed from a metre above them (a joint with no ground under it
-  // within 3 m takes the ground under the root), and the ground under each foot from its toe to
-  // its heel, for the ground the foot rests on (foot_support_height). One call.
+  // within 3 m takes the ground under the root), and the ground under each foot
+  // (foot_support_points), for the ground the foot rests on (foot_support_height). One call.
   void read_ground(const ControllerDebug& d, EvaluationFrame& r) {
-    constexpr int kJoints = 3, kAlong = kFootSupportSamples;
+    constexpr int kJoints = 3, kAlong = kFootSupportProbes;
     const int joints[kJoints] = {toes_[0], toes_[1], roles_.hips};
     std::array<GroundProbe, kJoints + 2 * kAlong> probes;
     std::array<GroundHit, kJoints + 2 * kAlong> hits;
@@ -611,11 +611,8 @@ class WorldReadings {
     };
     for (int k = 0; k < kJoints; ++k) probes[k] = from_above(joint(joints[k]));
     for (int side = 0; side < 2; ++side) {
-      const glm::vec3 toe = joint(toes_[side]), heel = joint(heels_[side]);
-      for (int k = 0; k < kAlong; ++k) {
-        const float along = static_cast<float>(k + 1) / kAlong;
-        probes[kJoints + side * kAlong + k] = from_above(glm::mix(toe, heel, along));
-      }
+      const auto points = foot_support_points(joint(toes_[side]), joint(heels_[side]));
+      for (int k = 0; k < kAlong; ++k) probes[kJoints + side * kAlong + k] = from_above(points[k]);
     }
     world_->probe_ground(r.origin, probes, hits);
     float* out[kJoints] = {&r.toe_ground[0], &r.toe_ground[1], &r.hips_ground};

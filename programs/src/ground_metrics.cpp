@@ -68,6 +68,23 @@ float foot_support_height(float toe_ground, const GroundHit& under,
   return support;
 }
 
+std::array<glm::vec3, kFootSupportProbes> foot_support_points(const glm::vec3& toe,
+                                                              const glm::vec3& heel) {
+  std::array<glm::vec3, kFootSupportProbes> points;
+  for (int k = 0; k < kFootSupportSamples; ++k) {
+    points[static_cast<size_t>(k)] =
+        glm::mix(toe, heel, static_cast<float>(k + 1) / kFootSupportSamples);
+  }
+  const glm::vec2 forward(toe.x - heel.x, toe.z - heel.z);
+  const float length = glm::length(forward);
+  const glm::vec2 across =
+      length > 1e-4f ? glm::vec2(-forward.y, forward.x) / length : glm::vec2(1.0f, 0.0f);
+  const glm::vec3 side = kFootHalfWidth * glm::vec3(across.x, 0.0f, across.y);
+  points[kFootSupportSamples] = toe + side;
+  points[kFootSupportSamples + 1] = toe - side;
+  return points;
+}
+
 struct GroundAccumulator::State {
   JointRoleIndices roles;
   float dt = 0.0f;

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -128,6 +129,51 @@ TEST(GroundMetrics, AFootRestsOnAnEdgeUnderItNotOnItsSlope) {
   GroundHit bad_normal = floor;
   bad_normal.normal = glm::vec3(NAN);
   EXPECT_FLOAT_EQ(foot_support_height(0.0f, bad_normal, on_tread, 0.24f), 0.2f);
+}
+
+// The foot is probed from toe to heel and beside the toe: a foot standing level along a tread's
+// side, its toe joint just past the side, rests on the tread with the inside of its foot; a
+// whole half-foot past the side, it does not.
+TEST(GroundMetrics, AFootRestsOnATreadItsToeIsJustPastTheSideOf) {
+  // The tread: x < 0, 36 cm high; the floor elsewhere. The foot points along +z.
+  const auto ground = [](const glm::vec3& p) {
+    return ground_at(p.x, p.x < 0.0f ? 0.36f : 0.0f, p.z);
+  };
+  const auto support = [&](float toe_x) {
+    const glm::vec3 toe(toe_x, 0.43f, 0.0f), heel(toe_x, 0.48f, -0.15f);
+    std::array<GroundHit, kFootSupportProbes> hits;
+    const auto points = foot_support_points(toe, heel);
+    for (size_t k = 0; k < points.size(); ++k) hits[k] = ground(points[k]);
+    const GroundHit under = ground(toe);
+    return foot_support_height(under.point.y, under, hits, toe.y);
+  };
+  EXPECT_FLOAT_EQ(support(0.02f), 0.36f);
+  EXPECT_FLOAT_EQ(support(kFootHalfWidth + 0.01f), 0.0f);
+  EXPECT_FLOAT_EQ(support(-0.05f), 0.36f);  // on the tread: its own ground
+}
+
+// The probe points: evenly from toe to heel, the heel last; then a half-width to each side of
+// the toe, across the foot on the level (across x for a foot pointing straight down).
+TEST(GroundMetrics, FootSupportPointsRunToTheHeelAndBesideTheToe) {
+  const glm::vec3 toe(1.0f, 0.1f, 2.0f), heel(1.0f - 0.12f, 0.2f, 2.0f - 0.16f);
+  const auto points = foot_support_points(toe, heel);
+  for (int k = 0; k < kFootSupportSamples; ++k) {
+    const glm::vec3 expected =
+        toe + (heel - toe) * (static_cast<float>(k + 1) / kFootSupportSamples);
+    EXPECT_NEAR(glm::length(points[static_cast<size_t>(k)] - expected), 0.0f, 1e-6f) << k;
+  }
+  const glm::vec3 forward = glm::normalize(glm::vec3(toe.x - heel.x, 0.0f, toe.z - heel.z));
+  for (size_t k = kFootSupportSamples; k < points.size(); ++k) {
+    const glm::vec3 out = points[k] - toe;
+    EXPECT_NEAR(glm::length(out), kFootHalfWidth, 1e-6f) << k;
+    EXPECT_NEAR(glm::dot(out, forward), 0.0f, 1e-6f) << k;
+    EXPECT_FLOAT_EQ(out.y, 0.0f) << k;
+  }
+  EXPECT_NEAR(glm::length(points[kFootSupportSamples] - points[kFootSupportSamples + 1]),
+              2.0f * kFootHalfWidth, 1e-6f);
+  const auto down = foot_support_points(toe, toe + glm::vec3(0.0f, 0.2f, 0.0f));
+  EXPECT_NEAR(std::abs(down[kFootSupportSamples].x - toe.x), kFootHalfWidth, 1e-6f);
+  EXPECT_FLOAT_EQ(down[kFootSupportSamples].z, toe.z);
 }
 
 TEST(GroundMetrics, HipsHeightAboveTheirGroundAndVerticalAcceleration) {

@@ -18,7 +18,8 @@
 // - foot_float_cm_mean: the height of a toe whose contact label is on above the ground its foot
 //   rests on (PhysDiff's float: a planted foot hovering): the ground under the toe, or an edge
 //   under the foot that the toe is above (foot_support_height: a foot held level on a tread,
-//   its toe a centimetre past the tread's edge, rests on the tread, not on the floor below);
+//   its toe a centimetre past the tread's edge or its side, rests on the tread, not on the
+//   floor below);
 // - hips_height_cm_mean / _std: the hips' height above the ground under them;
 //   hips_vertical_accel_p99_m_s2: the p99 of the hips' vertical acceleration (second
 //   differences of their height above the world's y = 0);
@@ -32,6 +33,7 @@
 //   wall to slide along and is not counted, nor is a push into a concave corner, where the
 //   capsule swept along the wall meets another within a few centimetres.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -53,10 +55,13 @@ inline constexpr float kStraightKneeDegrees = 1.0f;
 inline constexpr float kStuckAlongSpeed = 0.2f;  // m/s of desired velocity along the obstacle
 inline constexpr float kStuckSpeed = 0.05f;      // m/s
 // Ground under a foot this much higher than the plane of the surface under its toe is an edge
-// the foot may rest on (m); the foot is probed at kFootSupportSamples points from the toe to the
-// heel (the ankle), evenly, the heel last.
+// the foot may rest on (m); the foot is probed at foot_support_points.
 inline constexpr float kFootEdgeRise = 0.01f;
-inline constexpr int kFootSupportSamples = 4;
+inline constexpr int kFootSupportSamples = 4;  // from the toe to the heel
+// Beside the toe, on either side, this far out (m): the ball of a foot is about three times as
+// wide, so a toe joint this far past a tread's side still has the inside of its foot on it.
+inline constexpr float kFootHalfWidth = 0.03f;
+inline constexpr int kFootSupportProbes = kFootSupportSamples + 2;
 inline constexpr float kNoSupport = std::numeric_limits<float>::infinity();
 
 struct GroundMetrics {
@@ -99,6 +104,13 @@ struct GroundFrame {
 // answers are ignored.
 float foot_support_height(float toe_ground, const GroundHit& under,
                           std::span<const GroundHit> along, float toe_y);
+
+// Where foot_support_height's `along` is probed for a foot: kFootSupportSamples points from the
+// toe to the heel (the ankle), evenly, the heel last, then one kFootHalfWidth to each side of the
+// toe, across the heel-to-toe line on the level (across x where the foot points straight up or
+// down).
+std::array<glm::vec3, kFootSupportProbes> foot_support_points(const glm::vec3& toe,
+                                                              const glm::vec3& heel);
 
 class GroundAccumulator {
  public:
