@@ -310,9 +310,11 @@ TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_EQ(r.output.rfind("usage: mm-viewer", 0), 0u) << r.output;
   for (const char* option :
-       {"--db",   "--data",  "--body",     "--weights",  "--skinning",  "--script",      "--record",
-        "--set",  "--debug", "--no-panel", "--headless", "--frames",    "--screenshot",  "--every",
-        "--plot", "--size",  "--dt",       "--crowd",    "--budget-ms", "--tier-colours"}) {
+       {"--db",        "--data",       "--body",         "--weights",   "--skinning",
+        "--script",    "--record",     "--set",          "--debug",     "--no-panel",
+        "--headless",  "--frames",     "--screenshot",   "--every",     "--plot",
+        "--size",      "--dt",         "--crowd",        "--budget-ms", "--tier-colours",
+        "--view-turn", "--view-pitch", "--view-distance"}) {
     EXPECT_NE(r.output.find(std::string("  ") + option + " "), std::string::npos) << option << "\n"
                                                                                   << r.output;
   }
@@ -326,6 +328,9 @@ TEST(ViewerCli, HelpListsEveryOptionAndTypedOptionsRefuseBadValues) {
       {" --dt nan", "--dt: 'nan' is not a finite number"},
       {" --dt 0", "--dt: 0 is outside [0.0001, 1]"},
       {" --dt 0.000001", "--dt: 0.000001 is outside [0.0001, 1]"},
+      {" --view-turn 200", "--view-turn: 200 is outside [-180, 180]"},
+      {" --view-pitch 90", "--view-pitch: 90 is outside [-5, 80]"},
+      {" --view-distance 0.5", "--view-distance: 0.5 is outside [1, 30]"},
       {" --size 640x10", "--size: '640x10' is not WxH"},
       {" --skinning fancy", "--skinning: fancy not in {lbs,dqs}"},
       {" --debug roots,sparkles", "--debug: 'roots,sparkles' is not a list of"},

@@ -44,6 +44,9 @@ Status prepare(Stage& stage, const ViewerOptions& options, Scene& scene) {
   stage.renderer.emplace(std::move(*renderer));
   stage.renderer->set_body_triangles(scene.body().mesh().mesh.indices);
   stage.camera.snap(scene.controller().root_transform().translation);
+  if (!std::isnan(options.view_pitch_deg))
+    stage.camera.pitch = glm::radians(options.view_pitch_deg);
+  if (!std::isnan(options.view_distance)) stage.camera.distance = options.view_distance;
   stage.panel.skinning = options.skinning;
   scene.toggles = options.toggles;
   return Status::success();
@@ -160,7 +163,7 @@ int run_headless(const ViewerOptions& options, Scene& scene) {
   for (int frame = 1; frame <= frames; ++frame) {
     const ControllerInput input = script->at(scene.time());
     scene.step(dt, input, stage.panel.skinning);
-    stage.camera.yaw = input.camera_yaw;
+    stage.camera.yaw = input.camera_yaw + glm::radians(options.view_turn_deg);
     stage.camera.follow(scene.controller().root_transform().translation, dt);
     const bool last = frame == frames;
     const bool every = options.every > 0 && frame % options.every == 0;
@@ -271,7 +274,7 @@ int run_windowed(const ViewerOptions& options, Scene& scene) {
     const ControllerDatabase& db = scene.controller().controller_database();
     if (script) {
       input = script->at(scene.time());
-      stage.camera.yaw = input.camera_yaw;
+      stage.camera.yaw = input.camera_yaw + glm::radians(options.view_turn_deg);
     } else {
       styles.poll(window, db, !ui_keyboard);
       styles.apply(input);

@@ -138,6 +138,21 @@ void add_run_options(CLI::App& app, ViewerOptions& out) {
           ""))
       ->type_name("WxH");
   cli::add_dt_option(app, out.dt, "default: the wall clock in a window, 1/60 headless");
+  // The picture only: a script's camera yaw still turns its stick input.
+  app.add_option(
+         "--view-turn", out.view_turn_deg,
+         "with --script, turn the camera about the character by DEG from the script's camera "
+         "(the picture only: the script's input is unchanged; default 0)")
+      ->check(cli::number_in(-180.0, 180.0))
+      ->type_name("DEG");
+  app.add_option("--view-pitch", out.view_pitch_deg,
+                 "the camera's downward pitch in degrees (default 17)")
+      ->check(cli::number_in(-5.0, 80.0))
+      ->type_name("DEG");
+  app.add_option("--view-distance", out.view_distance,
+                 "the camera's distance from the character in metres (default 3.6)")
+      ->check(cli::number_in(1.0, 30.0))
+      ->type_name("M");
 }
 
 // The crowd (crowd_run.hpp).

@@ -1,6 +1,7 @@
 #pragma once
 // The command line of mm-viewer (`mm-viewer --help`; declared in viewer_options.cpp).
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,11 @@ struct ViewerOptions {
   std::string plot_path;
   int width = 1280, height = 720;
   float dt = 0.0f;  // seconds per update; 0: the wall clock (windowed), 1/60 (headless)
+  // Where the camera looks from: turned about the character from the input's camera yaw, its
+  // pitch and distance (OrbitCamera's, in degrees and metres); NaN keeps the camera's own.
+  float view_turn_deg = 0.0f;
+  float view_pitch_deg = NAN;
+  float view_distance = NAN;
   bool panel = true;
   DebugToggles toggles;
   int crowd = 0;           // --crowd N: a crowd of N characters instead of one (crowd_run.hpp)
