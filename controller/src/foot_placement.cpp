@@ -40,11 +40,6 @@ constexpr int slot(int side, int which) {
 constexpr int now_of(int which) {
   return which % 2;
 }
-// The toe's footprint: its probes' directions from the toe, on the level (x, z).
-constexpr float kAround[FootPlacement::kFootprint][2] = {
-    {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
-// A footprint probe this close to the heel-to-toe direction (cosine) is in front of the toe.
-constexpr float kInFront = 0.5f;
 
 void follow_ground(float& height, float& velocity, float goal, float dt) {
   if (std::abs(goal - height) <= kStepChange && std::abs(velocity) * dt <= kStepChange) {
@@ -159,6 +154,8 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
       const glm::vec3& p = probe_points_[slot(side, which)];
       probes_[slot(side, which)] = GroundProbe{glm::vec3(p.x, top[side], p.z), reach[side], 0.0f};
     }
+    constexpr float kAround[kFootprint][2] = {
+        {1.0f, 0.0f}, {-1.0f, 0.0f}, {0.0f, 1.0f}, {0.0f, -1.0f}};
     for (int k = 0; k < kFootprint; ++k) {
       const glm::vec3 at(leg.toe.x + kFootprintRadius * kAround[k][0], top[side],
                          leg.toe.z + kFootprintRadius * kAround[k][1]);
@@ -176,30 +173,18 @@ float FootPlacement::found(int i, float body_ground, const FootPlacementSettings
 }
 
 // Around the toe, only an edge counts: ground above the plane of the surface under the toe (on a
-// slope the footprint's uphill side is only the slope, and would lift the toe off it). Nor does
-// an edge in front of the toe higher above the heel's ground than the foot can pitch up to
-// (max_foot_tilt): a riser the foot faces, its toe on the lower side; lifted onto the edge, the
-// whole foot hung in the air in front of the riser, the heel far above its ground.
+// slope the footprint's uphill side is only the slope, and would lift the toe off it).
 void FootPlacement::stand_on_edges(float body_ground, const FootPlacementSettings& settings) {
   for (int side = 0; side < 2; ++side) {
     const GroundHit& under = hits_[slot(side, kToe)];
     const glm::vec3 n = under.hit ? under.normal : glm::vec3(0.0f, 1.0f, 0.0f);
     float& toe = probe_grounds_[slot(side, kToe)].y;
-    const glm::vec3 along = probe_points_[slot(side, kToe)] - probe_points_[slot(side, kHeel)];
-    const glm::vec2 forward(along.x, along.z);
-    const float forward_length = glm::length(forward);
-    const float highest_in_front =
-        probe_grounds_[slot(side, kHeel)].y + glm::length(along) * std::tan(settings.max_foot_tilt);
     const float plane_rise =
         kFootprintRadius * std::sqrt(std::max(0.0f, 1.0f - n.y * n.y)) / std::max(n.y, 0.1f);
     float edge = toe;
     for (int k = 0; k < kFootprint; ++k) {
       const float y = found(kProbes + side * kFootprint + k, body_ground, settings);
-      if (y <= toe + plane_rise + kEdgeRise) continue;
-      const bool in_front =
-          glm::dot(glm::vec2(kAround[k][0], kAround[k][1]), forward) > kInFront * forward_length;
-      if (in_front && y > highest_in_front) continue;
-      edge = std::max(edge, y);
+      if (y > toe + plane_rise + kEdgeRise) edge = std::max(edge, y);
     }
     toe = edge;
   }
