@@ -17,9 +17,11 @@ namespace {
 // slope, over bumps: a spring would lag behind a slope and land the foot above or in it), and
 // on a spring across a step (a tread's edge: the foot would pop). The spring rises faster
 // than it sinks: a toe late onto a tread is inside its riser, one late off it only hovers.
-constexpr float kStepChange = 0.06f;    // m in one update: a step, not a slope
-constexpr float kRiseHalflife = 0.02f;  // s
-constexpr float kFallHalflife = 0.06f;  // s
+// The goal's change is measured as a speed, so that the same ground is followed the same way
+// at every update rate (6 cm an update at 1/30 s; the same 6 cm at 1/144 s is a step).
+constexpr float kStepChangeSpeed = 1.8f;  // m/s: a step, not a slope
+constexpr float kRiseHalflife = 0.02f;    // s
+constexpr float kFallHalflife = 0.06f;    // s
 // How far above the highest walkable step a probe starts (m): the point it starts from is
 // never inside that step.
 constexpr float kProbeMargin = 0.02f;
@@ -42,12 +44,21 @@ constexpr int now_of(int which) {
 }
 
 void follow_ground(float& height, float& velocity, float goal, float dt) {
-  if (std::abs(goal - height) <= kStepChange && std::abs(velocity) * dt <= kStepChange) {
+  const float step_change = kStepChangeSpeed * dt;
+  if (std::abs(goal - height) <= step_change && std::abs(velocity) <= kStepChangeSpeed) {
     height = goal;
     velocity = 0.0f;
     return;
   }
   critical_spring_update(height, velocity, goal, goal > height ? kRiseHalflife : kFallHalflife, dt);
+}
+
+// A ground height held at or above `floor`: lifted onto it, the spring goes on from rest there
+// (with the speed it had, it would overshoot the floor and the goal).
+void stay_above(float& height, float& velocity, float floor) {
+  if (height >= floor) return;
+  height = floor;
+  velocity = 0.0f;
 }
 
 }  // namespace
@@ -75,12 +86,13 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     Foot& foot = feet_[side];
     follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
     follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
-    // The ground under heel and toe now is a floor the spring never lags under. Across a step
-    // the look-ahead sees the tread first, but a toe swinging over a tread's front corner toward
-    // its side (circling onto stairs, the look-ahead already beside them) reaches the tread the
-    // update it is over it, and the spring left it inside the tread's side (up to 3.9 cm).
-    foot.ground.heel = std::max(foot.ground.heel, probe_grounds_[slot(side, kHeel)].y);
-    foot.ground.toe = std::max(foot.ground.toe, probe_grounds_[slot(side, kToe)].y);
+    // The ground under the toe now is a floor the spring never lags under. Across a step the
+    // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
+    // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
+    // update it is over it, and the spring left it inside the tread's side (up to 3.9 cm). Not
+    // the heel's: a foot turning on its toe at a tread's edge has its ankle cross the edge, and
+    // the heel's ground jumped a whole step in an update, popping the leg straight.
+    stay_above(foot.ground.toe, foot.velocity.toe, probe_grounds_[slot(side, kToe)].y);
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.

@@ -115,6 +115,34 @@ TEST(FootPlacement, AToeAtATreadsEdgeStandsOnTheTreadNotBelowItsEdge) {
   }
 }
 
+// Ground rising under a standing foot by a step (a block slid under it): the heel's ground
+// follows on its spring, never a whole step in one update (a foot turning on its toe at a
+// tread's edge had its heel pop up a step, the leg with it); the toe's stands on the ground
+// under it at once. A rise slower than kStepChangeSpeed (a slope walked up) is followed at once,
+// at every update rate: 5 cm in an update is a slope at 1/30 s but a step at 1/60 and 1/144.
+TEST(FootPlacement, ARiseUnderTheHeelIsFollowedOnItsSpringAtEveryRate) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    for (const float rise : {0.05f, 0.15f}) {
+      AnalyticWorld world;
+      CharacterMover mover;
+      FootPlacement p;
+      const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
+                                             standing_leg(0.1f, 0.0f, 0.0f)};
+      settle(p, world, mover, legs, 0.0f);
+      world.boxes.push_back(AnalyticBox{glm::vec2(0.0f), glm::vec2(2.0f), 0.0f, rise});
+      p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+               dt);
+      EXPECT_NEAR(p.ground(0).toe, rise, 1e-4f) << dt << " " << rise;
+      if (rise <= 1.8f * dt) {
+        EXPECT_NEAR(p.ground(0).heel, rise, 1e-4f) << dt << " " << rise;
+      } else {
+        EXPECT_GT(p.ground(0).heel, 0.0f) << dt << " " << rise;
+        EXPECT_LT(p.ground(0).heel, rise - 0.01f) << dt << " " << rise;
+      }
+    }
+  }
+}
+
 TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
   // The body stands on a block whose edge is at z = 0.1, the toes beyond it: a 0.45 m drop is a
   // ledge (deeper than step_height, 0.35), a 0.2 m one a step the foot goes down to.
