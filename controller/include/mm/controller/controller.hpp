@@ -299,7 +299,7 @@ struct ControllerSettings {
   // leg's reach; during a contact it then steps (lifted) to the animation.
   float foot_unlock_radius = 0.5f;
   // A released foot eases back onto the animation with this halflife (s).
-  float foot_lock_release_halflife = 0.1f;
+  float foot_lock_release_halflife = 0.06f;
   // Passes of the distance-constraint solver that restores the leg's bone lengths.
   int bone_length_iterations = 2;
 
