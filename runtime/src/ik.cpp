@@ -6,6 +6,7 @@
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/transform_sse.hpp"
 
 namespace mm {
 
@@ -309,7 +310,7 @@ TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
       continue;
     }
     const size_t j = static_cast<size_t>(i);
-    global[j] = compose(global[static_cast<size_t>(parents[j])], local[j]);
+    sse::compose_into(global[static_cast<size_t>(parents[j])], local[j], global[j]);
   }
   return r;
 }
