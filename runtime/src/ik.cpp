@@ -72,7 +72,17 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
 }
 
 // A quaternion product and a rotated vector in GLM's formulas, always inlined: the solve's few
-// products and rotations were calls to GLM's out-of-line copies.
+// products and rotations were calls to GLM's out-of-line copies. With SSE2 in registers
+// (transform_sse.hpp: the same bits).
+#if defined(__SSE2__)
+[[gnu::always_inline]] inline glm::quat mul(const glm::quat& p, const glm::quat& q) {
+  return sse::to_quat(sse::product(sse::load(p), sse::load(q)));
+}
+
+[[gnu::always_inline]] inline glm::vec3 rotate(const glm::quat& q, const glm::vec3& v) {
+  return sse::to_vec3(sse::rotate(sse::load(q), sse::load(v)));
+}
+#else
 [[gnu::always_inline]] inline glm::quat mul(const glm::quat& p, const glm::quat& q) {
   return glm::quat(
       p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
@@ -85,6 +95,7 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
   const glm::vec3 uuv = glm::cross(u, uv);
   return v + ((uv * q.w) + uuv) * 2.0f;
 }
+#endif
 
 // The rotation that takes the orthonormal pair (u, n) to the orthonormal pair (u2, n2) (and so
 // u x n to u2 x n2): the product of the two frames' matrices, one transposed, as a quaternion.
@@ -261,12 +272,27 @@ TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform
     result.mid_local = local[m].rotation;
     return result;
   }
+#if defined(__SSE2__)
+  // The same products and normalizations in SSE registers (transform_sse.hpp: the same bits).
+  const __m128 parent_rotation = sse::load(in.root_parent_rotation);
+  const __m128 root_rotation = sse::load(in.root.rotation);
+  const __m128 root_local = sse::normalize(sse::product(
+      sse::conjugate(parent_rotation), sse::product(sse::load(t.hip_turn), root_rotation)));
+  sse::store(root_local, local[r].rotation);
+  sse::store(sse::normalize(
+                 sse::product(sse::conjugate(root_rotation),
+                              sse::product(sse::load(t.knee_bend), sse::load(in.mid.rotation)))),
+             local[m].rotation);
+  sse::store(root_parent >= 0 ? sse::product(parent_rotation, root_local) : root_local,
+             global[r].rotation);
+#else
   local[r].rotation = glm::normalize(
       mul(glm::conjugate(in.root_parent_rotation), mul(t.hip_turn, in.root.rotation)));
   local[m].rotation =
       glm::normalize(mul(glm::conjugate(in.root.rotation), mul(t.knee_bend, in.mid.rotation)));
   global[r].rotation =
       root_parent >= 0 ? mul(in.root_parent_rotation, local[r].rotation) : local[r].rotation;
+#endif
   result.root_local = local[r].rotation;
   result.mid_local = local[m].rotation;
   result.reached = t.reached;
