@@ -147,6 +147,14 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
 
 void CriticalSpringScalarCache::update(float& x, float& v, float goal, float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
+  // At rest on its goal the step's arithmetic is all zeros, settled to +0: the result is the
+  // goal (goal + 0 makes a -0 goal +0, as apply_scalar's double sum does) and no velocity. Held
+  // feet and settled lifts sit there most updates.
+  if (x == goal && v == 0.0f) {
+    x = goal + 0.0f;
+    v = 0.0f;
+    return;
+  }
   if (key_.changed(halflife, dt)) {
     const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
     xx_ = c.xx;
@@ -177,6 +185,14 @@ CriticalSpringStep critical_spring_step(float halflife, float dt) {
 void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
                            const CriticalSpringStep& step) {
   if (!step.moves || !finite(goal)) return;
+  // At rest on its goal: settled zeros, so the goal (a -0 component made +0) and no velocity,
+  // without the arithmetic (a released foot's offset sits there once it has decayed, a held
+  // foot's always).
+  if (x == goal && v == glm::vec3(0.0f)) {
+    x = goal + glm::vec3(0.0f);
+    v = glm::vec3(0.0f);
+    return;
+  }
   const glm::vec3 j0 = x - goal;
   const glm::vec3 v0 = v;
   x = goal + settled(step.xx * j0 + step.xv * v0);
