@@ -115,6 +115,28 @@ struct ChainTurns {
   bool reached = false;
 };
 
+// Whether every value the solve reads is finite (the end's rotation it does not read). With
+// SSE2 one check of a register instead of a compare and a branch per component: a finite value
+// times zero is a zero, an infinity or a NaN times zero is a NaN, and a sum with a NaN is NaN.
+bool input_finite(const TwoBoneIkInput& in) {
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps();
+  __m128 sum = _mm_mul_ps(sse::load(in.root.rotation), zero);
+  for (const __m128 value : {sse::load(in.mid.rotation), sse::load(in.root_parent_rotation),
+                             sse::load(in.root.translation), sse::load(in.mid.translation),
+                             sse::load(in.end.translation), sse::load(in.target),
+                             sse::load(in.pole), _mm_set_ss(in.extension_epsilon)}) {
+    sum = _mm_add_ps(sum, _mm_mul_ps(value, zero));
+  }
+  return _mm_movemask_ps(_mm_cmpunord_ps(sum, sum)) == 0;
+#else
+  return finite(in.root.translation) && finite(in.mid.translation) && finite(in.end.translation) &&
+         finite(in.target) && finite(in.pole) && finite(in.root.rotation) &&
+         finite(in.mid.rotation) && finite(in.root_parent_rotation) &&
+         std::isfinite(in.extension_epsilon);
+#endif
+}
+
 // False for zero-length bones or non-finite input (the chain is then left as it is).
 bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 a = in.root.translation;
@@ -126,9 +148,7 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 ac = c - a;
   const float upper = glm::length(ab);  // glm::distance(a, b) is this length
   const float lower = glm::distance(b, c);
-  if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
-      !finite(in.root.rotation) || !finite(in.mid.rotation) || !finite(in.root_parent_rotation) ||
-      !std::isfinite(in.extension_epsilon) || upper < kMinBoneLength || lower < kMinBoneLength) {
+  if (!input_finite(in) || upper < kMinBoneLength || lower < kMinBoneLength) {
     return false;
   }
 
