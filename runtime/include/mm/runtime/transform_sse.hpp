@@ -54,9 +54,11 @@ inline glm::quat to_quat(__m128 q) {
   return out;
 }
 
+// The lanes a, b, c, d of v. pshufd writes a register other than its source, where shufps
+// overwrites its first operand and so needs a copy first whenever v is used again.
 template <int a, int b, int c, int d>
 inline __m128 lanes(__m128 v) {
-  return _mm_shuffle_ps(v, v, _MM_SHUFFLE(d, c, b, a));
+  return _mm_castsi128_ps(_mm_shuffle_epi32(_mm_castps_si128(v), _MM_SHUFFLE(d, c, b, a)));
 }
 
 inline __m128 broadcast_w(__m128 q) {
