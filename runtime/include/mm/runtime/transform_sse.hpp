@@ -36,9 +36,10 @@ inline void store(__m128 q, glm::quat& out) {
   _mm_storeu_ps(&out.x, q);
 }
 
-// A vector's three floats (twelve bytes read, no more).
+// A vector's three floats (twelve bytes read, no more). x and y are read as one 64-bit lane
+// through __m128i, a type that may alias the floats (a double read would not be).
 inline __m128 load(const glm::vec3& v) {
-  const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(&v.x)));
+  const __m128 xy = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&v.x)));
   return _mm_movelh_ps(xy, _mm_load_ss(&v.z));
 }
 
