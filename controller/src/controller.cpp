@@ -17,6 +17,7 @@
 #include "mm/runtime/pose.hpp"
 #include "mm/runtime/skinning.hpp"
 #include "mm/runtime/spring.hpp"
+#include "mm/runtime/transform_sse.hpp"
 
 #include "mm/controller/style_search.hpp"
 
@@ -134,13 +135,32 @@ constexpr float kFloorSoftness = 0.005f;
 // line: enough to decide for a straight leg, small beside the bend of a walking knee.
 constexpr float kKneeForwardBias = 0.05f;
 
-// GLM's quaternion product, always inlined: reach's products were out-of-line calls, or not,
-// as the inliner's budget for this file fell, and its register use changed with each.
+// GLM's quaternion product, normalization and rotation of a vector, always inlined: reach's
+// products were out-of-line calls, or not, as the inliner's budget for this file fell, and its
+// register use changed with each. With SSE2 in registers (transform_sse.hpp: the same bits).
+#if defined(__SSE2__)
+[[gnu::always_inline]] inline glm::quat product(const glm::quat& p, const glm::quat& q) {
+  return sse::to_quat(sse::product(sse::load(p), sse::load(q)));
+}
+[[gnu::always_inline]] inline glm::quat normalized(const glm::quat& q) {
+  return sse::to_quat(sse::normalize(sse::load(q)));
+}
+[[gnu::always_inline]] inline glm::vec3 rotated(const glm::quat& q, const glm::vec3& v) {
+  return sse::to_vec3(sse::rotate(sse::load(q), sse::load(v)));
+}
+#else
 [[gnu::always_inline]] inline glm::quat product(const glm::quat& p, const glm::quat& q) {
   return glm::quat(
       p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
       p.w * q.y + p.y * q.w + p.z * q.x - p.x * q.z, p.w * q.z + p.z * q.w + p.x * q.y - p.y * q.x);
 }
+inline glm::quat normalized(const glm::quat& q) {
+  return glm::normalize(q);
+}
+inline glm::vec3 rotated(const glm::quat& q, const glm::vec3& v) {
+  return q * v;
+}
+#endif
 
 // `keep_animated` in [0, 1] is how much of the animation's own extension beyond kSoftReach is
 // kept (1 standing, 0 in motion, eased between, so the reach never jumps).
@@ -1440,14 +1460,15 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // a world pitched to its ground: foot_placement.hpp) puts it above the target toe.
   glm::quat swivel = yaw_rotation(feet_[side].heading_offset);
   if (world_) {
-    const glm::vec3 along = swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
+    const glm::vec3 along =
+        rotated(swivel, animated - globals_[static_cast<size_t>(foot)].translation);
     swivel = product(foot_placement_.tilt(side, along, settings_.max_foot_tilt), swivel);
   }
   const glm::quat foot_rotation =
-      glm::normalize(product(swivel, globals_[static_cast<size_t>(foot)].rotation));
+      normalized(product(swivel, globals_[static_cast<size_t>(foot)].rotation));
   const glm::vec3 hip_position = globals_[static_cast<size_t>(hip)].translation;
   glm::vec3 ankle_target =
-      target - swivel * (animated - globals_[static_cast<size_t>(foot)].translation);
+      target - rotated(swivel, animated - globals_[static_cast<size_t>(foot)].translation);
   const float animated_reach =
       glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
   glm::vec3 reached =
@@ -1468,7 +1489,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
     }
     if (f.heel_rise > 0.0f) {
       heel_rise = glm::angleAxis(f.heel_rise, f.heel_axis);
-      reached = target + heel_rise * (ankle_target - target) - hip_position;
+      reached = target + rotated(heel_rise, ankle_target - target) - hip_position;
       reached *= std::min(1.0f, length / glm::length(reached));
     }
   }
@@ -1478,7 +1499,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // so the character's forward breaks the tie.
   const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
                          0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
-                         kKneeForwardBias * (globals_[0].rotation * kForward);
+                         kKneeForwardBias * rotated(globals_[0].rotation, kForward);
   // The foot's subtree is refreshed once, below, after its rotation is set.
   const TwoBoneIkResult solved =
       apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
@@ -1487,14 +1508,14 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // local one: the toe's turn below is then the foot's rotation undone by itself.
   const bool heel_lifted = heel_rise != glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   const glm::quat raised_foot =
-      heel_lifted ? glm::normalize(product(heel_rise, foot_rotation)) : foot_rotation;
-  locals_[static_cast<size_t>(foot)].rotation = glm::normalize(
+      heel_lifted ? normalized(product(heel_rise, foot_rotation)) : foot_rotation;
+  locals_[static_cast<size_t>(foot)].rotation = normalized(
       product(glm::conjugate(globals_[static_cast<size_t>(knee)].rotation), raised_foot));
   // The toe stays flat on the ground while the heel rises: it bends at the ball of the foot.
   if (leg[3] >= 0 && heel_lifted) {
     Transform& toe = locals_[static_cast<size_t>(leg[3])];
     toe.rotation =
-        glm::normalize(product(product(glm::conjugate(raised_foot), foot_rotation), toe.rotation));
+        normalized(product(product(glm::conjugate(raised_foot), foot_rotation), toe.rotation));
   }
   refresh_subtree(foot);
   // A solve that reached its target unclamped turned the bones only, so their lengths hold and
@@ -1562,14 +1583,19 @@ float Controller::leg_length(int side) const {
          glm::length(locals_[static_cast<size_t>(leg[2])].translation);
 }
 
+// The globals of a joint and its descendants from their locals, each compose in SSE registers
+// (transform_sse.hpp: the same bits as compose's scalar code, in fewer instructions).
 void Controller::refresh_subtree(int joint) {
   const std::span<const int> parents = db_->skeleton().parents();
   const int end = joint + db_->skeleton().subtree_size(joint);
   for (int j = joint; j < end; ++j) {
     const int p = parents[static_cast<size_t>(j)];
-    globals_[static_cast<size_t>(j)] =
-        p < 0 ? locals_[static_cast<size_t>(j)]
-              : compose(globals_[static_cast<size_t>(p)], locals_[static_cast<size_t>(j)]);
+    if (p < 0) {
+      globals_[static_cast<size_t>(j)] = locals_[static_cast<size_t>(j)];
+    } else {
+      sse::compose_into(globals_[static_cast<size_t>(p)], locals_[static_cast<size_t>(j)],
+                        globals_[static_cast<size_t>(j)]);
+    }
   }
 }
 

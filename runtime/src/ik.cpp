@@ -6,6 +6,7 @@
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/transform_sse.hpp"
 
 namespace mm {
 
@@ -71,7 +72,17 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
 }
 
 // A quaternion product and a rotated vector in GLM's formulas, always inlined: the solve's few
-// products and rotations were calls to GLM's out-of-line copies.
+// products and rotations were calls to GLM's out-of-line copies. With SSE2 in registers
+// (transform_sse.hpp: the same bits).
+#if defined(__SSE2__)
+[[gnu::always_inline]] inline glm::quat mul(const glm::quat& p, const glm::quat& q) {
+  return sse::to_quat(sse::product(sse::load(p), sse::load(q)));
+}
+
+[[gnu::always_inline]] inline glm::vec3 rotate(const glm::quat& q, const glm::vec3& v) {
+  return sse::to_vec3(sse::rotate(sse::load(q), sse::load(v)));
+}
+#else
 [[gnu::always_inline]] inline glm::quat mul(const glm::quat& p, const glm::quat& q) {
   return glm::quat(
       p.w * q.w - p.x * q.x - p.y * q.y - p.z * q.z, p.w * q.x + p.x * q.w + p.y * q.z - p.z * q.y,
@@ -84,6 +95,7 @@ glm::vec3 perpendicular(const glm::vec3& u, const glm::vec3& hint) {
   const glm::vec3 uuv = glm::cross(u, uv);
   return v + ((uv * q.w) + uuv) * 2.0f;
 }
+#endif
 
 // The rotation that takes the orthonormal pair (u, n) to the orthonormal pair (u2, n2) (and so
 // u x n to u2 x n2): the product of the two frames' matrices, one transposed, as a quaternion.
@@ -103,6 +115,28 @@ struct ChainTurns {
   bool reached = false;
 };
 
+// Whether every value the solve reads is finite (the end's rotation it does not read). With
+// SSE2 one check of a register instead of a compare and a branch per component: a finite value
+// times zero is a zero, an infinity or a NaN times zero is a NaN, and a sum with a NaN is NaN.
+bool input_finite(const TwoBoneIkInput& in) {
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps();
+  __m128 sum = _mm_mul_ps(sse::load(in.root.rotation), zero);
+  for (const __m128 value : {sse::load(in.mid.rotation), sse::load(in.root_parent_rotation),
+                             sse::load(in.root.translation), sse::load(in.mid.translation),
+                             sse::load(in.end.translation), sse::load(in.target),
+                             sse::load(in.pole), _mm_set_ss(in.extension_epsilon)}) {
+    sum = _mm_add_ps(sum, _mm_mul_ps(value, zero));
+  }
+  return _mm_movemask_ps(_mm_cmpunord_ps(sum, sum)) == 0;
+#else
+  return finite(in.root.translation) && finite(in.mid.translation) && finite(in.end.translation) &&
+         finite(in.target) && finite(in.pole) && finite(in.root.rotation) &&
+         finite(in.mid.rotation) && finite(in.root_parent_rotation) &&
+         std::isfinite(in.extension_epsilon);
+#endif
+}
+
 // False for zero-length bones or non-finite input (the chain is then left as it is).
 bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 a = in.root.translation;
@@ -114,9 +148,7 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   const glm::vec3 ac = c - a;
   const float upper = glm::length(ab);  // glm::distance(a, b) is this length
   const float lower = glm::distance(b, c);
-  if (!finite(a) || !finite(b) || !finite(c) || !finite(in.target) || !finite(in.pole) ||
-      !finite(in.root.rotation) || !finite(in.mid.rotation) || !finite(in.root_parent_rotation) ||
-      !std::isfinite(in.extension_epsilon) || upper < kMinBoneLength || lower < kMinBoneLength) {
+  if (!input_finite(in) || upper < kMinBoneLength || lower < kMinBoneLength) {
     return false;
   }
 
@@ -260,12 +292,27 @@ TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform
     result.mid_local = local[m].rotation;
     return result;
   }
+#if defined(__SSE2__)
+  // The same products and normalizations in SSE registers (transform_sse.hpp: the same bits).
+  const __m128 parent_rotation = sse::load(in.root_parent_rotation);
+  const __m128 root_rotation = sse::load(in.root.rotation);
+  const __m128 root_local = sse::normalize(sse::product(
+      sse::conjugate(parent_rotation), sse::product(sse::load(t.hip_turn), root_rotation)));
+  sse::store(root_local, local[r].rotation);
+  sse::store(sse::normalize(
+                 sse::product(sse::conjugate(root_rotation),
+                              sse::product(sse::load(t.knee_bend), sse::load(in.mid.rotation)))),
+             local[m].rotation);
+  sse::store(root_parent >= 0 ? sse::product(parent_rotation, root_local) : root_local,
+             global[r].rotation);
+#else
   local[r].rotation = glm::normalize(
       mul(glm::conjugate(in.root_parent_rotation), mul(t.hip_turn, in.root.rotation)));
   local[m].rotation =
       glm::normalize(mul(glm::conjugate(in.root.rotation), mul(t.knee_bend, in.mid.rotation)));
   global[r].rotation =
       root_parent >= 0 ? mul(in.root_parent_rotation, local[r].rotation) : local[r].rotation;
+#endif
   result.root_local = local[r].rotation;
   result.mid_local = local[m].rotation;
   result.reached = t.reached;
@@ -309,7 +356,7 @@ TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
       continue;
     }
     const size_t j = static_cast<size_t>(i);
-    global[j] = compose(global[static_cast<size_t>(parents[j])], local[j]);
+    sse::compose_into(global[static_cast<size_t>(parents[j])], local[j], global[j]);
   }
   return r;
 }

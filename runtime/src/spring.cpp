@@ -8,6 +8,7 @@
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/interpolation.hpp"
+#include "mm/runtime/transform_sse.hpp"
 
 namespace mm {
 
@@ -27,6 +28,14 @@ glm::vec3 settled(const glm::vec3& v) {
   auto component = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
   return {component(v.x), component(v.y), component(v.z)};
 }
+
+#if defined(__SSE2__)
+// The same of each lane: +0 where the magnitude is below kSpringNegligible (a NaN is kept).
+__m128 settled(__m128 v) {
+  const __m128 magnitude = _mm_andnot_ps(_mm_set1_ps(-0.0f), v);
+  return _mm_andnot_ps(_mm_cmplt_ps(magnitude, _mm_set1_ps(kSpringNegligible)), v);
+}
+#endif
 
 double angular_frequency(float halflife) {
   return static_cast<double>(kHalflifeFrequencyFactor) /
@@ -147,6 +156,14 @@ void critical_spring_update(float& x, float& v, float goal, float halflife, floa
 
 void CriticalSpringScalarCache::update(float& x, float& v, float goal, float halflife, float dt) {
   if (!(dt > 0.0f) || !usable(halflife, dt) || !std::isfinite(goal)) return;
+  // At rest on its goal the step's arithmetic is all zeros, settled to +0: the result is the
+  // goal (goal + 0 makes a -0 goal +0, as apply_scalar's double sum does) and no velocity. Held
+  // feet and settled lifts sit there most updates.
+  if (x == goal && v == 0.0f) {
+    x = goal + 0.0f;
+    v = 0.0f;
+    return;
+  }
   if (key_.changed(halflife, dt)) {
     const SpringCoefficients c = spring_coefficients(angular_frequency(halflife), dt);
     xx_ = c.xx;
@@ -177,10 +194,30 @@ CriticalSpringStep critical_spring_step(float halflife, float dt) {
 void critical_spring_apply(glm::vec3& x, glm::vec3& v, const glm::vec3& goal,
                            const CriticalSpringStep& step) {
   if (!step.moves || !finite(goal)) return;
+  // At rest on its goal: settled zeros, so the goal (a -0 component made +0) and no velocity,
+  // without the arithmetic (a released foot's offset sits there once it has decayed, a held
+  // foot's always).
+  if (x == goal && v == glm::vec3(0.0f)) {
+    x = goal + glm::vec3(0.0f);
+    v = glm::vec3(0.0f);
+    return;
+  }
+#if defined(__SSE2__)
+  // The same in SSE registers, lane by lane in GLM's order (transform_sse.hpp).
+  const __m128 g = sse::load(goal), v0 = sse::load(v);
+  const __m128 j0 = _mm_sub_ps(sse::load(x), g);
+  const __m128 moved =
+      _mm_add_ps(_mm_mul_ps(_mm_set1_ps(step.xx), j0), _mm_mul_ps(_mm_set1_ps(step.xv), v0));
+  const __m128 rate =
+      _mm_add_ps(_mm_mul_ps(_mm_set1_ps(step.vx), j0), _mm_mul_ps(_mm_set1_ps(step.vv), v0));
+  x = sse::to_vec3(_mm_add_ps(g, settled(moved)));
+  v = sse::to_vec3(settled(rate));
+#else
   const glm::vec3 j0 = x - goal;
   const glm::vec3 v0 = v;
   x = goal + settled(step.xx * j0 + step.xv * v0);
   v = settled(step.vx * j0 + step.vv * v0);
+#endif
 }
 
 void critical_spring_update(glm::quat& rotation, glm::vec3& angular_velocity, const glm::quat& goal,

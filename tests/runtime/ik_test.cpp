@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -228,6 +229,51 @@ TEST(TwoBoneIk, DegenerateInputsNeverGiveNaN) {
     ASSERT_TRUE(finite_result(r));
     EXPECT_TRUE(near_vec3(r.end_position, leg.global[Leg::kAnkle].translation, 0.0f));
   }
+}
+
+// Every component the solve reads, made NaN or infinite in turn, leaves the chain as it was; the
+// end's rotation and the joints' scales, which it does not read, do not stop it.
+TEST(TwoBoneIk, AnyNonFiniteInputComponentLeavesTheChain) {
+  Leg leg(0.45f, 0.42f, true);
+  const glm::vec3 target = leg.global[Leg::kHip].translation + glm::vec3(0.1f, -0.6f, 0.1f);
+  const TwoBoneIkInput good = leg.input(target, {0, 0, 1});
+  const auto components = [](TwoBoneIkInput& in) {
+    std::vector<float*> c;
+    for (glm::quat* q : {&in.root.rotation, &in.mid.rotation, &in.root_parent_rotation}) {
+      for (int i = 0; i < 4; ++i) c.push_back(&(*q)[i]);
+    }
+    for (glm::vec3* v :
+         {&in.root.translation, &in.mid.translation, &in.end.translation, &in.target, &in.pole}) {
+      for (int i = 0; i < 3; ++i) c.push_back(&(*v)[i]);
+    }
+    c.push_back(&in.extension_epsilon);
+    return c;
+  };
+  const size_t count = [&] {
+    TwoBoneIkInput in = good;
+    return components(in).size();
+  }();
+  for (size_t k = 0; k < count; ++k) {
+    for (const float bad :
+         {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+          -std::numeric_limits<float>::infinity()}) {
+      SCOPED_TRACE(testing::Message() << "component " << k << " = " << bad);
+      TwoBoneIkInput in = good;
+      *components(in)[k] = bad;
+      const TwoBoneIkResult r = solve_two_bone_ik(in);
+      EXPECT_FALSE(r.reached);
+      // The input's own bits (a NaN is not equal to itself).
+      EXPECT_EQ(std::memcmp(&r.root_global, &in.root.rotation, sizeof(glm::quat)), 0);
+      EXPECT_EQ(std::memcmp(&r.mid_global, &in.mid.rotation, sizeof(glm::quat)), 0);
+    }
+  }
+  TwoBoneIkInput unread = good;
+  unread.end.rotation.x = std::numeric_limits<float>::quiet_NaN();
+  unread.root.scale.x = unread.mid.scale.x = unread.end.scale.x =
+      std::numeric_limits<float>::infinity();
+  const TwoBoneIkResult r = solve_two_bone_ik(unread);
+  EXPECT_TRUE(r.reached);
+  EXPECT_TRUE(near_vec3(r.end_position, target, 1e-4f));
 }
 
 TEST(TwoBoneIk, StraightStartingLimbBendsTowardThePole) {

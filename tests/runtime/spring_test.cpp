@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include <glm/gtc/constants.hpp>
@@ -589,6 +590,72 @@ TEST(CriticalSpringScalarCache, EqualsCriticalSpringUpdateAndFollowsChanges) {
     cache.update(x, v, goal, halflife, dt);
     EXPECT_EQ(std::bit_cast<uint32_t>(x), std::bit_cast<uint32_t>(expected_x));
     EXPECT_EQ(std::bit_cast<uint32_t>(v), std::bit_cast<uint32_t>(expected_v));
+  }
+}
+
+// A spring at rest on its goal (its offset and velocity zero, either sign) takes a shortcut; its
+// result is the full step's to the bit: the scalar one against the uncached update, the vector
+// one against the step's formula written out here.
+TEST(CriticalSpring, AtRestOnTheGoalEqualsTheFullStepToTheBit) {
+  const auto settled = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
+  const float halflife = 0.1f, dt = 1.0f / 60.0f;
+  const CriticalSpringStep step = critical_spring_step(halflife, dt);
+  for (const float goal : {0.0f, -0.0f, 1.5f, -2.0f}) {
+    for (const float x0 : {goal, goal == 0.0f ? -goal : goal}) {
+      for (const float v0 : {0.0f, -0.0f}) {
+        SCOPED_TRACE(testing::Message() << "goal " << goal << ", x " << x0 << ", v " << v0);
+        CriticalSpringScalarCache cache;
+        float x = x0, v = v0, expected_x = x0, expected_v = v0;
+        critical_spring_update(expected_x, expected_v, goal, halflife, dt);
+        cache.update(x, v, goal, halflife, dt);
+        EXPECT_EQ(std::bit_cast<uint32_t>(x), std::bit_cast<uint32_t>(expected_x));
+        EXPECT_EQ(std::bit_cast<uint32_t>(v), std::bit_cast<uint32_t>(expected_v));
+
+        const glm::vec3 goal3(goal, 0.25f, goal), v3(v0, 0.0f, v0);
+        glm::vec3 x3(x0, 0.25f, x0), velocity3 = v3;
+        const glm::vec3 j0 = x3 - goal3;
+        const glm::vec3 moved = step.xx * j0 + step.xv * v3;
+        const glm::vec3 rate = step.vx * j0 + step.vv * v3;
+        const glm::vec3 expected_x3 =
+            goal3 + glm::vec3(settled(moved.x), settled(moved.y), settled(moved.z));
+        const glm::vec3 expected_v3(settled(rate.x), settled(rate.y), settled(rate.z));
+        critical_spring_apply(x3, velocity3, goal3, step);
+        for (int i = 0; i < 3; ++i) {
+          EXPECT_EQ(std::bit_cast<uint32_t>(x3[i]), std::bit_cast<uint32_t>(expected_x3[i]));
+          EXPECT_EQ(std::bit_cast<uint32_t>(velocity3[i]), std::bit_cast<uint32_t>(expected_v3[i]));
+        }
+      }
+    }
+  }
+}
+
+// critical_spring_apply (in SSE registers where built with SSE2) against the step's formula
+// written out in GLM's scalar arithmetic, to the bit: random states, components that settle to
+// zero (below kSpringNegligible after the step) and a NaN that must stay one.
+TEST(CriticalSpring, ApplyEqualsTheStepFormulaToTheBit) {
+  const auto settled = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> value(-3.0f, 3.0f);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const CriticalSpringStep step =
+        critical_spring_step(0.02f + 0.001f * static_cast<float>(trial % 300), 1.0f / 60.0f);
+    glm::vec3 x(value(random), value(random), value(random));
+    glm::vec3 v(value(random), value(random), value(random));
+    const glm::vec3 goal(value(random), value(random), value(random));
+    if (trial % 5 == 1) x.y = goal.y + 1e-14f, v.y = -1e-14f;
+    if (trial % 97 == 3) x.z = std::numeric_limits<float>::quiet_NaN();
+    const glm::vec3 j0 = x - goal;
+    const glm::vec3 moved = step.xx * j0 + step.xv * v;
+    const glm::vec3 rate = step.vx * j0 + step.vv * v;
+    const glm::vec3 expected_x =
+        goal + glm::vec3(settled(moved.x), settled(moved.y), settled(moved.z));
+    const glm::vec3 expected_v(settled(rate.x), settled(rate.y), settled(rate.z));
+    critical_spring_apply(x, v, goal, step);
+    for (int i = 0; i < 3; ++i) {
+      SCOPED_TRACE(testing::Message() << "trial " << trial << ", component " << i);
+      EXPECT_EQ(std::bit_cast<uint32_t>(x[i]), std::bit_cast<uint32_t>(expected_x[i]));
+      EXPECT_EQ(std::bit_cast<uint32_t>(v[i]), std::bit_cast<uint32_t>(expected_v[i]));
+    }
   }
 }
 
