@@ -420,6 +420,7 @@ void Controller::place_feet(float dt) {
     const FootLock& f = feet_[side];
     const glm::vec3 at = f.locked ? f.position : p.toe + f.offset;
     const glm::vec3 moved(at.x - p.toe.x, 0.0f, at.z - p.toe.z);
+    p.shift = moved;
     p.toe += moved;
     p.ankle += moved;
     p.length = leg_length(side);

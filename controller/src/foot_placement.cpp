@@ -155,7 +155,7 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
   for (int side = 0; side < 2; ++side) {
     const PlacementLeg& leg = legs[side];
     const glm::vec3 body = leg.planted ? glm::vec3(0.0f) : ahead;
-    const glm::vec3 own = leg.planted ? glm::vec3(0.0f) : feet_[side].toe_velocity * kToeLookahead;
+    const glm::vec3 own = leg.planted ? glm::vec3(0.0f) : own_lookahead(side, leg);
     probe_points_[slot(side, kHeel)] = leg.ankle;
     probe_points_[slot(side, kToe)] = leg.toe;
     probe_points_[slot(side, kHeelAhead)] = leg.ankle + body;
@@ -174,6 +174,16 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
       probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach[side], 0.0f};
     }
   }
+}
+
+// Where a foot in the air is heading by its own motion: its toe's velocity ahead, or, farther,
+// back to the animated toe that a released foot's offset decays toward. Just released, the toe
+// is still at rest, and the first updates of its way back (a strafe's swing back over the
+// tread's edge it stood in front of) went unprobed.
+glm::vec3 FootPlacement::own_lookahead(int side, const PlacementLeg& leg) const {
+  const glm::vec3 ahead = feet_[side].toe_velocity * kToeLookahead;
+  const glm::vec3 back(-leg.shift.x, 0.0f, -leg.shift.z);
+  return glm::dot(back, back) > glm::dot(ahead, ahead) ? back : ahead;
 }
 
 // The ground query `i` found. Deeper below the body than a step, it is over a ledge the body

@@ -143,6 +143,26 @@ TEST(FootPlacement, ARiseUnderTheHeelIsFollowedOnItsSpringAtEveryRate) {
   }
 }
 
+// A foot just released with an offset from the animated toe has a toe still at rest, and its
+// way back to the animated toe, over a tread's edge (a strafe swinging back onto the tread it
+// stood beside), was not probed until it was over it: a frame inside the tread. The way back
+// is probed like the toe's own velocity ahead, whichever goes farther.
+TEST(FootPlacement, AReleasedToeSeesTheTreadItsOffsetTakesItBackOnto) {
+  AnalyticWorld world;
+  // A 17 cm tread beside the foot: x < -0.05.
+  world.boxes.push_back(AnalyticBox{glm::vec2(-1.05f, 0.0f), glm::vec2(1.0f, 2.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(0.0f, 0.0f, 0.0f), standing_leg(0.3f, 0.0f, 0.0f)};
+  p.reset(0.0f);
+  legs[0].planted = false;
+  legs[0].shift = glm::vec3(0.08f, 0.0f, 0.0f);  // the animated toe is 8 cm back, on the tread
+  p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+           kDt);
+  EXPECT_GT(p.ground(0).toe, 0.03f);  // on its way up, on the spring
+  EXPECT_EQ(p.ground(1).toe, 0.0f);   // the other foot, with no offset, stays on the floor
+}
+
 TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
   // The body stands on a block whose edge is at z = 0.1, the toes beyond it: a 0.45 m drop is a
   // ledge (deeper than step_height, 0.35), a 0.2 m one a step the foot goes down to.

@@ -40,6 +40,9 @@ struct PlacementLeg {
   glm::vec3 hip{0.0f};
   glm::vec3 ankle{0.0f};
   glm::vec3 toe{0.0f};
+  // The toe's horizontal shift from the animated toe: a lock's hold, or a released foot's
+  // offset, which decays back to none.
+  glm::vec3 shift{0.0f};
   float length = 0.0f;       // upper plus lower leg (m)
   bool planted = false;      // locked or in contact: its probes look only where it is
   bool near_ground = false;  // planted or about to be: its reach counts for the pelvis
@@ -118,6 +121,7 @@ class FootPlacement {
              float body_ground, const glm::vec3& body_velocity);
   void place_probes(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                     float body_ground, const glm::vec3& body_velocity);
+  glm::vec3 own_lookahead(int side, const PlacementLeg& leg) const;
   float found(int i, float body_ground, const FootPlacementSettings& settings) const;
   void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
   void keep_steps_ahead();
