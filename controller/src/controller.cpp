@@ -820,14 +820,9 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
 void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
                                         std::span<glm::vec3> angular_velocities) const {
   const Database& db = *db_;
-  const int joints = db.joint_count();
-  for (int j = 1; j < joints; ++j) {
-    const size_t i = static_cast<size_t>(j);
-    velocities[i] =
-        glm::mix(db.local_velocity(at.frame0, j), db.local_velocity(at.frame1, j), at.weight);
-    angular_velocities[i] = glm::mix(db.local_angular_velocity(at.frame0, j),
-                                     db.local_angular_velocity(at.frame1, j), at.weight);
-  }
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  pose_velocity_mix(db.frame_pose_lanes(at.frame0), db.frame_pose_lanes(at.frame1), at.weight, 1,
+                    velocities.first(joints), angular_velocities.first(joints));
   for (const int j : folded_joints_) {
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
     const glm::vec3 v = velocities[static_cast<size_t>(j)];

@@ -219,4 +219,39 @@ void pose_hermite(std::span<const float> a, std::span<const float> b, float dura
 #endif
 }
 
+void pose_velocity_mix(std::span<const float> a, std::span<const float> b, float weight,
+                       size_t first, std::span<glm::vec3> velocities,
+                       std::span<glm::vec3> angular_velocities) {
+  const size_t n = velocities.size();
+  MM_ASSERT(angular_velocities.size() == n && a.size() == pose_lane_floats(n) &&
+            b.size() == pose_lane_floats(n));
+#if defined(__SSE2__)
+  // glm::mix: a (1 - w) + b w, lane by lane.
+  static_assert(kAngularVelocityX == kVelocityX + 3);
+  const __m128 keep = c(1.0f - weight), take = c(weight);
+  for (size_t group = first / 4; group < pose_lane_groups(n); ++group) {
+    const float* ga = &a[group * kPoseLaneGroupFloats];
+    const float* gb = &b[group * kPoseLaneGroupFloats];
+    alignas(16) float rows[6][4];
+    for (size_t r = 0; r < 6; ++r) {
+      const size_t row = kVelocityX + r;  // the angular velocity's rows follow the velocity's
+      _mm_store_ps(rows[r], _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(ga + 4 * row), keep),
+                                       _mm_mul_ps(_mm_loadu_ps(gb + 4 * row), take)));
+    }
+    for (size_t j = std::max(first, 4 * group); j < std::min(n, 4 * group + 4); ++j) {
+      const size_t l = j % 4;
+      velocities[j] = glm::vec3(rows[0][l], rows[1][l], rows[2][l]);
+      angular_velocities[j] = glm::vec3(rows[3][l], rows[4][l], rows[5][l]);
+    }
+  }
+#else
+  for (size_t j = first; j < n; ++j) {
+    velocities[j] = glm::mix(pose_lane_vec3(a.data(), j, kVelocityX),
+                             pose_lane_vec3(b.data(), j, kVelocityX), weight);
+    angular_velocities[j] = glm::mix(pose_lane_vec3(a.data(), j, kAngularVelocityX),
+                                     pose_lane_vec3(b.data(), j, kAngularVelocityX), weight);
+  }
+#endif
+}
+
 }  // namespace mm
