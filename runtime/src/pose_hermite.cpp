@@ -134,21 +134,35 @@ struct Hermite4 {
 // translation's three with the scale's first (1) in the fourth, then the scale's other two. A
 // lane whose curve passes through zero (opposite tangents) takes transform_hermite's fallback.
 template <class Frame>
-void store_joints(const Hermite4& h, const Frame& a, const Frame& b, float duration, float t,
-                  size_t first, size_t count, std::span<Transform> out) {
+[[gnu::always_inline]] inline void store_joints(const Hermite4& h, const Frame& a, const Frame& b,
+                                                float duration, float t, size_t first, size_t count,
+                                                std::span<Transform> out) {
   __m128 rx = h.rotation.x, ry = h.rotation.y, rz = h.rotation.z, rw = h.rotation.w;
   _MM_TRANSPOSE4_PS(rx, ry, rz, rw);
   __m128 x = h.translation.x, y = h.translation.y, z = h.translation.z, ones = c(1.0f);
   _MM_TRANSPOSE4_PS(x, y, z, ones);
   const __m128 rotations[4] = {rx, ry, rz, rw};
   const __m128 translations[4] = {x, y, z, ones};
+  Transform* o = &out[first];
+  const auto put = [&](size_t i) {
+    _mm_storeu_ps(&o[i].rotation.x, rotations[i]);
+    _mm_storeu_ps(&o[i].translation.x, translations[i]);
+    o[i].scale.y = o[i].scale.z = 1.0f;
+  };
+  // A whole group written straight, without a loop or a test per joint.
+  if (count == 4) {
+    put(0);
+    put(1);
+    put(2);
+    put(3);
+  } else {
+    for (size_t i = 0; i < count; ++i) put(i);
+  }
   const int usable = _mm_movemask_ps(_mm_cmpgt_ps(h.length, c(1e-6f)));
+  const int lanes = (1 << count) - 1;
+  if ((usable & lanes) == lanes) return;
   for (size_t i = 0; i < count; ++i) {
-    Transform& o = out[first + i];
-    _mm_storeu_ps(&o.rotation.x, rotations[i]);
-    _mm_storeu_ps(&o.translation.x, translations[i]);
-    o.scale.y = o.scale.z = 1.0f;
-    if (!(usable & (1 << i))) o = joint_hermite(a, b, duration, t, first + i);
+    if (!(usable & (1 << i))) o[i] = joint_hermite(a, b, duration, t, first + i);
   }
 }
 
