@@ -593,7 +593,11 @@ void Controller::search() {
   const auto start = std::chrono::steady_clock::now();
   build_query();
   const SearchResult best = search_candidates();
-  if (best.frame >= 0 && !best.continuation) transition_to(best.frame);
+  // The update samples the playing clip again right after the search, and nothing reads the
+  // incoming body before: only inertialization's start reads it at the jump.
+  if (best.frame >= 0 && !best.continuation) {
+    transition_to(best.frame, settings_.transition_mode == TransitionMode::Inertialization);
+  }
 
   force_search_ = false;
   search_timer_ = 0.0f;
@@ -664,7 +668,7 @@ void Controller::record_search(const SearchResult& best) {
 // Jumps to a database frame. The outgoing pose is what plays now (sampled_); the incoming one is
 // the new frame, its root mapped so that it starts exactly where the outgoing root is (the new
 // transition source) with the database root of the new frame as the destination.
-void Controller::transition_to(int frame) {
+void Controller::transition_to(int frame, bool incoming_body) {
   const Database& db = *db_;
   const int clip = db.frame_clip()[static_cast<size_t>(frame)];
   const ClipRange& range = db.clips()[static_cast<size_t>(clip)];
@@ -681,7 +685,11 @@ void Controller::transition_to(int frame) {
   transition_dst_rotation_ = db.local_rotation(frame, 0);
   clip_ = clip;
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
-  sample_playback(other_, other_velocities_, other_angular_velocities_, true);
+  if (incoming_body) {
+    sample_playback(other_, other_velocities_, other_angular_velocities_, true);
+  } else {
+    sample_playback_root(other_, other_velocities_, other_angular_velocities_);
+  }
   if (had_clip) {
     start_transition();
     ++debug_.transitions;
@@ -691,7 +699,7 @@ void Controller::transition_to(int frame) {
   std::swap(sampled_, other_);
   std::swap(sampled_velocities_, other_velocities_);
   std::swap(sampled_angular_velocities_, other_angular_velocities_);
-  sampled_body_velocities_ = true;
+  sampled_body_velocities_ = incoming_body;
 }
 
 // At a jump, the outgoing clip (sampled_) hands over to the incoming one (other_).
@@ -791,11 +799,6 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
   const PlaybackPoint at = playback_point();
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
-  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
-  velocities[0] =
-      glm::mix(db.local_velocity(at.frame0, 0), db.local_velocity(at.frame1, 0), at.weight);
-  angular_velocities[0] = glm::mix(db.local_angular_velocity(at.frame0, 0),
-                                   db.local_angular_velocity(at.frame1, 0), at.weight);
   if (body_velocities) sample_body_velocities(at, velocities, angular_velocities);
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
@@ -807,6 +810,29 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
         compose(local[static_cast<size_t>(j)], local[static_cast<size_t>(c)]);
   }
   for (const int j : folded_joints_) local[static_cast<size_t>(j)] = Transform{};
+  map_playback_root(at, local, velocities, angular_velocities);
+}
+
+// sample_playback's root alone (joint 0 and its velocities, to the same bits: sample_joint equals
+// sample_database_pose joint for joint); the rest of `local` and the velocities are left alone.
+void Controller::sample_playback_root(std::span<Transform> local, std::span<glm::vec3> velocities,
+                                      std::span<glm::vec3> angular_velocities) const {
+  const PlaybackPoint at = playback_point();
+  local[0] = sample_joint(at, 0);
+  map_playback_root(at, local, velocities, angular_velocities);
+}
+
+// The sampled database root (local[0]) kept for database_root, its velocities, and all three
+// mapped into the world through the transition source and destination.
+void Controller::map_playback_root(const PlaybackPoint& at, std::span<Transform> local,
+                                   std::span<glm::vec3> velocities,
+                                   std::span<glm::vec3> angular_velocities) const {
+  const Database& db = *db_;
+  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
+  velocities[0] =
+      glm::mix(db.local_velocity(at.frame0, 0), db.local_velocity(at.frame1, 0), at.weight);
+  angular_velocities[0] = glm::mix(db.local_angular_velocity(at.frame0, 0),
+                                   db.local_angular_velocity(at.frame1, 0), at.weight);
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
   local[0].translation =
       map * (local[0].translation - transition_dst_position_) + transition_src_position_;
