@@ -67,7 +67,7 @@ Quat4 exp_series(const Vec4x3& h, __m128& ok) {
 
 // quat_to_scaled_angle_axis of quaternions through quat_log's series branch, lane by lane; `ok`
 // marks the lanes inside it.
-Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
+[[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
   const Vec4x3 v{a.x, a.y, a.z};
   const __m128 s2 = dot(v, v);
@@ -109,7 +109,7 @@ __m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
 
 // quat_to_scaled_angle_axis through quat_log's general branch (atan2_polynomial), lane by lane;
 // `ok` marks the lanes it covers (not a zero vector part, nor the library's atan2).
-Vec4x3 scaled_angle_axis_general(const Quat4& q, __m128& ok) {
+[[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_general(const Quat4& q, __m128& ok) {
   const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
   const Vec4x3 v{a.x, a.y, a.z};
   const __m128 s = _mm_sqrt_ps(dot(v, v));
