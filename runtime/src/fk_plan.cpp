@@ -105,8 +105,10 @@ Transforms4 gather(const Transform* a, const Transform* b, const Transform* c, c
 }
 
 template <bool kUnitScale>
-void compose_block(const std::array<int, 4>& parents, std::span<const Transform> local,
-                   std::span<Transform> global, const std::array<int, 4>& joints) {
+[[gnu::always_inline]] inline void compose_block(const std::array<int, 4>& parents,
+                                                 std::span<const Transform> local,
+                                                 std::span<Transform> global,
+                                                 const std::array<int, 4>& joints) {
   const auto at = [](auto span, int j) { return &span[static_cast<size_t>(j)]; };
   const Transforms4 p = gather<kUnitScale>(at(global, parents[0]), at(global, parents[1]),
                                            at(global, parents[2]), at(global, parents[3]));
