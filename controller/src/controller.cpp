@@ -400,7 +400,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
     sampled_at_ = playback_point();
-    sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, true);
+    sample_playback(sampled_at_, sampled_, sampled_velocities_, sampled_angular_velocities_, true);
     sampled_body_velocities_ = true;
     std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
     move_root(glm::vec3(sim_position_.x, 0.0f, sim_position_.z), rotation);
@@ -436,7 +436,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   }
   advance_playback(dt);
   sampled_at_ = playback_point();
-  sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, false);
+  sample_playback(sampled_at_, sampled_, sampled_velocities_, sampled_angular_velocities_, false);
   sampled_body_velocities_ = false;
   show_transitions(dt);
   // Only the root's displayed motion is needed (by the synchronization): the playing root's
@@ -686,7 +686,7 @@ void Controller::transition_to(int frame, bool incoming_body) {
   clip_ = clip;
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
   if (incoming_body) {
-    sample_playback(other_, other_velocities_, other_angular_velocities_, true);
+    sample_playback(playback_point(), other_, other_velocities_, other_angular_velocities_, true);
   } else {
     sample_playback_root(other_, other_velocities_, other_angular_velocities_);
   }
@@ -788,15 +788,15 @@ Transform Controller::database_root(const PlaybackPoint& at) const {
   return sample_joint(at, 0);
 }
 
-// The playing clip at clip_time_, interpolated between its two nearest frames, with the root
+// The playing clip at `at`, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
 // The root's velocities always; the body's (joints 1..) only when `body_velocities`.
-void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
+void Controller::sample_playback(const PlaybackPoint& at, std::span<Transform> local,
+                                 std::span<glm::vec3> velocities,
                                  std::span<glm::vec3> angular_velocities,
                                  bool body_velocities) const {
   const Database& db = *db_;
-  const PlaybackPoint at = playback_point();
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
   if (body_velocities) sample_body_velocities(at, velocities, angular_velocities);
@@ -824,9 +824,9 @@ void Controller::sample_playback_root(std::span<Transform> local, std::span<glm:
 
 // The sampled database root (local[0]) kept for database_root, its velocities, and all three
 // mapped into the world through the transition source and destination.
-void Controller::map_playback_root(const PlaybackPoint& at, std::span<Transform> local,
-                                   std::span<glm::vec3> velocities,
-                                   std::span<glm::vec3> angular_velocities) const {
+[[gnu::always_inline]] inline void Controller::map_playback_root(
+    const PlaybackPoint& at, std::span<Transform> local, std::span<glm::vec3> velocities,
+    std::span<glm::vec3> angular_velocities) const {
   const Database& db = *db_;
   root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
   velocities[0] =

@@ -583,8 +583,11 @@ class Controller {
   PlaybackPoint playback_point() const;
   Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
   Transform database_root(const PlaybackPoint& at) const;
-  void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
-                       std::span<glm::vec3> angular_velocities, bool body_velocities) const;
+  // The playing clip at `at` (playback_point() of the present clip and time): the update passes
+  // the point it keeps in sampled_at_.
+  void sample_playback(const PlaybackPoint& at, std::span<Transform> local,
+                       std::span<glm::vec3> velocities, std::span<glm::vec3> angular_velocities,
+                       bool body_velocities) const;
   void sample_playback_root(std::span<Transform> local, std::span<glm::vec3> velocities,
                             std::span<glm::vec3> angular_velocities) const;
   void map_playback_root(const PlaybackPoint& at, std::span<Transform> local,
