@@ -422,7 +422,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   if (clip_ >= 0) {
     // Without offsets the displayed pose is the played one, then placed.
     sampled_at_ = playback_point();
-    sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, true);
+    sample_playback(sampled_at_, sampled_, sampled_velocities_, sampled_angular_velocities_, true);
     sampled_body_velocities_ = true;
     std::copy(sampled_.begin(), sampled_.end(), locals_.begin());
     move_root(glm::vec3(sim_position_.x, 0.0f, sim_position_.z), rotation);
@@ -458,7 +458,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   }
   advance_playback(dt);
   sampled_at_ = playback_point();
-  sample_playback(sampled_, sampled_velocities_, sampled_angular_velocities_, false);
+  sample_playback(sampled_at_, sampled_, sampled_velocities_, sampled_angular_velocities_, false);
   sampled_body_velocities_ = false;
   show_transitions(dt);
   // Only the root's displayed motion is needed (by the synchronization): the playing root's
@@ -615,7 +615,11 @@ void Controller::search() {
   const auto start = std::chrono::steady_clock::now();
   build_query();
   const SearchResult best = search_candidates();
-  if (best.frame >= 0 && !best.continuation) transition_to(best.frame);
+  // The update samples the playing clip again right after the search, and nothing reads the
+  // incoming body before: only inertialization's start reads it at the jump.
+  if (best.frame >= 0 && !best.continuation) {
+    transition_to(best.frame, settings_.transition_mode == TransitionMode::Inertialization);
+  }
 
   force_search_ = false;
   search_timer_ = 0.0f;
@@ -686,7 +690,7 @@ void Controller::record_search(const SearchResult& best) {
 // Jumps to a database frame. The outgoing pose is what plays now (sampled_); the incoming one is
 // the new frame, its root mapped so that it starts exactly where the outgoing root is (the new
 // transition source) with the database root of the new frame as the destination.
-void Controller::transition_to(int frame) {
+void Controller::transition_to(int frame, bool incoming_body) {
   const Database& db = *db_;
   const int clip = db.frame_clip()[static_cast<size_t>(frame)];
   const ClipRange& range = db.clips()[static_cast<size_t>(clip)];
@@ -703,7 +707,11 @@ void Controller::transition_to(int frame) {
   transition_dst_rotation_ = db.local_rotation(frame, 0);
   clip_ = clip;
   clip_time_ = static_cast<float>(frame - range.start) * db.frame_time();
-  sample_playback(other_, other_velocities_, other_angular_velocities_, true);
+  if (incoming_body) {
+    sample_playback(playback_point(), other_, other_velocities_, other_angular_velocities_, true);
+  } else {
+    sample_playback_root(other_, other_velocities_, other_angular_velocities_);
+  }
   if (had_clip) {
     start_transition();
     ++debug_.transitions;
@@ -713,7 +721,7 @@ void Controller::transition_to(int frame) {
   std::swap(sampled_, other_);
   std::swap(sampled_velocities_, other_velocities_);
   std::swap(sampled_angular_velocities_, other_angular_velocities_);
-  sampled_body_velocities_ = true;
+  sampled_body_velocities_ = incoming_body;
 }
 
 // At a jump, the outgoing clip (sampled_) hands over to the incoming one (other_).
@@ -802,22 +810,17 @@ Transform Controller::database_root(const PlaybackPoint& at) const {
   return sample_joint(at, 0);
 }
 
-// The playing clip at clip_time_, interpolated between its two nearest frames, with the root
+// The playing clip at `at`, interpolated between its two nearest frames, with the root
 // (joint 0) mapped into the world through the transition source and destination:
 //   root = source * inverse(destination) * database root.
 // The root's velocities always; the body's (joints 1..) only when `body_velocities`.
-void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
+void Controller::sample_playback(const PlaybackPoint& at, std::span<Transform> local,
+                                 std::span<glm::vec3> velocities,
                                  std::span<glm::vec3> angular_velocities,
                                  bool body_velocities) const {
   const Database& db = *db_;
-  const PlaybackPoint at = playback_point();
   sample_database_pose(db, at.frame0, at.frame1, at.weight, settings_.cubic_playback,
                        settings_.interpolation, local);
-  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
-  velocities[0] =
-      glm::mix(db.local_velocity(at.frame0, 0), db.local_velocity(at.frame1, 0), at.weight);
-  angular_velocities[0] = glm::mix(db.local_angular_velocity(at.frame0, 0),
-                                   db.local_angular_velocity(at.frame1, 0), at.weight);
   if (body_velocities) sample_body_velocities(at, velocities, angular_velocities);
   // Source roots (such as the Bandai joint_Root, the capture's world origin) are folded into
   // their children so that every joint below the root is relative to the character: their
@@ -829,6 +832,29 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
         compose(local[static_cast<size_t>(j)], local[static_cast<size_t>(c)]);
   }
   for (const int j : folded_joints_) local[static_cast<size_t>(j)] = Transform{};
+  map_playback_root(at, local, velocities, angular_velocities);
+}
+
+// sample_playback's root alone (joint 0 and its velocities, to the same bits: sample_joint equals
+// sample_database_pose joint for joint); the rest of `local` and the velocities are left alone.
+void Controller::sample_playback_root(std::span<Transform> local, std::span<glm::vec3> velocities,
+                                      std::span<glm::vec3> angular_velocities) const {
+  const PlaybackPoint at = playback_point();
+  local[0] = sample_joint(at, 0);
+  map_playback_root(at, local, velocities, angular_velocities);
+}
+
+// The sampled database root (local[0]) kept for database_root, its velocities, and all three
+// mapped into the world through the transition source and destination.
+[[gnu::always_inline]] inline void Controller::map_playback_root(
+    const PlaybackPoint& at, std::span<Transform> local, std::span<glm::vec3> velocities,
+    std::span<glm::vec3> angular_velocities) const {
+  const Database& db = *db_;
+  root_sample_ = {at, settings_.cubic_playback, settings_.interpolation, local[0], true};
+  velocities[0] =
+      glm::mix(db.local_velocity(at.frame0, 0), db.local_velocity(at.frame1, 0), at.weight);
+  angular_velocities[0] = glm::mix(db.local_angular_velocity(at.frame0, 0),
+                                   db.local_angular_velocity(at.frame1, 0), at.weight);
   const glm::quat map = transition_src_rotation_ * glm::conjugate(transition_dst_rotation_);
   local[0].translation =
       map * (local[0].translation - transition_dst_position_) + transition_src_position_;
@@ -842,14 +868,9 @@ void Controller::sample_playback(std::span<Transform> local, std::span<glm::vec3
 void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
                                         std::span<glm::vec3> angular_velocities) const {
   const Database& db = *db_;
-  const int joints = db.joint_count();
-  for (int j = 1; j < joints; ++j) {
-    const size_t i = static_cast<size_t>(j);
-    velocities[i] =
-        glm::mix(db.local_velocity(at.frame0, j), db.local_velocity(at.frame1, j), at.weight);
-    angular_velocities[i] = glm::mix(db.local_angular_velocity(at.frame0, j),
-                                     db.local_angular_velocity(at.frame1, j), at.weight);
-  }
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  pose_velocity_mix(db.frame_pose_lanes(at.frame0), db.frame_pose_lanes(at.frame1), at.weight, 1,
+                    velocities.first(joints), angular_velocities.first(joints));
   for (const int j : folded_joints_) {
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
     const glm::vec3 v = velocities[static_cast<size_t>(j)];

@@ -67,7 +67,7 @@ Quat4 exp_series(const Vec4x3& h, __m128& ok) {
 
 // quat_to_scaled_angle_axis of quaternions through quat_log's series branch, lane by lane; `ok`
 // marks the lanes inside it.
-Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
+[[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_series(const Quat4& q, __m128& ok) {
   const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
   const Vec4x3 v{a.x, a.y, a.z};
   const __m128 s2 = dot(v, v);
@@ -109,7 +109,7 @@ __m128 atan2_polynomial_lanes(__m128 y, __m128 x, __m128& ok) {
 
 // quat_to_scaled_angle_axis through quat_log's general branch (atan2_polynomial), lane by lane;
 // `ok` marks the lanes it covers (not a zero vector part, nor the library's atan2).
-Vec4x3 scaled_angle_axis_general(const Quat4& q, __m128& ok) {
+[[gnu::always_inline]] inline Vec4x3 scaled_angle_axis_general(const Quat4& q, __m128& ok) {
   const Quat4 a = negate_where(q, _mm_cmplt_ps(q.w, _mm_setzero_ps()));  // quat_abs
   const Vec4x3 v{a.x, a.y, a.z};
   const __m128 s = _mm_sqrt_ps(dot(v, v));
@@ -324,6 +324,122 @@ void blend_x4(const DeadBlend& blend, size_t g, const Transform* in, const PoseM
   }
 }
 
+// The incoming side of four joints for the switch: poses and velocities.
+struct Incoming4 {
+  const Transform* local;
+  Vec4x3 velocity, angular_velocity;
+};
+
+// A blend's velocity terms one lane at a time: what the lanes leave to the scalar Jacobians.
+struct Rates4 {
+  Lanes d, relative, partial_ws;
+};
+
+// The angular velocity of blend_joint, its Jacobians lane by lane (in double with the library's
+// sine and cosine: they stay scalar), the vector sums in its order.
+Vec4x3 blend_angular_velocities(const Vec4x3& d, const Vec4x3& relative, const Vec4x3& partial_ws,
+                                Weight w) {
+  Rates4 r;
+  const auto put = [](const Vec4x3& v, Lanes& l) {
+    _mm_store_ps(l.x, v.x);
+    _mm_store_ps(l.y, v.y);
+    _mm_store_ps(l.z, v.z);
+  };
+  put(d, r.d);
+  put(relative, r.relative);
+  put(partial_ws, r.partial_ws);
+  Lanes out;
+  for (int l = 0; l < 4; ++l) {
+    const glm::vec3 dl(r.d.x[l], r.d.y[l], r.d.z[l]);
+    const glm::vec3 d_rate = angular_velocity_to_rotation_vector_rate(
+        dl, glm::vec3(r.relative.x[l], r.relative.y[l], r.relative.z[l]));
+    const glm::vec3 a =
+        rotation_vector_rate_to_angular_velocity(w.value * dl, w.rate * dl + w.value * d_rate) +
+        glm::vec3(r.partial_ws.x[l], r.partial_ws.y[l], r.partial_ws.z[l]);
+    out.x[l] = a.x;
+    out.y[l] = a.y;
+    out.z[l] = a.z;
+  }
+  return {_mm_load_ps(out.x), _mm_load_ps(out.y), _mm_load_ps(out.z)};
+}
+
+// Group g of the switch: blend_joint with velocities of its joints, written back as the new
+// source. Lanes past `count` keep the source's joints at rest; a lane whose rotation has no
+// length is done by blend_joint itself (before the group is overwritten: it reads the source).
+void blend_switch_x4(DeadBlend& blend, size_t g, const Incoming4& in, const PoseMotion& outgoing,
+                     Weight w, size_t count) {
+  DeadBlendSourceGroup& s = blend.groups[g];
+  const Quat4 source = load_rotations(s);
+  const Vec4x3 st = load_rows(s.translation);
+  const Vec4x3 vs = load_rows(s.velocity);
+  const Vec4x3 ws = load_rows(s.angular_velocity);
+  const Vec4x3 d =
+      scaled_angle_axis_lanes(multiply(transform_rotations(in.local), conjugate(source)));
+  const Quat4 partial = exp_lanes(scale(scale(d, c(w.value)), c(0.5f)));
+  __m128 length;
+  const Quat4 rotation = normalize(multiply(partial, source), length);
+  const int ok = _mm_movemask_ps(_mm_cmpgt_ps(length, _mm_setzero_ps()));
+  JointBlend redone[4];
+  for (size_t l = 0; l < count; ++l) {
+    if (!(ok & (1 << l))) redone[l] = blend_joint(blend, 4 * g + l, outgoing, w, true);
+  }
+  // glm::mix: a (1 - w) + b w.
+  const Vec4x3 ti = load_translations(in.local).t;
+  const __m128 keep = c(1.0f - w.value), take = c(w.value);
+  const Vec4x3 translation = add(scale(st, keep), scale(ti, take));
+  const Vec4x3 velocity =
+      add(add(scale(vs, keep), scale(in.velocity, take)),
+          scale(Vec4x3{sub(ti.x, st.x), sub(ti.y, st.y), sub(ti.z, st.z)}, c(w.rate)));
+  const Vec4x3 exp_d_ws = rotate(exp_lanes(scale(d, c(0.5f))), ws);
+  const Vec4x3 relative = {sub(in.angular_velocity.x, exp_d_ws.x),
+                           sub(in.angular_velocity.y, exp_d_ws.y),
+                           sub(in.angular_velocity.z, exp_d_ws.z)};
+  const Vec4x3 angular_velocity = blend_angular_velocities(d, relative, rotate(partial, ws), w);
+  // The joints' lanes replace the source's; the padding lanes keep theirs.
+  const __m128 real = _mm_castsi128_ps(
+      _mm_cmplt_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(static_cast<int>(count))));
+  const auto keep_rest = [&](__m128 joint, __m128 rest) {
+    return _mm_or_ps(_mm_and_ps(real, joint), _mm_andnot_ps(real, rest));
+  };
+  const auto put_rows = [&](const Vec4x3& v, float(&rows)[3][4]) {
+    store_rows({keep_rest(v.x, _mm_load_ps(rows[0])), keep_rest(v.y, _mm_load_ps(rows[1])),
+                keep_rest(v.z, _mm_load_ps(rows[2]))},
+               rows);
+  };
+  store_rotations({keep_rest(rotation.w, source.w), keep_rest(rotation.x, source.x),
+                   keep_rest(rotation.y, source.y), keep_rest(rotation.z, source.z)},
+                  s);
+  put_rows(translation, s.translation);
+  put_rows(velocity, s.velocity);
+  put_rows(angular_velocity, s.angular_velocity);
+  for (size_t l = 0; l < count; ++l) {
+    if (!(ok & (1 << l))) {
+      blend.set_source(4 * g + l, redone[l].pose, redone[l].velocity, redone[l].angular_velocity);
+    }
+  }
+}
+
+// The switch during a blend: every group in the lanes, the last one's outgoing joints
+// completed with joints at rest.
+void blend_switch(DeadBlend& blend, const PoseMotion& outgoing, Weight w) {
+  const size_t n = static_cast<size_t>(blend.joints);
+  const auto vectors = [](std::span<const glm::vec3> v, size_t first, size_t count) {
+    glm::vec3 four[4] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+    if (!v.empty()) std::copy_n(&v[first], count, four);
+    return load_vec3s(four);
+  };
+  for (size_t g = 0; g < blend.groups.size(); ++g) {
+    const size_t first = 4 * g;
+    const size_t count = std::min<size_t>(4, n - first);
+    Transform local[4];
+    std::copy_n(&outgoing.local[first], count, local);
+    blend_switch_x4(blend, g,
+                    {local, vectors(outgoing.velocities, first, count),
+                     vectors(outgoing.angular_velocities, first, count)},
+                    outgoing, w, count);
+  }
+}
+
 // The blended pose alone, every group in the lanes; the last group's incoming joints are
 // completed with joints at rest.
 void blend_pose(const DeadBlend& blend, const PoseMotion& incoming, Weight w,
@@ -399,6 +515,15 @@ void dead_blend_transition(DeadBlend& blend, const PoseMotion& outgoing, float b
   MM_ASSERT(outgoing.velocities.empty() || outgoing.velocities.size() == n);
   MM_ASSERT(outgoing.angular_velocities.empty() || outgoing.angular_velocities.size() == n);
   const Weight w = blend.active ? weight_at(blend.time, usable_length(blend_time)) : Weight{};
+#if defined(__SSE2__)
+  // During a blend the shown joints, four at a time, each lane equal to blend_joint's to the bit.
+  if (w.value < 1.0f) {
+    blend_switch(blend, outgoing, w);
+    blend.time = 0.0f;
+    blend.active = true;
+    return;
+  }
+#endif
   for (size_t i = 0; i < n; ++i) {
     if (w.value < 1.0f) {
       const JointBlend shown = blend_joint(blend, i, outgoing, w, true);

@@ -37,9 +37,11 @@ ForwardKinematicsPlan::ForwardKinematicsPlan(std::span<const int> parents)
     });
     Block block;
     block.count = std::min<int>(4, static_cast<int>(ready.size()));
-    for (int l = 0; l < 4; ++l)
-      block.joints[static_cast<size_t>(l)] =
-          ready[static_cast<size_t>(std::min(l, block.count - 1))];
+    for (int l = 0; l < 4; ++l) {
+      const int j = ready[static_cast<size_t>(std::min(l, block.count - 1))];
+      block.joints[static_cast<size_t>(l)] = j;
+      block.parents[static_cast<size_t>(l)] = parents[static_cast<size_t>(j)];
+    }
     block.lanes = block.count > 1;
     for (int l = 0; l < block.count; ++l) {
       const int j = ready[static_cast<size_t>(l)];
@@ -103,14 +105,13 @@ Transforms4 gather(const Transform* a, const Transform* b, const Transform* c, c
 }
 
 template <bool kUnitScale>
-void compose_block(std::span<const int> parents, std::span<const Transform> local,
-                   std::span<Transform> global, const std::array<int, 4>& joints) {
+[[gnu::always_inline]] inline void compose_block(const std::array<int, 4>& parents,
+                                                 std::span<const Transform> local,
+                                                 std::span<Transform> global,
+                                                 const std::array<int, 4>& joints) {
   const auto at = [](auto span, int j) { return &span[static_cast<size_t>(j)]; };
-  const auto parent = [&](int l) {
-    return parents[static_cast<size_t>(joints[static_cast<size_t>(l)])];
-  };
-  const Transforms4 p = gather<kUnitScale>(at(global, parent(0)), at(global, parent(1)),
-                                           at(global, parent(2)), at(global, parent(3)));
+  const Transforms4 p = gather<kUnitScale>(at(global, parents[0]), at(global, parents[1]),
+                                           at(global, parents[2]), at(global, parents[3]));
   const Transforms4 l = gather<kUnitScale>(at(local, joints[0]), at(local, joints[1]),
                                            at(local, joints[2]), at(local, joints[3]));
   const Quat4 rotation = multiply(p.rotation, l.rotation);
@@ -147,7 +148,7 @@ void ForwardKinematicsPlan::run_blocks(std::span<const Transform> local,
   for (const Block& b : blocks_) {
 #if defined(__SSE2__)
     if (b.lanes) {
-      compose_block<kUnitScale>(parents_, local, global, b.joints);
+      compose_block<kUnitScale>(b.parents, local, global, b.joints);
       continue;
     }
 #endif

@@ -134,21 +134,35 @@ struct Hermite4 {
 // translation's three with the scale's first (1) in the fourth, then the scale's other two. A
 // lane whose curve passes through zero (opposite tangents) takes transform_hermite's fallback.
 template <class Frame>
-void store_joints(const Hermite4& h, const Frame& a, const Frame& b, float duration, float t,
-                  size_t first, size_t count, std::span<Transform> out) {
+[[gnu::always_inline]] inline void store_joints(const Hermite4& h, const Frame& a, const Frame& b,
+                                                float duration, float t, size_t first, size_t count,
+                                                std::span<Transform> out) {
   __m128 rx = h.rotation.x, ry = h.rotation.y, rz = h.rotation.z, rw = h.rotation.w;
   _MM_TRANSPOSE4_PS(rx, ry, rz, rw);
   __m128 x = h.translation.x, y = h.translation.y, z = h.translation.z, ones = c(1.0f);
   _MM_TRANSPOSE4_PS(x, y, z, ones);
   const __m128 rotations[4] = {rx, ry, rz, rw};
   const __m128 translations[4] = {x, y, z, ones};
+  Transform* o = &out[first];
+  const auto put = [&](size_t i) {
+    _mm_storeu_ps(&o[i].rotation.x, rotations[i]);
+    _mm_storeu_ps(&o[i].translation.x, translations[i]);
+    o[i].scale.y = o[i].scale.z = 1.0f;
+  };
+  // A whole group written straight, without a loop or a test per joint.
+  if (count == 4) {
+    put(0);
+    put(1);
+    put(2);
+    put(3);
+  } else {
+    for (size_t i = 0; i < count; ++i) put(i);
+  }
   const int usable = _mm_movemask_ps(_mm_cmpgt_ps(h.length, c(1e-6f)));
+  const int lanes = (1 << count) - 1;
+  if ((usable & lanes) == lanes) return;
   for (size_t i = 0; i < count; ++i) {
-    Transform& o = out[first + i];
-    _mm_storeu_ps(&o.rotation.x, rotations[i]);
-    _mm_storeu_ps(&o.translation.x, translations[i]);
-    o.scale.y = o.scale.z = 1.0f;
-    if (!(usable & (1 << i))) o = joint_hermite(a, b, duration, t, first + i);
+    if (!(usable & (1 << i))) o[i] = joint_hermite(a, b, duration, t, first + i);
   }
 }
 
@@ -216,6 +230,41 @@ void pose_hermite(std::span<const float> a, std::span<const float> b, float dura
   }
 #else
   for (size_t j = 0; j < n; ++j) out[j] = joint_hermite(a, b, duration, t, j);
+#endif
+}
+
+void pose_velocity_mix(std::span<const float> a, std::span<const float> b, float weight,
+                       size_t first, std::span<glm::vec3> velocities,
+                       std::span<glm::vec3> angular_velocities) {
+  const size_t n = velocities.size();
+  MM_ASSERT(angular_velocities.size() == n && a.size() == pose_lane_floats(n) &&
+            b.size() == pose_lane_floats(n));
+#if defined(__SSE2__)
+  // glm::mix: a (1 - w) + b w, lane by lane.
+  static_assert(kAngularVelocityX == kVelocityX + 3);
+  const __m128 keep = c(1.0f - weight), take = c(weight);
+  for (size_t group = first / 4; group < pose_lane_groups(n); ++group) {
+    const float* ga = &a[group * kPoseLaneGroupFloats];
+    const float* gb = &b[group * kPoseLaneGroupFloats];
+    alignas(16) float rows[6][4];
+    for (size_t r = 0; r < 6; ++r) {
+      const size_t row = kVelocityX + r;  // the angular velocity's rows follow the velocity's
+      _mm_store_ps(rows[r], _mm_add_ps(_mm_mul_ps(_mm_loadu_ps(ga + 4 * row), keep),
+                                       _mm_mul_ps(_mm_loadu_ps(gb + 4 * row), take)));
+    }
+    for (size_t j = std::max(first, 4 * group); j < std::min(n, 4 * group + 4); ++j) {
+      const size_t l = j % 4;
+      velocities[j] = glm::vec3(rows[0][l], rows[1][l], rows[2][l]);
+      angular_velocities[j] = glm::vec3(rows[3][l], rows[4][l], rows[5][l]);
+    }
+  }
+#else
+  for (size_t j = first; j < n; ++j) {
+    velocities[j] = glm::mix(pose_lane_vec3(a.data(), j, kVelocityX),
+                             pose_lane_vec3(b.data(), j, kVelocityX), weight);
+    angular_velocities[j] = glm::mix(pose_lane_vec3(a.data(), j, kAngularVelocityX),
+                                     pose_lane_vec3(b.data(), j, kAngularVelocityX), weight);
+  }
 #endif
 }
 

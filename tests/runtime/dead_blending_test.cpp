@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "mm/runtime/dead_blending.hpp"
+#include "mm/runtime/inertialization.hpp"
+#include "mm/runtime/interpolation.hpp"
 #include "mm/runtime/spring.hpp"
 #include "test_math.hpp"
 
@@ -235,8 +237,9 @@ TEST(DeadBlending, TheSameSpanOfTimeGivesTheSamePoseHoweverItIsCut) {
 // their incoming pose (the logarithm's and exponential's series) and far from it (their
 // trigonometric forms), with a joint count that leaves a remainder after the blocks of four
 // (its last group is completed with joints at rest in the lanes).
-TEST(DeadBlending, ThePoseAloneEqualsThePoseWithItsVelocitiesToTheBit) {
-  constexpr size_t n = 22;
+// The lanes (the pose alone) against blend_joint (the pose with its velocities) for n joints.
+void expect_pose_alone_equals_pose_with_velocities(size_t n) {
+  SCOPED_TRACE(std::to_string(n) + " joints");
   std::vector<Transform> outgoing(n), incoming(n), pose_alone(n), pose(n);
   std::vector<glm::vec3> out_v(n), out_w(n), in_v(n), in_w(n), v(n), w(n);
   for (size_t j = 0; j < n; ++j) {
@@ -268,6 +271,91 @@ TEST(DeadBlending, ThePoseAloneEqualsThePoseWithItsVelocitiesToTheBit) {
     }
   }
   EXPECT_GT(blended, 20);
+}
+
+// Every count of joints in the last group (a short last group is blended as the four joints
+// ending at the last one, straddling two groups of the source), and fewer than four joints.
+TEST(DeadBlending, ThePoseAloneEqualsThePoseWithItsVelocitiesToTheBit) {
+  for (const size_t n : {1, 2, 3, 4, 5, 6, 7, 8, 9, 22})
+    expect_pose_alone_equals_pose_with_velocities(n);
+}
+
+// A switch's new source for joint j as blend_joint writes it with its velocities, from the
+// blend's state before the switch (the reference the lanes are held to, operation for operation).
+struct ShownJoint {
+  Transform pose;
+  glm::vec3 velocity, angular_velocity;
+};
+
+ShownJoint shown_joint(const DeadBlend& before, size_t j, const Transform& in, const glm::vec3& vi,
+                       const glm::vec3& wi) {
+  const float x = before.time / kBlendTime;
+  const float value = x * x * (3.0f - 2.0f * x), rate = 6.0f * x * (1.0f - x) / kBlendTime;
+  const Transform s = before.source(j);
+  const glm::vec3 vs = before.source_velocity(j), ws = before.source_angular_velocity(j);
+  const glm::vec3 d = quat_to_scaled_angle_axis(in.rotation * glm::conjugate(s.rotation));
+  const glm::quat partial = quat_from_scaled_angle_axis(value * d);
+  ShownJoint out;
+  out.pose.rotation = glm::normalize(partial * s.rotation);
+  out.pose.translation = glm::mix(s.translation, in.translation, value);
+  out.velocity = glm::mix(vs, vi, value) + rate * (in.translation - s.translation);
+  const glm::vec3 d_rate =
+      angular_velocity_to_rotation_vector_rate(d, wi - quat_from_scaled_angle_axis(d) * ws);
+  out.angular_velocity =
+      rotation_vector_rate_to_angular_velocity(value * d, rate * d + value * d_rate) + partial * ws;
+  return out;
+}
+
+// A switch during a blend (in SSE lanes) for n joints: every joint's new source equals
+// blend_joint's to the bit, and the last group's lanes past the joints stay at rest.
+void expect_switch_equals_blend_joint(size_t n, bool outgoing_velocities) {
+  SCOPED_TRACE(std::to_string(n) + " joints");
+  std::vector<Transform> first(n), incoming(n), outgoing(n), scratch(n);
+  std::vector<glm::vec3> v(n), w(n), out_v(n), out_w(n);
+  for (size_t j = 0; j < n; ++j) {
+    first[j] = test::random_transform(0.5f);
+    incoming[j] = test::random_transform(0.5f);
+    // A third of the joints far from the source (the logarithm's general branch).
+    outgoing[j].rotation = j % 3 == 0 ? test::random_rotation()
+                                      : turn(test::random_vec3(-0.2f, 0.2f)) * incoming[j].rotation;
+    outgoing[j].translation = test::random_vec3(-0.5f, 0.5f);
+    v[j] = test::random_vec3(-2.0f, 2.0f);
+    w[j] = test::random_vec3(-6.0f, 6.0f);
+    out_v[j] = outgoing_velocities ? test::random_vec3(-2.0f, 2.0f) : glm::vec3(0.0f);
+    out_w[j] = outgoing_velocities ? test::random_vec3(-6.0f, 6.0f) : glm::vec3(0.0f);
+  }
+  DeadBlend blend;
+  blend.resize(static_cast<int>(n));
+  dead_blend_transition(blend, {first, v, w}, kBlendTime);
+  for (int step = 0; step < 9; ++step) {
+    dead_blend_update(blend, {incoming, v, w}, kBlendTime, kDecay, 1.0f / 60.0f, scratch, {}, {});
+  }
+  ASSERT_TRUE(blend.active);
+  const DeadBlend before = blend;
+  const PoseMotion motion =
+      outgoing_velocities ? PoseMotion{outgoing, out_v, out_w} : PoseMotion{outgoing, {}, {}};
+  dead_blend_transition(blend, motion, kBlendTime);
+  for (size_t j = 0; j < n; ++j) {
+    SCOPED_TRACE("joint " + std::to_string(j));
+    const ShownJoint expected = shown_joint(before, j, outgoing[j], out_v[j], out_w[j]);
+    EXPECT_EQ(blend.source(j).rotation, expected.pose.rotation);
+    EXPECT_EQ(blend.source(j).translation, expected.pose.translation);
+    EXPECT_EQ(blend.source_velocity(j), expected.velocity);
+    EXPECT_EQ(blend.source_angular_velocity(j), expected.angular_velocity);
+  }
+  for (size_t j = n; j < 4 * blend.groups.size(); ++j) {
+    EXPECT_EQ(blend.source(j).rotation, glm::quat(1.0f, 0.0f, 0.0f, 0.0f));
+    EXPECT_EQ(blend.source(j).translation, glm::vec3(0.0f));
+    EXPECT_EQ(blend.source_velocity(j), glm::vec3(0.0f));
+    EXPECT_EQ(blend.source_angular_velocity(j), glm::vec3(0.0f));
+  }
+}
+
+TEST(DeadBlending, ASwitchDuringABlendEqualsBlendJointToTheBit) {
+  for (const size_t n : {1, 3, 4, 5, 6, 7, 8, 22}) {
+    expect_switch_equals_blend_joint(n, true);
+    expect_switch_equals_blend_joint(n, false);
+  }
 }
 
 TEST(DeadBlending, BadTimesNeverPoisonTheState) {

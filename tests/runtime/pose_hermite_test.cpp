@@ -96,5 +96,30 @@ TEST(PoseHermite, FromTheLanesLayoutEqualsTransformHermiteToTheBit) {
   });
 }
 
+// The velocities' mix from the lanes' layout, every joint from `first` on, against glm::mix of
+// each joint's values; the joints before `first` untouched.
+TEST(PoseHermite, TheVelocityMixEqualsGlmMixToTheBit) {
+  for_each_pose_pair([](const Frame& a, const Frame& b, size_t joints) {
+    std::vector<float> la(pose_lane_floats(joints)), lb(pose_lane_floats(joints));
+    pose_to_lanes(a.view(), la);
+    pose_to_lanes(b.view(), lb);
+    for (const size_t first : {size_t{0}, size_t{1}, joints - 1}) {
+      for (const float t : kTimes) {
+        const glm::vec3 untouched(7.0f, -7.0f, 7.0f);
+        std::vector<glm::vec3> v(joints, untouched), w(joints, untouched);
+        pose_velocity_mix(la, lb, t, first, v, w);
+        for (size_t j = 0; j < joints; ++j) {
+          const bool mixed = j >= first;
+          EXPECT_EQ(v[j], mixed ? glm::mix(a.velocities[j], b.velocities[j], t) : untouched)
+              << joints << " joints, joint " << j;
+          EXPECT_EQ(w[j], mixed ? glm::mix(a.angular_velocities[j], b.angular_velocities[j], t)
+                                : untouched)
+              << joints << " joints, joint " << j;
+        }
+      }
+    }
+  });
+}
+
 }  // namespace
 }  // namespace mm

@@ -566,7 +566,9 @@ class Controller {
   bool on_idle_clip() const;
   bool playing_idle_through() const;
   void record_search(const SearchResult& best);
-  void transition_to(int frame);
+  // `incoming_body`: also sample the incoming clip's body (joints 1..) at the jump; without it
+  // only its root is sampled and sampled_'s body is stale until the next sample_playback.
+  void transition_to(int frame, bool incoming_body = true);
   void start_transition();
   void show_transitions(float dt);
   void clear_transitions();
@@ -581,8 +583,16 @@ class Controller {
   PlaybackPoint playback_point() const;
   Transform sample_joint(const PlaybackPoint& at, size_t joint) const;
   Transform database_root(const PlaybackPoint& at) const;
-  void sample_playback(std::span<Transform> local, std::span<glm::vec3> velocities,
-                       std::span<glm::vec3> angular_velocities, bool body_velocities) const;
+  // The playing clip at `at` (playback_point() of the present clip and time): the update passes
+  // the point it keeps in sampled_at_.
+  void sample_playback(const PlaybackPoint& at, std::span<Transform> local,
+                       std::span<glm::vec3> velocities, std::span<glm::vec3> angular_velocities,
+                       bool body_velocities) const;
+  void sample_playback_root(std::span<Transform> local, std::span<glm::vec3> velocities,
+                            std::span<glm::vec3> angular_velocities) const;
+  void map_playback_root(const PlaybackPoint& at, std::span<Transform> local,
+                         std::span<glm::vec3> velocities,
+                         std::span<glm::vec3> angular_velocities) const;
   void sample_body_velocities(const PlaybackPoint& at, std::span<glm::vec3> velocities,
                               std::span<glm::vec3> angular_velocities) const;
   void root_motion(float dt);

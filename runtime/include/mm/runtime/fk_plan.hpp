@@ -31,7 +31,8 @@ class ForwardKinematicsPlan {
 
  private:
   struct Block {
-    std::array<int, 4> joints{};  // unused lanes repeat the last joint
+    std::array<int, 4> joints{};   // unused lanes repeat the last joint
+    std::array<int, 4> parents{};  // the lanes' parents, looked up once here
     int count = 0;
     bool lanes = false;  // composed in SSE lanes: more than one joint, none a root
   };

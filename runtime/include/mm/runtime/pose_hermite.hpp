@@ -26,4 +26,12 @@ void pose_hermite(const PoseFrameView& a, const PoseFrameView& b, float duration
 void pose_hermite(std::span<const float> a, std::span<const float> b, float duration, float t,
                   std::span<Transform> out);
 
+// The velocities between two frames in the lanes' layout (pose_to_lanes of
+// `velocities.size()` joints), the two-point mix the Hermite's velocities take: for every joint j
+// from `first` on, velocities[j] = glm::mix(a's velocity j, b's, weight) and the same of the
+// angular velocities, to the bit. The joints before `first` are left alone.
+void pose_velocity_mix(std::span<const float> a, std::span<const float> b, float weight,
+                       size_t first, std::span<glm::vec3> velocities,
+                       std::span<glm::vec3> angular_velocities);
+
 }  // namespace mm
