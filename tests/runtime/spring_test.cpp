@@ -593,11 +593,33 @@ TEST(CriticalSpringScalarCache, EqualsCriticalSpringUpdateAndFollowsChanges) {
   }
 }
 
+// critical_spring_apply's result written out in GLM's scalar arithmetic: the step's formula,
+// each component of the offset and the velocity below kSpringNegligible settled to zero.
+struct SpringState {
+  glm::vec3 x, v;
+};
+SpringState apply_by_formula(const CriticalSpringStep& step, const glm::vec3& x, const glm::vec3& v,
+                             const glm::vec3& goal) {
+  const auto settled = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
+  const glm::vec3 j0 = x - goal;
+  const glm::vec3 moved = step.xx * j0 + step.xv * v;
+  const glm::vec3 rate = step.vx * j0 + step.vv * v;
+  return {goal + glm::vec3(settled(moved.x), settled(moved.y), settled(moved.z)),
+          glm::vec3(settled(rate.x), settled(rate.y), settled(rate.z))};
+}
+
+// Both vectors' components equal to the bit (a NaN equals the same NaN; +0 is not -0).
+void expect_same_bits(const glm::vec3& actual, const glm::vec3& expected) {
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(std::bit_cast<uint32_t>(actual[i]), std::bit_cast<uint32_t>(expected[i]))
+        << "component " << i;
+  }
+}
+
 // A spring at rest on its goal (its offset and velocity zero, either sign) takes a shortcut; its
 // result is the full step's to the bit: the scalar one against the uncached update, the vector
 // one against the step's formula written out here.
 TEST(CriticalSpring, AtRestOnTheGoalEqualsTheFullStepToTheBit) {
-  const auto settled = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
   const float halflife = 0.1f, dt = 1.0f / 60.0f;
   const CriticalSpringStep step = critical_spring_step(halflife, dt);
   for (const float goal : {0.0f, -0.0f, 1.5f, -2.0f}) {
@@ -613,17 +635,10 @@ TEST(CriticalSpring, AtRestOnTheGoalEqualsTheFullStepToTheBit) {
 
         const glm::vec3 goal3(goal, 0.25f, goal), v3(v0, 0.0f, v0);
         glm::vec3 x3(x0, 0.25f, x0), velocity3 = v3;
-        const glm::vec3 j0 = x3 - goal3;
-        const glm::vec3 moved = step.xx * j0 + step.xv * v3;
-        const glm::vec3 rate = step.vx * j0 + step.vv * v3;
-        const glm::vec3 expected_x3 =
-            goal3 + glm::vec3(settled(moved.x), settled(moved.y), settled(moved.z));
-        const glm::vec3 expected_v3(settled(rate.x), settled(rate.y), settled(rate.z));
+        const SpringState expected3 = apply_by_formula(step, x3, v3, goal3);
         critical_spring_apply(x3, velocity3, goal3, step);
-        for (int i = 0; i < 3; ++i) {
-          EXPECT_EQ(std::bit_cast<uint32_t>(x3[i]), std::bit_cast<uint32_t>(expected_x3[i]));
-          EXPECT_EQ(std::bit_cast<uint32_t>(velocity3[i]), std::bit_cast<uint32_t>(expected_v3[i]));
-        }
+        expect_same_bits(x3, expected3.x);
+        expect_same_bits(velocity3, expected3.v);
       }
     }
   }
@@ -633,7 +648,6 @@ TEST(CriticalSpring, AtRestOnTheGoalEqualsTheFullStepToTheBit) {
 // written out in GLM's scalar arithmetic, to the bit: random states, components that settle to
 // zero (below kSpringNegligible after the step) and a NaN that must stay one.
 TEST(CriticalSpring, ApplyEqualsTheStepFormulaToTheBit) {
-  const auto settled = [](float c) { return std::abs(c) < kSpringNegligible ? 0.0f : c; };
   std::mt19937 random(7);
   std::uniform_real_distribution<float> value(-3.0f, 3.0f);
   for (int trial = 0; trial < 2000; ++trial) {
@@ -644,18 +658,11 @@ TEST(CriticalSpring, ApplyEqualsTheStepFormulaToTheBit) {
     const glm::vec3 goal(value(random), value(random), value(random));
     if (trial % 5 == 1) x.y = goal.y + 1e-14f, v.y = -1e-14f;
     if (trial % 97 == 3) x.z = std::numeric_limits<float>::quiet_NaN();
-    const glm::vec3 j0 = x - goal;
-    const glm::vec3 moved = step.xx * j0 + step.xv * v;
-    const glm::vec3 rate = step.vx * j0 + step.vv * v;
-    const glm::vec3 expected_x =
-        goal + glm::vec3(settled(moved.x), settled(moved.y), settled(moved.z));
-    const glm::vec3 expected_v(settled(rate.x), settled(rate.y), settled(rate.z));
+    const SpringState expected = apply_by_formula(step, x, v, goal);
     critical_spring_apply(x, v, goal, step);
-    for (int i = 0; i < 3; ++i) {
-      SCOPED_TRACE(testing::Message() << "trial " << trial << ", component " << i);
-      EXPECT_EQ(std::bit_cast<uint32_t>(x[i]), std::bit_cast<uint32_t>(expected_x[i]));
-      EXPECT_EQ(std::bit_cast<uint32_t>(v[i]), std::bit_cast<uint32_t>(expected_v[i]));
-    }
+    SCOPED_TRACE(testing::Message() << "trial " << trial);
+    expect_same_bits(x, expected.x);
+    expect_same_bits(v, expected.v);
   }
 }
 
