@@ -1183,31 +1183,33 @@ void Controller::adjust_root_local(const glm::vec3& position, const glm::quat& r
 
 void Controller::move_root(const glm::vec3& position, const glm::quat& rotation) {
   // The displayed root is the playing root plus the inertialization offsets; find the playing
-  // root that displays as requested.
+  // root that displays as requested. (GLM's arithmetic, in registers: product, normalized,
+  // rotated.)
   const glm::quat offset = quat_from_scaled_angle_axis(root_offsets_.rotations[0]);
   const glm::vec3 played_position = position - root_offsets_.positions[0];
-  const glm::quat played_rotation = glm::normalize(glm::conjugate(offset) * rotation);
+  const glm::quat played_rotation = normalized(product(glm::conjugate(offset), rotation));
   // The database root relative to the destination: M = inverse(destination) * root(t).
   const Transform root = database_root(playback_point());
   const glm::quat inverse_destination = glm::conjugate(transition_dst_rotation_);
-  const glm::quat relative_rotation = inverse_destination * root.rotation;
+  const glm::quat relative_rotation = product(inverse_destination, root.rotation);
   const glm::vec3 relative_position =
-      inverse_destination * (root.translation - transition_dst_position_);
+      rotated(inverse_destination, root.translation - transition_dst_position_);
   // The new source: the destination's rotation mapped onto the requested one, then the source
   // position recomputed from it so that the mapped root lands exactly on the request.
-  const glm::quat old_map = transition_src_rotation_ * inverse_destination;
-  transition_src_rotation_ = glm::normalize(played_rotation * glm::conjugate(relative_rotation));
-  transition_src_position_ = played_position - transition_src_rotation_ * relative_position;
-  const glm::quat new_map = transition_src_rotation_ * inverse_destination;
-  const glm::quat turn = new_map * glm::conjugate(old_map);
+  const glm::quat old_map = product(transition_src_rotation_, inverse_destination);
+  transition_src_rotation_ =
+      normalized(product(played_rotation, glm::conjugate(relative_rotation)));
+  transition_src_position_ = played_position - rotated(transition_src_rotation_, relative_position);
+  const glm::quat new_map = product(transition_src_rotation_, inverse_destination);
+  const glm::quat turn = product(new_map, glm::conjugate(old_map));
 
   sampled_[0].translation = played_position;
   sampled_[0].rotation = played_rotation;
-  sampled_velocities_[0] = turn * sampled_velocities_[0];
-  sampled_angular_velocities_[0] = turn * sampled_angular_velocities_[0];
+  sampled_velocities_[0] = rotated(turn, sampled_velocities_[0]);
+  sampled_angular_velocities_[0] = rotated(turn, sampled_angular_velocities_[0]);
   locals_[0].translation = position;
-  locals_[0].rotation = glm::normalize(rotation);
-  displayed_velocity_ = turn * displayed_velocity_;
+  locals_[0].rotation = normalized(rotation);
+  displayed_velocity_ = rotated(turn, displayed_velocity_);
 }
 
 void Controller::finish_pose() {
