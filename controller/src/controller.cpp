@@ -1167,7 +1167,8 @@ void Controller::turn_chest_to_facing(float dt) {
     const glm::quat parent =
         forward_kinematics_rotation(parents, locals_, db_->skeleton().parent(joint));
     Transform& local = locals_[static_cast<size_t>(joint)];
-    local.rotation = glm::normalize(glm::conjugate(parent) * turn * parent * local.rotation);
+    local.rotation =
+        normalized(product(product(product(glm::conjugate(parent), turn), parent), local.rotation));
   }
 }
 

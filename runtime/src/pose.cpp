@@ -3,6 +3,7 @@
 #include <cmath>
 #include "mm/runtime/assert.hpp"
 #include "mm/runtime/atan2_polynomial.hpp"
+#include "mm/runtime/transform_sse.hpp"
 #include "quat_lanes.hpp"
 
 namespace mm {
@@ -91,9 +92,18 @@ std::array<glm::vec3, 2> forward_kinematics_positions(std::span<const int> paren
 glm::quat forward_kinematics_rotation(std::span<const int> parents,
                                       std::span<const Transform> local, int joint) {
   MM_ASSERT(joint >= 0 && static_cast<size_t>(joint) < parents.size());
+#if defined(__SSE2__)
+  // GLM's products in registers (transform_sse.hpp: the same bits).
+  __m128 rotation = sse::load(local[joint].rotation);
+  for (int p = parents[joint]; p >= 0; p = parents[p]) {
+    rotation = sse::product(sse::load(local[p].rotation), rotation);
+  }
+  return sse::to_quat(rotation);
+#else
   glm::quat rotation = local[joint].rotation;
   for (int p = parents[joint]; p >= 0; p = parents[p]) rotation = local[p].rotation * rotation;
   return rotation;
+#endif
 }
 
 void bone_lengths(std::span<const int> parents, std::span<const Transform> global,
