@@ -10,7 +10,7 @@
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
 //    tilted at most max_foot_tilt, the other end hanging over), each on a spring that rises
-//    faster than it falls and never lags under the ground probed under it now;
+//    faster than it falls (the toe's never lags under the ground probed under it now);
 // 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
 //    their ground reaches it without straightening its leg further than the animation did (or
 //    than kMaxLegExtension of its length, if that is further).
