@@ -151,6 +151,8 @@ void CharacterMover::collide(const WorldQueries& world, const glm::dvec3& origin
       if (climbed_[k] && hit.hit) {
         result.blocked = true;
         result.normal = horizontal_normal(hit.normal, slide);
+      } else if (hit.hit) {
+        result.slide_normal = horizontal_normal(hit.normal, slide);
       }
     }
   }
@@ -305,6 +307,67 @@ void CharacterMover::sweep(const WorldQueries& world, const glm::dvec3& origin,
   if (sweeps.empty()) return;
   world.sweep(origin, sweeps, hits);
   for (size_t i = 0; i < sweeps.size(); ++i) accept(sweeps[i], hits[i]);
+}
+
+void HeldContacts::hold(glm::vec3& end, const MoveResult& move, float dt) {
+  int kept = 0;
+  for (int i = 0; i < count_; ++i) {
+    HalfPlane h = planes_[static_cast<size_t>(i)];
+    h.age += dt;
+    if (h.age <= kMemory) planes_[static_cast<size_t>(kept++)] = h;
+  }
+  count_ = kept;
+  if (finite(move.position)) {
+    remember(move.position, move.normal);
+    remember(move.position, move.slide_normal);
+    remember(move.position, move.edge_normal);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < count_; ++i) {
+      const HalfPlane& h = planes_[static_cast<size_t>(i)];
+      const float past = glm::dot(h.point - end, h.normal);
+      if (past > 0.0f) end += h.normal * past;
+    }
+  }
+  kept = 0;
+  for (int i = 0; i < count_; ++i) {
+    const HalfPlane& h = planes_[static_cast<size_t>(i)];
+    if (glm::dot(end - h.point, h.normal) <= kRelease) planes_[static_cast<size_t>(kept++)] = h;
+  }
+  count_ = kept;
+}
+
+// The same obstacle met again moves its line to where the end is now; a new one takes a free
+// slot, or the oldest's.
+void HeldContacts::remember(const glm::vec3& point, const glm::vec3& normal) {
+  const glm::vec3 n(normal.x, 0.0f, normal.z);
+  if (glm::length(n) < 0.5f) return;
+  const glm::vec3 unit = glm::normalize(n);
+  int slot = -1;
+  for (int i = 0; i < count_ && slot < 0; ++i) {
+    if (glm::dot(planes_[static_cast<size_t>(i)].normal, unit) >= kSameNormal) slot = i;
+  }
+  if (slot < 0 && count_ < kMax) slot = count_++;
+  if (slot < 0) {
+    slot = 0;
+    for (int i = 1; i < count_; ++i) {
+      if (planes_[static_cast<size_t>(i)].age > planes_[static_cast<size_t>(slot)].age) slot = i;
+    }
+  }
+  planes_[static_cast<size_t>(slot)] = HalfPlane{point, unit, 0.0f};
+}
+
+glm::vec3 HeldContacts::reach(const glm::vec3& goal) const {
+  glm::vec3 deeper = goal;
+  for (int i = 0; i < count_; ++i) {
+    const HalfPlane& h = planes_[static_cast<size_t>(i)];
+    if (glm::dot(h.point - goal, h.normal) >= 0.0f) deeper -= h.normal * kReach;
+  }
+  return deeper;
+}
+
+void HeldContacts::shift(const glm::vec3& by) {
+  for (int i = 0; i < count_; ++i) planes_[static_cast<size_t>(i)].point += by;
 }
 
 }  // namespace mm

@@ -468,7 +468,7 @@ void Controller::update(float dt, const ControllerInput& input) {
                                 rotation_vector_rate_to_angular_velocity(
                                     root_offsets_.rotations[0], root_offsets_.rotation_rates[0]);
   simulate(dt);
-  if (world_) collide_root_motion();
+  if (world_) collide_root_motion(dt);
   synchronize(dt);
   limit_body_turn(dt);
   turn_chest_to_facing(dt);

@@ -44,6 +44,7 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
   moved.translation = sim_position_ + turn * (moved.translation - before);
   moved.rotation = glm::normalize(turn * moved.rotation);
   last_root_ = sim_position_ + turn * (last_root_ - before);
+  root_contacts_.clear();  // moved with the body, not against what it met
   if (origin_ != glm::dvec3(0.0)) {
     world_globals_[0] = moved;
     world_globals_[0].translation = glm::vec3(to_world(origin_, moved.translation));

@@ -46,6 +46,7 @@ void Controller::shift_origin(const glm::vec3& shift) {
   debug_.origin = origin_;
   sim_position_ -= shift;
   last_root_ -= shift;
+  root_contacts_.shift(-shift);
   obstacle_point_ -= shift;
   transition_src_position_ -= shift;
   for (std::vector<Transform>* pose : {&sampled_, &other_, &locals_}) {

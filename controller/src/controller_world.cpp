@@ -49,6 +49,7 @@ void Controller::set_world(const WorldQueries* world) {
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = edge_normal_ = glm::vec3(0.0f);
+  root_contacts_.clear();
   wall_push_ = wall_push_velocity_ = 0.0f;
   // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
   body_shift_ = glm::vec3(0.0f);
@@ -117,12 +118,20 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
 // before the synchronization pulls it toward the simulation object: root motion cannot walk
 // through a wall either, and the simulation object's yield toward the root (synchronize) moves
 // it toward a place the world allows.
-void Controller::collide_root_motion() {
+void Controller::collide_root_motion(float dt) {
   const Transform root = locals_[0];
   const glm::vec3 goal(root.translation.x, 0.0f, root.translation.z);
-  const MoveResult m = mover_.move(*world_, origin_, character_shape(), last_root_, goal);
-  if (m.position.x != goal.x || m.position.z != goal.z) {
-    move_root(glm::vec3(m.position.x, root.translation.y, m.position.z), root.rotation);
+  // Held by the walls and edges it met lately too (HeldContacts): met afresh on every update,
+  // a wall or an edge stopped the root on one update and not the next. The move reaching deeper
+  // toward them only finds them: where the root goes is its goal held by what was found (the
+  // mover's own slide of the deeper move along an edge went sideways).
+  const bool holding = root_contacts_.count() > 0;
+  const MoveResult m =
+      mover_.move(*world_, origin_, character_shape(), last_root_, root_contacts_.reach(goal));
+  glm::vec3 end = holding && !m.no_ground ? goal : m.position;
+  root_contacts_.hold(end, m, dt);
+  if (end.x != goal.x || end.z != goal.z) {
+    move_root(glm::vec3(end.x, root.translation.y, end.z), root.rotation);
   }
   last_root_.y = m.position.y;
   debug_.world_rejected = mover_.rejected();
@@ -237,6 +246,7 @@ void Controller::settle_on_ground() {
   ground_height_ = sim_position_.y;
   ground_velocity_ = 0.0f;
   last_root_ = sim_position_;
+  root_contacts_.clear();
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);

@@ -29,6 +29,9 @@ constexpr float kProbeMargin = 0.02f;
 constexpr float kStepRise = 0.02f;
 // Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
 constexpr float kEdgeRise = 0.01f;
+// A foot whose heel-to-toe line's horizontal extent is at least this share of its length is
+// tilted fully (tilt()).
+constexpr float kTiltFullShare = 0.5f;
 
 // Probe slots: per side, heel and toe now, where the body takes them, where their own velocity
 // takes them.
@@ -277,7 +280,13 @@ glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) 
   const float h1 =
       (-s * y0 + std::sqrt(std::max(0.0f, s * s * y0 * y0 - a * (y0 * y0 - length * length)))) / a;
   const float y1 = s * h1 + y0;
-  const float angle = std::clamp(std::atan2(y1, h1) - std::atan2(y0, h0), -max_tilt, max_tilt);
+  // A foot pitched past kTiltFullShare of its length toward vertical is tilted less, none at
+  // vertical: passing it (a toe-off's heel swinging over the toe) turns the tilt's axis round, and
+  // a tilt kept to the end turned the foot from one side of it to the other in an update (the
+  // knee moved 9 cm, on a ramp's slope).
+  const float fade = std::min(1.0f, h0 / (kTiltFullShare * length));
+  const float angle =
+      fade * std::clamp(std::atan2(y1, h1) - std::atan2(y0, h0), -max_tilt, max_tilt);
   return glm::angleAxis(angle, glm::normalize(glm::cross(level, glm::vec3(0.0f, 1.0f, 0.0f))));
 }
 

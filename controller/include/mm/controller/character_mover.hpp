@@ -63,11 +63,12 @@ struct CharacterShape {
 
 // Where a move ended.
 struct MoveResult {
-  glm::vec3 position{0.0f};  // on the ground
-  glm::vec3 normal{0.0f};    // the (horizontal) normal of the first obstacle met, else zero
-  bool blocked = false;      // the sweeps met something
-  bool no_ground = false;    // no walkable ground at the end: the move was cancelled
-  bool edge = false;         // blocked by a ledge's edge beside its end (normal: away from it)
+  glm::vec3 position{0.0f};      // on the ground
+  glm::vec3 normal{0.0f};        // the (horizontal) normal of the first obstacle met, else zero
+  glm::vec3 slide_normal{0.0f};  // of a second one that stopped the slide along it (a corner)
+  bool blocked = false;          // the sweeps met something
+  bool no_ground = false;        // no walkable ground at the end: the move was cancelled
+  bool edge = false;             // blocked by a ledge's edge beside its end (normal: away from it)
   // The horizontal unit normal (away from the drop) of a ledge's edge within kEdgeRing radii of
   // a short move's end, whether or not the move went toward it, or of the ledge straight ahead
   // that cancelled it (no_ground); else zero.
@@ -143,6 +144,51 @@ class CharacterMover {
   std::array<int, kMaxMoves> slid_{};      // the move each slide sweep belongs to
   std::array<bool, kMaxMoves> climbed_{};  // the sweep met a step's top (phase 2), not a wall
   int64_t rejected_ = 0;
+};
+
+// The obstacles one repeated move (the animated root's, update after update) met lately: a
+// wall's face or a ledge's edge, each remembered as a half-plane for kMemory seconds. Judged
+// afresh on every update, the obstacle was met on one and missed on the next (a sweep stops kSkin
+// short, and the next step starting inside the skin misses the face; a probe of the ring sees a
+// drop from one end and not from the next, or sees it in the next of its eight directions), and
+// the end went in and out by millimetres on alternate updates, sliding one way and then another:
+// a jitter the joints' accelerations show at once. Held inside every remembered half-plane, the
+// end slides along the obstacle the same way on every update. Held on the line, the move no
+// longer reaches the obstacle (a wall kSkin beyond it), so a move pushing past a line is made
+// kReach deeper (reach()) to meet it again while it is there. A half-plane is forgotten once the
+// end is kRelease off its line (the move went away) or kMemory after it was last met (the
+// obstacle ended). No allocation.
+class HeldContacts {
+ public:
+  static constexpr int kMax = 3;
+  static constexpr float kMemory = 0.25f;   // s
+  static constexpr float kRelease = 0.02f;  // m
+  static constexpr float kReach = 0.02f;    // m
+  // Two half-planes whose normals are this close (cosine) are the same obstacle.
+  static constexpr float kSameNormal = 0.99f;
+
+  // Ages the remembered half-planes by dt (forgetting those kMemory old), remembers what `move`
+  // met (the obstacle that blocked it, the one that stopped its slide, a ledge's edge beside or
+  // ahead of it) with the move's end on their lines, holds `end` inside every half-plane (at most
+  // kMax, projected in turn, twice) and forgets those `end` is kRelease off.
+  void hold(glm::vec3& end, const MoveResult& move, float dt);
+  // The goal to move toward instead of `goal`: kReach deeper into every remembered obstacle whose
+  // line `goal` is at or past.
+  glm::vec3 reach(const glm::vec3& goal) const;
+  void shift(const glm::vec3& by);  // every remembered point, by `by`
+  void clear() { count_ = 0; }
+  int count() const { return count_; }
+
+ private:
+  struct HalfPlane {
+    glm::vec3 point{0.0f};   // on the line
+    glm::vec3 normal{0.0f};  // horizontal, unit, away from the obstacle
+    float age = 0.0f;
+  };
+  void remember(const glm::vec3& point, const glm::vec3& normal);
+
+  std::array<HalfPlane, kMax> planes_{};
+  int count_ = 0;
 };
 
 }  // namespace mm

@@ -537,7 +537,7 @@ class Controller {
   CharacterShape character_shape() const;
   void collide_simulation(const glm::vec3& before);
   void collide_trajectory(std::span<glm::vec3> positions);
-  void collide_root_motion();
+  void collide_root_motion(float dt);
   void move_displayed_root(const glm::vec3& position, const glm::quat& rotation);
   void lift_to_ground(float dt);
   void settle_on_ground();
@@ -830,6 +830,8 @@ class Controller {
   float ground_height_ = 0.0f;
   float ground_velocity_ = 0.0f;
   glm::vec3 last_root_{0.0f};
+  // The walls and ledges' edges the root's own moves met lately (collide_root_motion).
+  HeldContacts root_contacts_;
   // The game moves the capsule (set_simulation_position): the simulation object keeps the
   // height the game gave it, and the body stands at it. With a world or the game's capsule, the
   // displayed root (locals_[0]) is lifted by ground_height_ between updates.
