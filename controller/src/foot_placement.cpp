@@ -20,7 +20,7 @@ namespace {
 // The goal's change is measured as a speed, so that the same ground is followed the same way
 // at every update rate (6 cm an update at 1/30 s; the same 6 cm at 1/144 s is a step).
 constexpr float kStepChangeSpeed = 1.8f;  // m/s: a step, not a slope
-constexpr float kRiseHalflife = 0.02f;    // s
+constexpr float kRiseHalflife = 0.03f;    // s
 constexpr float kFallHalflife = 0.06f;    // s
 // How far above the highest walkable step a probe starts (m): the point it starts from is
 // never inside that step.
