@@ -7,6 +7,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 
 #include "mm/database/sampling.hpp"
 #include "mm/runtime/atan2_polynomial.hpp"
@@ -74,6 +75,10 @@ constexpr float kSweepHalflife = 0.015f;
 // starts moving against it), so that it does not go from rest to the animation's speed in one
 // update: at a run's push-off that speed is metres per second.
 constexpr float kReleaseHold = 0.5f;
+// The most (m/s^2) a released toe's offset starts accelerating at: a long offset (the new clip's
+// foot far from the held one) decays on a longer halflife than foot_lock_release_halflife. A
+// critical spring from rest accelerates at (2 ln 2 / halflife)^2 times its offset.
+constexpr float kReleaseMaxAcceleration = 20.0f;
 // A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
 // follows the animation's own lift rather than stepping with a lift of its own.
 constexpr float kLiftOffSpeed = 0.2f;
@@ -1343,6 +1348,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
       f.stepping = contact && (settle || dragged) && f.velocity.y < kLiftOffSpeed;
       f.offset = f.target - on_ground;
       f.offset_velocity = -kReleaseHold * f.velocity;
+      f.release_halflife =
+          std::max(settings_.foot_lock_release_halflife,
+                   2.0f * std::numbers::ln2_v<float> * std::sqrt(glm::length(f.offset) / kReleaseMaxAcceleration));
     }
   }
   f.previous_contact = contact;
@@ -1351,7 +1359,8 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   if (!released) {
     critical_spring_apply(
         f.offset, f.offset_velocity, glm::vec3(0.0f),
-        foot_springs_[side].offset.step(settings_.foot_lock_release_halflife, dt));
+        foot_springs_[side].offset.step(
+            std::max(f.release_halflife, settings_.foot_lock_release_halflife), dt));
   }
   glm::vec3 target = on_ground;
   // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting

@@ -774,6 +774,7 @@ class Controller {
     float lock_ground = 0.0f;  // the toe's ground (toe_ground) when the lock last followed it
     glm::vec3 offset{0.0f};    // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
+    float release_halflife = 0.0f;  // the offset's, since the release (s)
     glm::vec3 target{0.0f};  // the toe's target last update (without a step's lift)
     bool has_target = false;
     bool previous_contact = false;
