@@ -34,6 +34,18 @@ PlacementLeg standing_leg(float x, float z, float ground) {
   return leg;
 }
 
+// Both legs standing side by side, 20 cm apart, about the origin on the plane y = 0's height.
+std::array<PlacementLeg, 2> standing_legs() {
+  return {standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
+}
+
+// Makes `world`'s ground a plane rising `degrees` toward +Z through the origin (falling for
+// negative degrees).
+void make_slope(AnalyticWorld& world, float degrees) {
+  const double slope = std::tan(degrees * kPi / 180.0f);
+  world.height = [slope](double, double z) { return z * slope; };
+}
+
 // Runs the placement until its springs have settled (3 s), the body standing on `ground`.
 void settle(FootPlacement& p, const AnalyticWorld& world, CharacterMover& mover,
             const std::array<PlacementLeg, 2>& legs, float ground,
@@ -57,13 +69,11 @@ float tilted_toe_clearance(const FootPlacement& p, const AnalyticWorld& world,
 TEST(FootPlacement, OnSlopesUpAndDownHeelAndToeKeepTheirHeightAboveTheSurface) {
   for (const float degrees : {10.0f, 20.0f, 30.0f}) {
     for (const float direction : {1.0f, -1.0f}) {  // uphill, then downhill (the O3DE case)
-      const double slope = direction * std::tan(degrees * kPi / 180.0f);
       AnalyticWorld world;
-      world.height = [slope](double, double z) { return z * slope; };
+      make_slope(world, direction * degrees);
       CharacterMover mover;
       FootPlacement p;
-      const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
-                                             standing_leg(0.1f, 0.0f, 0.0f)};
+      const std::array<PlacementLeg, 2> legs = standing_legs();
       settle(p, world, mover, legs, 0.0f);
       const PlacementLeg& leg = legs[0];
       EXPECT_NEAR(p.ground(0).heel, world.surface(leg.ankle.x, leg.ankle.z), 1e-3)
@@ -83,13 +93,11 @@ TEST(FootPlacement, OnSlopesUpAndDownHeelAndToeKeepTheirHeightAboveTheSurface) {
 // threw the toe from one side to the other (9 cm at the knee in a course run). Faded out toward
 // vertical, the tilted foot line turns as smoothly as the animated one.
 TEST(FootPlacement, AFootTurningThroughVerticalOnASlopeIsTiltedContinuously) {
-  const double slope = std::tan(20.0 * kPi / 180.0);
   AnalyticWorld world;
-  world.height = [slope](double, double z) { return z * slope; };
+  make_slope(world, 20.0f);
   CharacterMover mover;
   FootPlacement p;
-  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
-                                         standing_leg(0.1f, 0.0f, 0.0f)};
+  const std::array<PlacementLeg, 2> legs = standing_legs();
   settle(p, world, mover, legs, 0.0f);
   ASSERT_TRUE(p.tilted(0));
   const float length = glm::length(legs[0].toe - legs[0].ankle);
