@@ -1348,9 +1348,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
       f.stepping = contact && (settle || dragged) && f.velocity.y < kLiftOffSpeed;
       f.offset = f.target - on_ground;
       f.offset_velocity = -kReleaseHold * f.velocity;
-      f.release_halflife =
-          std::max(settings_.foot_lock_release_halflife,
-                   2.0f * std::numbers::ln2_v<float> * std::sqrt(glm::length(f.offset) / kReleaseMaxAcceleration));
+      f.release_halflife = std::max(settings_.foot_lock_release_halflife,
+                                    2.0f * std::numbers::ln2_v<float> *
+                                        std::sqrt(glm::length(f.offset) / kReleaseMaxAcceleration));
     }
   }
   f.previous_contact = contact;

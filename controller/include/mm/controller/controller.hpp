@@ -775,7 +775,7 @@ class Controller {
     glm::vec3 offset{0.0f};    // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
     float release_halflife = 0.0f;  // the offset's, since the release (s)
-    glm::vec3 target{0.0f};  // the toe's target last update (without a step's lift)
+    glm::vec3 target{0.0f};         // the toe's target last update (without a step's lift)
     bool has_target = false;
     bool previous_contact = false;
     bool stepping = false;  // released during a contact: stepping, in the air until it lands
