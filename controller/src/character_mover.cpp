@@ -310,13 +310,8 @@ void CharacterMover::sweep(const WorldQueries& world, const glm::dvec3& origin,
 }
 
 void HeldContacts::hold(glm::vec3& end, const MoveResult& move, float dt) {
-  int kept = 0;
-  for (int i = 0; i < count_; ++i) {
-    HalfPlane h = planes_[static_cast<size_t>(i)];
-    h.age += dt;
-    if (h.age <= kMemory) planes_[static_cast<size_t>(kept++)] = h;
-  }
-  count_ = kept;
+  for (int i = 0; i < count_; ++i) planes_[static_cast<size_t>(i)].age += dt;
+  keep_if([](const HalfPlane& h) { return h.age <= kMemory; });
   if (finite(move.position)) {
     remember(move.position, move.normal);
     remember(move.position, move.slide_normal);
@@ -329,12 +324,7 @@ void HeldContacts::hold(glm::vec3& end, const MoveResult& move, float dt) {
       if (past > 0.0f) end += h.normal * past;
     }
   }
-  kept = 0;
-  for (int i = 0; i < count_; ++i) {
-    const HalfPlane& h = planes_[static_cast<size_t>(i)];
-    if (glm::dot(end - h.point, h.normal) <= kRelease) planes_[static_cast<size_t>(kept++)] = h;
-  }
-  count_ = kept;
+  keep_if([&](const HalfPlane& h) { return glm::dot(end - h.point, h.normal) <= kRelease; });
 }
 
 // The same obstacle met again moves its line to where the end is now; a new one takes a free

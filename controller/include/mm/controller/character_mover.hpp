@@ -186,6 +186,17 @@ class HeldContacts {
     float age = 0.0f;
   };
   void remember(const glm::vec3& point, const glm::vec3& normal);
+  // Keeps the half-planes `keep` is true of, in their order.
+  template <typename Keep>
+  void keep_if(Keep keep) {
+    int kept = 0;
+    for (int i = 0; i < count_; ++i) {
+      if (keep(planes_[static_cast<size_t>(i)])) {
+        planes_[static_cast<size_t>(kept++)] = planes_[static_cast<size_t>(i)];
+      }
+    }
+    count_ = kept;
+  }
 
   std::array<HalfPlane, kMax> planes_{};
   int count_ = 0;
