@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
@@ -14,14 +15,22 @@ namespace mm {
 namespace {
 
 // A foot's ground follows its goal at once where the goal moves little in an update (along a
-// slope, over bumps: a spring would lag behind a slope and land the foot above or in it), and
-// on a spring across a step (a tread's edge: the foot would pop). The spring rises faster
-// than it sinks: a toe late onto a tread is inside its riser, one late off it only hovers.
-// The goal's change is measured as a speed, so that the same ground is followed the same way
-// at every update rate (6 cm an update at 1/30 s; the same 6 cm at 1/144 s is a step).
-constexpr float kStepChangeSpeed = 1.8f;  // m/s: a step, not a slope
-constexpr float kRiseHalflife = 0.03f;    // s
-constexpr float kFallHalflife = 0.06f;    // s
+// slope, over bumps: anything slower would lag behind a slope and land the foot above or in
+// it); across a step (a tread's edge: the foot would pop) down on a spring, up with an
+// acceleration of kStepAcceleration, arriving at rest. A spring answers a step with its largest
+// acceleration at once (a 20 cm riser at a 0.03 s halflife: over 600 m/s^2, where the data's
+// locomotion p99 is about 60), and the foot's joints carry it. Only a toe that meets the step
+// sooner than that rise takes (a riser met late in a swing, a box's side a toe lifts off
+// beside; sweep_toes) rises on the spring. The goal's change is measured as a speed, so that
+// the same ground is followed the same way at every update rate (6 cm an update at 1/30 s; the
+// same 6 cm at 1/144 s is a step).
+constexpr float kStepChangeSpeed = 1.8f;    // m/s: a step, not a slope
+constexpr float kStepAcceleration = 40.0f;  // m/s^2
+constexpr float kRiseHalflife = 0.03f;      // s
+constexpr float kFallHalflife = 0.06f;      // s
+// The sphere swept along a swinging toe's way at its height (m), to find when it meets a step's
+// side (sweep_toes).
+constexpr float kToeSweepRadius = 0.02f;
 // How far above the highest walkable step a probe starts (m): the point it starts from is
 // never inside that step.
 constexpr float kProbeMargin = 0.02f;
@@ -46,17 +55,48 @@ constexpr int now_of(int which) {
   return which % 2;
 }
 
-void follow_ground(float& height, float& velocity, float goal, float dt) {
+// Toward `goal` as fast as an acceleration of at most `acceleration` allows, arriving at rest:
+// each update the velocity turns by at most acceleration * dt toward the fastest one that can
+// still stop at the goal braking at that rate in updates of dt (v^2 / 2a + v dt / 2 = distance).
+void approach(float& x, float& velocity, float goal, float acceleration, float dt) {
+  const float change = acceleration * dt;
+  const float distance = goal - x;
+  if (std::abs(distance) <= change * dt && std::abs(velocity) <= change) {
+    x = goal;
+    velocity = 0.0f;
+    return;
+  }
+  const float braking =
+      std::sqrt(0.25f * change * change + 2.0f * acceleration * std::abs(distance)) - 0.5f * change;
+  velocity += std::clamp(std::copysign(braking, distance) - velocity, -change, change);
+  // A step of more than an update's reach (acceleration * dt^2 above the distance) lands on it.
+  if (velocity * distance > 0.0f && std::abs(velocity * dt) >= std::abs(distance)) {
+    x = goal;
+    velocity = 0.0f;
+    return;
+  }
+  x += velocity * dt;
+}
+
+// `seconds`: how soon the foot meets the ground it rises to.
+void follow_ground(float& height, float& velocity, float goal, float seconds, float dt) {
+  if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
-  if (std::abs(goal - height) <= step_change && std::abs(velocity) <= kStepChangeSpeed) {
+  if (std::abs(goal - height) <= step_change && std::abs(velocity) <= kStepAcceleration * dt) {
     height = goal;
     velocity = 0.0f;
     return;
   }
-  critical_spring_update(height, velocity, goal, goal > height ? kRiseHalflife : kFallHalflife, dt);
+  if (goal < height) {
+    critical_spring_update(height, velocity, goal, kFallHalflife, dt);
+  } else if (2.0f * std::sqrt((goal - height) / kStepAcceleration) > seconds) {
+    critical_spring_update(height, velocity, goal, kRiseHalflife, dt);
+  } else {
+    approach(height, velocity, goal, kStepAcceleration, dt);
+  }
 }
 
-// A ground height held at or above `floor`: lifted onto it, the spring goes on from rest there
+// A ground height held at or above `floor`: lifted onto it, it goes on from rest there
 // (with the speed it had, it would overshoot the floor and the goal).
 void stay_above(float& height, float& velocity, float floor) {
   if (height >= floor) return;
@@ -74,6 +114,7 @@ void FootPlacement::reset(float ground) {
     foot.toe_velocity = glm::vec3(0.0f);
   }
   pelvis_drop_ = pelvis_drop_velocity_ = drop_goal_ = drop_goal_velocity_ = 0.0f;
+  toe_meets_.fill(1.0f);
   probe_grounds_.fill(glm::vec3(0.0f, ground, 0.0f));
 }
 
@@ -87,12 +128,15 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
     const FootGround g = goal(side, settings, foot_length);
     Foot& foot = feet_[side];
-    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
-    // The ground under the toe now is a floor the spring never lags under. Across a step the
+    // The heel never rises on the spring: a foot turning on its toe at a tread's edge has its
+    // ankle cross the edge, and a heel lifted at once popped the leg straight.
+    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel,
+                  std::numeric_limits<float>::infinity(), dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, toe_time_to_step(side), dt);
+    // The ground under the toe now is a floor the height never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
-    // update it is over it, and the spring left it inside the tread's side (up to 3.9 cm). Not
+    // update it is over it, and the height left it inside the tread's side (up to 3.9 cm). Not
     // the heel's: a foot turning on its toe at a tread's edge has its ankle cross the edge, and
     // the heel's ground jumped a whole step in an update, popping the leg straight.
     stay_above(foot.ground.toe, foot.velocity.toe, probe_grounds_[slot(side, kToe)].y);
@@ -135,6 +179,43 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   }
   stand_on_edges(body_ground, settings);
   keep_steps_ahead();
+  sweep_toes(world, origin, mover, legs, body_ground);
+}
+
+// Each swinging toe's way ahead (its own look-ahead) swept with a small sphere at the toe's
+// height as placed (the animation's height over the body's ground, over the toe's ground
+// instead), never lower than a step above that ground: where it stops is where the toe would
+// meet the side of a step it is not yet above (a toe lifting off beside a box meets it at once).
+void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& origin,
+                               CharacterMover& mover, std::span<const PlacementLeg, 2> legs,
+                               float body_ground) {
+  std::array<ShapeSweep, 2> sweeps;
+  size_t count = 0;
+  std::array<int, 2> sides{};
+  for (int side = 0; side < 2; ++side) {
+    toe_meets_[side] = 1.0f;
+    const glm::vec3 way = probe_points_[slot(side, kToeOwn)] - probe_points_[slot(side, kToe)];
+    const float length = glm::length(way);
+    if (length < 1e-3f) continue;
+    const glm::vec3& toe = legs[side].toe;
+    const float ground = feet_[side].ground.toe;
+    const float bottom =
+        std::max(toe.y - body_ground + ground - kToeSweepRadius, ground + kStepRise);
+    // From a radius behind the toe: a sphere starting in contact finds nothing.
+    const glm::vec3 back = way * (kToeSweepRadius / length);
+    sweeps[count] = ShapeSweep{glm::vec3(toe.x - back.x, bottom, toe.z - back.z),
+                               glm::vec3(toe.x + way.x, bottom, toe.z + way.z), kToeSweepRadius,
+                               2.0f * kToeSweepRadius};
+    sides[count++] = side;
+  }
+  std::array<SweepHit, 2> hits;
+  mover.sweep(world, origin, std::span(sweeps).first(count), std::span(hits).first(count));
+  for (size_t i = 0; i < count; ++i) {
+    if (!hits[i].hit) continue;
+    const float along = glm::length(sweeps[i].to - sweeps[i].from);
+    const float reach = std::max(0.0f, hits[i].fraction * along - kToeSweepRadius);
+    toe_meets_[sides[i]] = reach / (along - kToeSweepRadius);
+  }
 }
 
 // Heel and toe, where they are and (for a foot in the air) where the body's velocity takes them
@@ -241,6 +322,14 @@ FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
   const float toe = std::max({height(kToe), height(kToeAhead), height(kToeOwn)});
   const float rise = foot_length * std::tan(settings.max_foot_tilt);
   return FootGround{std::max(heel, toe - rise), std::max(toe, heel - rise)};
+}
+
+// How soon (s) the toe meets ground a step above its own: at once where it is over it now; where
+// its sweep stops (sweep_toes), at that share of its own look-ahead; else (a step it is above, or
+// only the body's look-ahead sees) at the end of the body's.
+float FootPlacement::toe_time_to_step(int side) const {
+  if (probe_grounds_[slot(side, kToe)].y > feet_[side].ground.toe + kStepRise) return 0.0f;
+  return toe_meets_[side] < 1.0f ? toe_meets_[side] * kToeLookahead : kLookahead;
 }
 
 // How far the pelvis must come down so that every leg near its ground reaches the ground under

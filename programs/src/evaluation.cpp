@@ -501,7 +501,9 @@ std::string csv_header(const Database& db) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
   h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
-  h.append(",toe_support_l,toe_support_r");
+  h.append(
+      ",toe_support_l,toe_support_r,body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_"
+      "drop");
   return h;
 }
 
@@ -525,8 +527,11 @@ std::string csv_row(const EvaluationFrame& r) {
                 r.toe_ground[1], r.hips_ground, r.wall_depth, r.stuck ? 1 : 0, r.locked[0] ? 1 : 0,
                 r.locked[1] ? 1 : 0);
   row += buffer;
-  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f", std::max(r.toe_ground[0], r.toe_support[0]),
-                std::max(r.toe_ground[1], r.toe_support[1]));
+  const auto world_y = [&](float y) { return to_world(r.origin, glm::vec3(0.0f, y, 0.0f)).y; };
+  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
+                std::max(r.toe_ground[0], r.toe_support[0]),
+                std::max(r.toe_ground[1], r.toe_support[1]), world_y(r.body_ground),
+                world_y(r.placed_toe_ground[0]), world_y(r.placed_toe_ground[1]), r.pelvis_drop);
   row += buffer;
   return row;
 }
@@ -561,6 +566,10 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.update_seconds = update_seconds;
   r.searched = d.searched;
   r.search_seconds = d.search_seconds;
+  r.body_ground = d.ground_height;
+  r.placed_toe_ground[0] = d.foot_ground[0].toe;
+  r.placed_toe_ground[1] = d.foot_ground[1].toe;
+  r.pelvis_drop = d.pelvis_drop;
   for (size_t j = 0; j < positions.size(); ++j) positions[j] = globals[j].translation;
   r.joints = positions;
   return r;

@@ -263,6 +263,73 @@ TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   EXPECT_EQ(p.ground(1).toe, 0.0f);
 }
 
+// A riser seen at the end of the look-ahead (the body's, 0.2 s) is climbed with the toe's ground
+// accelerating at about kStepAcceleration (40 m/s^2; the flat data's locomotion p99 is about
+// 60), reaching the tread's height before the toe is over it, at every update rate. On a spring
+// (0.03 s halflife) the same rise began at over 600 m/s^2, which the foot's joints carried.
+TEST(FootPlacement, ARiserSeenAheadIsClimbedWithBoundedAcceleration) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    AnalyticWorld world;
+    // The riser at z = 0.6, 17 cm high.
+    world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.6f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+    CharacterMover mover;
+    FootPlacement p;
+    std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, -0.15f, 0.0f),
+                                     standing_leg(0.1f, 0.0f, 0.0f)};
+    legs[0].planted = legs[0].near_ground = false;
+    p.reset(0.0f);
+    const glm::vec3 velocity(0.0f, 0.0f, 1.2f);
+    std::array<float, 3> heights{0.0f, 0.0f, 0.0f};
+    float largest = 0.0f;
+    int updates = 0;
+    while (legs[0].toe.z + velocity.z * dt < 0.6f) {
+      legs[0].toe += velocity * dt;
+      legs[0].ankle += velocity * dt;
+      p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, velocity, dt);
+      heights = {heights[1], heights[2], p.ground(0).toe};
+      if (++updates >= 3) {
+        largest =
+            std::max(largest, std::abs(heights[2] - 2.0f * heights[1] + heights[0]) / (dt * dt));
+      }
+    }
+    EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f) << dt;  // on the tread's height, the riser ahead
+    EXPECT_LE(largest, 44.0f) << dt;  // kStepAcceleration, the last update landing on the tread
+  }
+}
+
+// A toe lifting off a couple of centimetres from a box's side, toward it (a step up onto a 35 cm
+// box begun beside it), meets the side in a few hundredths of a second: its sweep finds it, and
+// its ground rises in that time, where a step met later rises more gently. (Rising at
+// kStepAcceleration whatever the time left, toes stood 3 mm into the box's side, 14 cm below its
+// top: the second course off its lanes, stop-and-go from x = 39.05 at 1/144 s.)
+TEST(FootPlacement, AToeLiftingOffBesideABoxsSideRisesAtOnce) {
+  constexpr float kStep = 1.0f / 144.0f;
+  const auto risen = [](float gap) {
+    AnalyticWorld world;
+    // The box's side at z = 0.15 + gap, its top 35 cm up.
+    world.boxes.push_back(
+        AnalyticBox{glm::vec2(0.0f, 0.65f + gap), glm::vec2(5.0f, 0.5f), 0.0f, 0.35f});
+    CharacterMover mover;
+    FootPlacement p;
+    std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
+                                     standing_leg(0.1f, -0.5f, 0.0f)};
+    legs[0].planted = legs[0].near_ground = false;
+    p.reset(0.0f);
+    const glm::vec3 velocity(0.0f, 0.0f, 0.6f);
+    for (int f = 0; f < 3; ++f) {
+      legs[0].toe += velocity * kStep;
+      legs[0].ankle += velocity * kStep;
+      p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+               kStep);
+    }
+    return p.ground(0).toe;
+  };
+  const float near = risen(0.02f), farther = risen(0.055f);
+  EXPECT_GT(near, 0.3f);            // 2 cm away: met within 0.04 s
+  EXPECT_LT(farther, 0.5f * near);  // 5.5 cm away: met in 0.09 s
+  EXPECT_EQ(risen(0.2f), 0.0f);     // beyond its look-ahead: not yet seen
+}
+
 // On a circle or a step to the side the swinging toe heads where the body does not, and
 // farther in the body's 0.2 s than in its own 0.1 s: looking only the farther way, the toe met
 // the riser it swung into (the course off its lanes, circle at 1/144: 12 cm into the stairs).

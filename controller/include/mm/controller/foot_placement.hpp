@@ -5,12 +5,14 @@
 // step up, a tread down, a slope under the toe. Once per update, after forward kinematics and
 // before foot locking, FootPlacement
 // 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
-//    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes;
+//    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes,
+//    and sweeps each swinging toe's own way ahead at its height in one more call (two sweeps);
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
-//    tilted at most max_foot_tilt, the other end hanging over), each on a spring that rises
-//    faster than it falls (the toe's never lags under the ground probed under it now);
+//    tilted at most max_foot_tilt, the other end hanging over), each falling on a spring and
+//    rising with a bounded acceleration (a toe that meets the step sooner than that allows, on a
+//    quick spring), the toe's never lagging under the ground probed under it now;
 // 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
 //    their ground reaches it without straightening its leg further than the animation did (or
 //    than kMaxLegExtension of its length, if that is further).
@@ -127,6 +129,9 @@ class FootPlacement {
   void keep_steps_ahead();
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
+  void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
+                  std::span<const PlacementLeg, 2> legs, float body_ground);
+  float toe_time_to_step(int side) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                   float body_ground) const;
 
@@ -139,6 +144,8 @@ class FootPlacement {
   std::array<GroundHit, kQueries> hits_{};
   std::array<glm::vec3, kProbes> probe_points_{};
   std::array<glm::vec3, kProbes> probe_grounds_{};
+  // Per toe, the share of its look-ahead its sweep got (sweep_toes; 1: it met nothing).
+  std::array<float, 2> toe_meets_{1.0f, 1.0f};
 };
 
 }  // namespace mm

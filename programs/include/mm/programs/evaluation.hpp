@@ -241,6 +241,11 @@ struct EvaluationFrame {
   float hips_ground = 0.0f;
   float wall_depth = 0.0f;
   bool stuck = false;
+  // The controller's own view (ControllerDebug): the ground the body stands on, the ground each
+  // toe is placed on (foot_placement.hpp; world y) and how far the pelvis came down (m).
+  float body_ground = 0.0f;
+  float placed_toe_ground[2] = {0.0f, 0.0f};
+  float pelvis_drop = 0.0f;
 };
 
 // The metrics of a run, fed one frame at a time. Holds the previous frames it needs, running
