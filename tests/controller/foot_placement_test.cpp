@@ -202,8 +202,9 @@ TEST(FootPlacement, AReleasedToeSeesTheTreadItsOffsetTakesItBackOnto) {
 
 TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
   // The body stands on a block whose edge is at z = 0.1, the toes beyond it: a 0.45 m drop is a
-  // ledge (deeper than step_height, 0.35), a 0.2 m one a step the foot goes down to.
-  for (const float drop : {0.45f, 0.2f}) {
+  // ledge (deeper than step_height, 0.35, and the mover's kStepClearance), a 0.2 m one a step the
+  // foot goes down to, and so is a 0.36 m one, which the body steps down too.
+  for (const float drop : {0.45f, 0.2f, 0.36f}) {
     AnalyticWorld world;
     world.boxes.push_back(
         AnalyticBox{glm::vec2(0.0f, 0.1f - 1.0f), glm::vec2(5.0f, 1.0f), 0.0f, drop});
@@ -215,7 +216,9 @@ TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
     const FootPlacementSettings settings;
     // Down the step, the toe goes as far as the foot may tilt from its heel on the block.
     const float rise = glm::length(legs[0].toe - legs[0].ankle) * std::tan(settings.max_foot_tilt);
-    const float expected = drop > settings.step_height ? drop : std::max(0.0f, drop - rise);
+    const float expected = drop > settings.step_height + CharacterMover::kStepClearance
+                               ? drop
+                               : std::max(0.0f, drop - rise);
     EXPECT_NEAR(p.ground(0).toe, expected, 2e-3f) << drop;
     EXPECT_NEAR(p.ground(0).heel, drop, 1e-3f) << drop;  // the heel is on the block
   }
