@@ -39,6 +39,19 @@ std::array<PlacementLeg, 2> standing_legs() {
   return {standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
 }
 
+// Both legs standing, the left one `z` along +Z and in the air (not planted, not near the ground).
+std::array<PlacementLeg, 2> left_swinging(float z) {
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, z, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
+  legs[0].planted = legs[0].near_ground = false;
+  return legs;
+}
+
+// A riser `height` high across the way at z = `at`, its tread 4 m deep beyond it.
+void add_riser(AnalyticWorld& world, float at, float height) {
+  world.boxes.push_back(
+      AnalyticBox{glm::vec2(0.0f, at + 2.0f), glm::vec2(5.0f, 2.0f), 0.0f, height});
+}
+
 // Makes `world`'s ground a plane rising `degrees` toward +Z through the origin (falling for
 // negative degrees).
 void make_slope(AnalyticWorld& world, float degrees) {
@@ -249,11 +262,10 @@ TEST(FootPlacement, AFootHeldUpASlopeTheBodyRunsDownKeepsItsGround) {
 TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   AnalyticWorld world;
   // The riser at z = 0.3, ahead of a toe at z = 0.15 moving forward with the body.
-  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.3f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+  add_riser(world, 0.3f, 0.17f);
   CharacterMover mover;
   FootPlacement p;
-  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
-  legs[0].planted = legs[0].near_ground = false;
+  std::array<PlacementLeg, 2> legs = left_swinging(0.0f);
   p.reset(0.0f);
   const FootPlacementSettings settings;
   const glm::vec3 velocity(0.0f, 0.0f, 1.4f);
@@ -273,13 +285,10 @@ TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
 TEST(FootPlacement, ARiserSeenAheadIsClimbedWithBoundedAcceleration) {
   for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
     AnalyticWorld world;
-    // The riser at z = 0.6, 17 cm high.
-    world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.6f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+    add_riser(world, 0.6f, 0.17f);
     CharacterMover mover;
     FootPlacement p;
-    std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, -0.15f, 0.0f),
-                                     standing_leg(0.1f, 0.0f, 0.0f)};
-    legs[0].planted = legs[0].near_ground = false;
+    std::array<PlacementLeg, 2> legs = left_swinging(-0.15f);
     p.reset(0.0f);
     const glm::vec3 velocity(0.0f, 0.0f, 1.2f);
     std::array<float, 3> heights{0.0f, 0.0f, 0.0f};
@@ -338,12 +347,10 @@ TEST(FootPlacement, AToeLiftingOffBesideABoxsSideRisesAtOnce) {
 // the riser it swung into (the course off its lanes, circle at 1/144: 12 cm into the stairs).
 TEST(FootPlacement, AToeSwingingAcrossTheBodysPathRisesBeforeTheRiserItHeadsFor) {
   AnalyticWorld world;
-  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.3f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
+  add_riser(world, 0.3f, 0.17f);
   CharacterMover mover;
   FootPlacement p;
-  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, -0.35f, 0.0f),
-                                   standing_leg(0.1f, 0.0f, 0.0f)};
-  legs[0].planted = legs[0].near_ground = false;
+  std::array<PlacementLeg, 2> legs = left_swinging(-0.35f);
   p.reset(0.0f);
   const FootPlacementSettings settings;
   const glm::vec3 body_velocity(3.0f, 0.0f, 0.0f);  // sideways: 0.6 m in 0.2 s
