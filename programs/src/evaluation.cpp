@@ -501,9 +501,8 @@ std::string csv_header(const Database& db) {
     h.append(",").append(name).append("_x,").append(name).append("_y,").append(name).append("_z");
   }
   h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
-  h.append(
-      ",toe_support_l,toe_support_r,body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_"
-      "drop");
+  h.append(",toe_support_l,toe_support_r");
+  h.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop");
   return h;
 }
 
@@ -527,11 +526,10 @@ std::string csv_row(const EvaluationFrame& r) {
                 r.toe_ground[1], r.hips_ground, r.wall_depth, r.stuck ? 1 : 0, r.locked[0] ? 1 : 0,
                 r.locked[1] ? 1 : 0);
   row += buffer;
-  const auto world_y = [&](float y) { return to_world(r.origin, glm::vec3(0.0f, y, 0.0f)).y; };
   std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
                 std::max(r.toe_ground[0], r.toe_support[0]),
-                std::max(r.toe_ground[1], r.toe_support[1]), world_y(r.body_ground),
-                world_y(r.placed_toe_ground[0]), world_y(r.placed_toe_ground[1]), r.pelvis_drop);
+                std::max(r.toe_ground[1], r.toe_support[1]), r.body_ground, r.placed_toe_ground[0],
+                r.placed_toe_ground[1], r.pelvis_drop);
   row += buffer;
   return row;
 }

@@ -169,8 +169,8 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
         "_z");
   }
   header.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
-  header.append(",toe_support_l,toe_support_r,body_ground,placed_toe_ground_l,placed_toe_ground_r");
-  header.append(",pelvis_drop");
+  header.append(",toe_support_l,toe_support_r");
+  header.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop");
   std::istringstream lines(dumps[0]);
   std::string first;
   std::getline(lines, first);

@@ -242,7 +242,8 @@ struct EvaluationFrame {
   float wall_depth = 0.0f;
   bool stuck = false;
   // The controller's own view (ControllerDebug): the ground the body stands on, the ground each
-  // toe is placed on (foot_placement.hpp; world y) and how far the pelvis came down (m).
+  // toe is placed on (foot_placement.hpp) and how far the pelvis came down (m). Heights, like
+  // toe_ground's: the controller's origin moves only horizontally.
   float body_ground = 0.0f;
   float placed_toe_ground[2] = {0.0f, 0.0f};
   float pelvis_drop = 0.0f;
