@@ -75,9 +75,12 @@ constexpr float kSweepHalflife = 0.015f;
 // starts moving against it), so that it does not go from rest to the animation's speed in one
 // update: at a run's push-off that speed is metres per second.
 constexpr float kReleaseHold = 0.5f;
-// The most (m/s^2) a released toe's offset starts accelerating at: a long offset (the new clip's
-// foot far from the held one) decays on a longer halflife than foot_lock_release_halflife. A
-// critical spring from rest accelerates at (2 ln 2 / halflife)^2 times its offset.
+// Bounds how fast a released toe's offset starts accelerating: a long offset (the new clip's foot
+// far from the held one) decays on a longer halflife than foot_lock_release_halflife, 2 ln 2
+// sqrt(offset / kReleaseMaxAcceleration). A spring of spring.hpp starts from rest at
+// (kHalflifeFrequencyFactor / halflife)^2 times its offset, so the bound is
+// (kHalflifeFrequencyFactor / 2 ln 2)^2 = 1.47 times this: about 29 m/s^2 (the formula was
+// written with the other convention of halflife; kept, as the motion was measured with it).
 constexpr float kReleaseMaxAcceleration = 20.0f;
 // A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
 // follows the animation's own lift rather than stepping with a lift of its own.
