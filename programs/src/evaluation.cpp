@@ -595,10 +595,11 @@ class WorldReadings {
     const glm::vec3 along =
         r.desired_velocity -
         d.simulation_contact * glm::dot(r.desired_velocity, d.simulation_contact);
-    const bool at_wall = d.simulation_blocked && glm::length(d.simulation_contact) > 0.5f;
-    r.stuck = at_wall && glm::length(along) >= kStuckAlongSpeed && moved < kStuckSpeed &&
+    r.stuck = held_at_wall(d.simulation_blocked, d.simulation_contact, r.desired_velocity,
+                           previous_sim_velocity_, d.simulation_velocity, moved) &&
               can_slide(controller.settings(), d, r.origin, along);
     previous_sim_ = d.simulation_position;
+    previous_sim_velocity_ = d.simulation_velocity;
   }
 
  private:
@@ -664,6 +665,7 @@ class WorldReadings {
   int heels_[2] = {-1, -1};  // the feet (ankles), or the toes where a side has none
   WallDepthReader walls_;
   glm::vec3 previous_sim_{0.0f};
+  glm::vec3 previous_sim_velocity_{0.0f};
 };
 
 // The acceleration the playing clips have on their own at the moments transition_accel_p99

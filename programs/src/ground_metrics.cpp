@@ -260,6 +260,22 @@ float WallDepthReader::read(const WorldQueries& world, const glm::dvec3& origin,
   return deepest_depth;
 }
 
+// Twice kStuckSpeed, at the frame's start and end: a simulation object starting from rest
+// beside a wall (the stick turned along it, or back) moves as slowly as it would in the open
+// until its spring has built the speed up, and the yield toward the character may take back half
+// of a slide along a wall (Controller::without_slide_back); neither is the wall holding it.
+bool held_at_wall(bool blocked, const glm::vec3& contact, const glm::vec3& desired_velocity,
+                  const glm::vec3& velocity_before, const glm::vec3& velocity_now,
+                  float moved_speed) {
+  if (!blocked || !(glm::length(contact) > 0.5f) || !(moved_speed < kStuckSpeed)) return false;
+  const glm::vec3 along = desired_velocity - contact * glm::dot(desired_velocity, contact);
+  const float push = glm::length(along);
+  if (!(push >= kStuckAlongSpeed)) return false;
+  const glm::vec3 direction = along / push;
+  return std::min(glm::dot(velocity_before, direction), glm::dot(velocity_now, direction)) >=
+         2.0f * kStuckSpeed;
+}
+
 double database_geometric_skate(const Database& db, float dt, uint64_t excluded_tags) {
   if (!(dt > 0.0f)) return 0.0;
   const size_t joints = static_cast<size_t>(db.joint_count());

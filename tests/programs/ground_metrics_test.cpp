@@ -217,6 +217,29 @@ TEST(GroundMetrics, StraightKneesWallDepthAndStuckTime) {
   EXPECT_NEAR(m.stuck_s, 3 * kDt, 1e-6);
 }
 
+// A wall whose normal is +x; the stick pushes along it (+z) and a little into it.
+TEST(GroundMetrics, HeldAtAWallOnlyWhenItsOwnVelocityAsksToMove) {
+  const glm::vec3 normal(1.0f, 0.0f, 0.0f);
+  const glm::vec3 push(-0.3f, 0.0f, 1.0f);
+  const glm::vec3 fast(0.0f, 0.0f, 0.4f);
+  // Snagged: its velocity along the wall is 0.4 m/s through the frame, it moved 1 cm/s.
+  EXPECT_TRUE(held_at_wall(true, normal, push, fast, fast, 0.01f));
+  // Starting from rest beside the wall: the spring has built 6 cm/s of the 1 m/s asked for, or
+  // 15 cm/s at the frame's end but 8 at its start: as slow as in the open, not held.
+  const glm::vec3 slow(0.0f, 0.0f, 0.06f);
+  EXPECT_FALSE(held_at_wall(true, normal, push, slow, slow, 0.01f));
+  EXPECT_FALSE(held_at_wall(true, normal, push, glm::vec3(0.0f, 0.0f, 0.08f),
+                            glm::vec3(0.0f, 0.0f, 0.15f), 0.04f));
+  // Its velocity points back along the wall (the stick has just turned): not held.
+  EXPECT_FALSE(held_at_wall(true, normal, push, -fast, -fast, 0.01f));
+  // Moving at kStuckSpeed or faster, not blocked, or no contact normal: not held.
+  EXPECT_FALSE(held_at_wall(true, normal, push, fast, fast, kStuckSpeed));
+  EXPECT_FALSE(held_at_wall(false, normal, push, fast, fast, 0.01f));
+  EXPECT_FALSE(held_at_wall(true, glm::vec3(0.0f), push, fast, fast, 0.01f));
+  // Pushed head-on: nothing along the wall to slide by.
+  EXPECT_FALSE(held_at_wall(true, normal, glm::vec3(-1.0f, 0.0f, 0.1f), fast, fast, 0.01f));
+}
+
 TEST(GroundMetrics, AShiftedFrameIsNotASlide) {
   GroundAccumulator a(roles(), kDt);
   for (int f = 0; f < 6; ++f) {

@@ -81,14 +81,15 @@ TEST(CourseRuns, AToeHeldOnALandingBesideItsDropStaysAboveTheLanding) {
 // Sliding along a turned wall (the first course's wall_30 strafed into, the second's wall_60
 // zigzagged along): the simulation object's yield toward the character (synchronize) gave the
 // whole slide back each update, the clip played not sliding, and the character stood still
-// beside the wall where it could have slid (0.77 and 0.63 s stuck). The yield may take back only
-// part of the slide (without_slide_back).
+// beside the wall where it could have slid (0.77 and 0.63 s stuck as first measured; 0.63 and
+// 0.37 s under today's stuck_s, which leaves out starts from rest). The yield may take back only
+// part of the slide (without_slide_back): not a frame stuck.
 TEST(CourseRuns, AlongATurnedWallTheCharacterKeepsSliding) {
   const CourseRun runs[] = {{"data/levels/course.glb", "strafe.txt", {22.0, 3.0}, 1.0f / 60.0f},
                             {"data/levels/course2.glb", "zigzag.txt", {25.8, 2.0}, 1.0f / 60.0f}};
   for (const CourseRun& r : runs) {
     const EvaluationMetrics m = run(r);
-    EXPECT_LT(m.ground.stuck_s, 0.4) << r.course << " " << r.script;
+    EXPECT_LT(m.ground.stuck_s, 0.1) << r.course << " " << r.script;
     EXPECT_LT(m.ground.wall_depth_cm_max, 2.0) << r.course << " " << r.script;
     EXPECT_LT(m.ground.foot_skate_geom_cm_s_mean, m.foot_skate_geom_data_cm_s_mean)
         << r.course << " " << r.script;

@@ -28,10 +28,14 @@
 // - wall_depth_cm_max: the deepest any joint is inside a wall (EvaluationFrame::wall_depth,
 //   from the world's queries by WallDepthReader; 0 without a world);
 // - stuck_s: time the simulation object was blocked by a wall while the stick pushed at least
-//   kStuckAlongSpeed along the wall and it moved slower than kStuckSpeed: stuck where it could
-//   have slid. A stop at a ledge (no ground ahead, no wall: the mover does not step off) has no
-//   wall to slide along and is not counted, nor is a push into a concave corner, where the
-//   capsule swept along the wall meets another within a few centimetres.
+//   kStuckAlongSpeed along the wall and it moved slower than kStuckSpeed although its own
+//   velocity along the push was at least twice that through the frame (held_at_wall): stuck
+//   where it could have slid. An object starting from rest there (the stick just turned along
+//   the wall) is not held back: its spring starts as slowly as in the open, and the yield
+//   toward the character may take back half of a slide along a wall. A stop at a ledge (no ground
+//   ahead, no wall: the mover does not step off) has no wall to slide along and is not counted, nor
+//   is a push into a concave corner, where the capsule swept along the wall meets another within a
+//   few centimetres.
 
 #include <array>
 #include <cstddef>
@@ -167,6 +171,16 @@ class WallDepthReader {
   std::vector<float> depth_;  // behind the face, of each joint past one
   std::vector<int> joint_;    // the joint each query is about
 };
+
+// Whether the simulation object is held at a wall (stuck_s, before asking the world whether
+// it could slide there): `blocked` by an obstacle of horizontal normal `contact` while the stick
+// asks `desired_velocity` (m/s) of at least kStuckAlongSpeed along it, the object moving at
+// `moved_speed` (m/s, horizontal) over the frame, slower than kStuckSpeed, although its own
+// velocity along the push was at least twice that at the frame's start and end
+// (`velocity_before`, `velocity_now`).
+bool held_at_wall(bool blocked, const glm::vec3& contact, const glm::vec3& desired_velocity,
+                  const glm::vec3& velocity_before, const glm::vec3& velocity_now,
+                  float moved_speed);
 
 // The database's own geometric skating: every clip that carries none of `excluded_tags` played
 // straight through at `dt` (linear interpolation between frames, as database_acceleration_p99)
