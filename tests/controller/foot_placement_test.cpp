@@ -215,9 +215,9 @@ TEST(FootPlacement, AReleasedToeSeesTheTreadItsOffsetTakesItBackOnto) {
 
 TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
   // The body stands on a block whose edge is at z = 0.1, the toes beyond it: a 0.45 m drop is a
-  // ledge (deeper than step_height, 0.35, and the mover's kStepClearance), a 0.2 m one a step the
-  // foot goes down to, and so is a 0.36 m one, which the body steps down too.
-  for (const float drop : {0.45f, 0.2f, 0.36f}) {
+  // ledge (deeper than step_height, 0.35, and the mover's kStepClearance), a 0.2 m one a step,
+  // and so is a 0.36 m one, which the body steps down too; a 0.08 m one the toe reaches.
+  for (const float drop : {0.45f, 0.2f, 0.36f, 0.08f}) {
     AnalyticWorld world;
     world.boxes.push_back(
         AnalyticBox{glm::vec2(0.0f, 0.1f - 1.0f), glm::vec2(5.0f, 1.0f), 0.0f, drop});
@@ -227,11 +227,13 @@ TEST(FootPlacement, AFootOutOverALedgeDeeperThanAStepStaysLevelWithTheBody) {
                                            standing_leg(0.1f, 0.0f, drop)};
     settle(p, world, mover, legs, drop);
     const FootPlacementSettings settings;
-    // Down the step, the toe goes as far as the foot may tilt from its heel on the block.
+    // Down a step the foot's tilt reaches (from its heel on the block), the toe goes down to the
+    // floor; down a deeper one it stays level with the heel, as a foot standing on a tread's
+    // edge does (tilted as far as it may, it hung over the floor all the same), and over a
+    // ledge level with the body.
     const float rise = glm::length(legs[0].toe - legs[0].ankle) * std::tan(settings.max_foot_tilt);
-    const float expected = drop > settings.step_height + CharacterMover::kStepClearance
-                               ? drop
-                               : std::max(0.0f, drop - rise);
+    ASSERT_GT(rise, 0.08f);
+    const float expected = drop > rise ? drop : 0.0f;
     EXPECT_NEAR(p.ground(0).toe, expected, 2e-3f) << drop;
     EXPECT_NEAR(p.ground(0).heel, drop, 1e-3f) << drop;  // the heel is on the block
   }

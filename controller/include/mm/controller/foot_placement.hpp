@@ -10,7 +10,8 @@
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
-//    tilted at most max_foot_tilt, the other end hanging over), each falling on a spring and
+//    tilted at most max_foot_tilt, the other end hanging over; a toe whose ground that tilt does
+//    not reach, level with the heel), each falling on a spring and
 //    rising with a bounded acceleration (a toe that meets the step sooner than that allows, on a
 //    quick spring), the toe's never lagging under the ground probed under it now;
 // 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
