@@ -131,8 +131,7 @@ constexpr float kMinSoftSpan = 0.01f;
 // hips by ten degrees in under half a second.
 constexpr float kMaxHipsAlign = 0.2f;
 constexpr float kHipsAlignHalflife = 0.05f;
-// The most (radians) a held foot's heel lifts about its toe for a leg that falls short of it.
-constexpr float kMaxHeelRise = 0.5f;
+constexpr float kMaxHeelRise = FootPlacement::kMaxHeelRise;
 // Halflife (s) of the easing between keeping the animation's extension (standing) and not.
 constexpr float kStandingReachHalflife = 0.1f;
 // The width (m) of the smooth maximum that keeps a toe target above the data's lowest toe: the

@@ -31,6 +31,10 @@ constexpr float kFallHalflife = 0.06f;      // s
 // The sphere swept along a swinging toe's way at its height (m), to find when it meets a step's
 // side (sweep_toes).
 constexpr float kToeSweepRadius = 0.02f;
+// How far toward its hip (m) a planted toe looks for a step's side its leg would drag it into,
+// and the largest vertical share of a normal that is such a side (a slope's is larger).
+constexpr float kBesideStepReach = 0.1f;
+constexpr float kSideNormalY = 0.5f;
 // How far above the highest walkable step a probe starts (m): the point it starts from is
 // never inside that step.
 constexpr float kProbeMargin = 0.02f;
@@ -41,6 +45,9 @@ constexpr float kEdgeRise = 0.01f;
 // A foot whose heel-to-toe line's horizontal extent is at least this share of its length is
 // tilted fully (tilt()).
 constexpr float kTiltFullShare = 0.5f;
+// Halvings of the pelvis drop's range that find the least drop reaching a planted toe
+// (reach_drop): 0.35 m to well under a millimetre.
+constexpr int kReachDropBisections = 12;
 
 // Probe slots: per side, heel and toe now, where the body takes them, where their own velocity
 // takes them.
@@ -112,9 +119,12 @@ void FootPlacement::reset(float ground) {
     foot.velocity = FootGround{};
     foot.has_toe = false;
     foot.toe_velocity = glm::vec3(0.0f);
+    foot.reach_shortfall = 0.0f;
+    foot.reach_planted = false;
   }
   pelvis_drop_ = pelvis_drop_velocity_ = drop_goal_ = drop_goal_velocity_ = 0.0f;
   toe_meets_.fill(1.0f);
+  toe_beside_step_.fill(false);
   probe_grounds_.fill(glm::vec3(0.0f, ground, 0.0f));
 }
 
@@ -144,10 +154,12 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.
   const float halflife = 0.5f * settings.pelvis_drop_halflife;
+  const float drop_before = pelvis_drop_;
   critical_spring_update(drop_goal_, drop_goal_velocity_, drop_goal(settings, legs, body_ground),
                          halflife, dt);
   critical_spring_update(pelvis_drop_, pelvis_drop_velocity_, drop_goal_, halflife, dt);
   pelvis_drop_ = std::clamp(pelvis_drop_, 0.0f, settings.max_pelvis_drop);
+  keep_planted_toes_reached(settings, legs, body_ground, drop_before, dt);
 }
 
 // Each toe's horizontal velocity, from where it was on the last update (none on the first, or
@@ -186,6 +198,9 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
 // height as placed (the animation's height over the body's ground, over the toe's ground
 // instead), never lower than a step above that ground: where it stops is where the toe would
 // meet the side of a step it is not yet above (a toe lifting off beside a box meets it at once).
+// Each planted toe's way toward its hip swept the same way, kBesideStepReach long: a step's
+// side there is one that the leg's reach would drag the toe into (keep_planted_toes_reached).
+// One call for both.
 void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& origin,
                                CharacterMover& mover, std::span<const PlacementLeg, 2> legs,
                                float body_ground) {
@@ -194,10 +209,17 @@ void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& orig
   std::array<int, 2> sides{};
   for (int side = 0; side < 2; ++side) {
     toe_meets_[side] = 1.0f;
-    const glm::vec3 way = probe_points_[slot(side, kToeOwn)] - probe_points_[slot(side, kToe)];
+    toe_beside_step_[side] = false;
+    const PlacementLeg& leg = legs[side];
+    glm::vec3 way = probe_points_[slot(side, kToeOwn)] - probe_points_[slot(side, kToe)];
+    if (leg.planted) {
+      const glm::vec3 to_hip(leg.hip.x - leg.toe.x, 0.0f, leg.hip.z - leg.toe.z);
+      const float across = glm::length(to_hip);
+      way = across > 1e-3f ? to_hip * (kBesideStepReach / across) : glm::vec3(0.0f);
+    }
     const float length = glm::length(way);
     if (length < 1e-3f) continue;
-    const glm::vec3& toe = legs[side].toe;
+    const glm::vec3& toe = leg.toe;
     const float ground = feet_[side].ground.toe;
     const float bottom =
         std::max(toe.y - body_ground + ground - kToeSweepRadius, ground + kStepRise);
@@ -212,9 +234,15 @@ void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& orig
   mover.sweep(world, origin, std::span(sweeps).first(count), std::span(hits).first(count));
   for (size_t i = 0; i < count; ++i) {
     if (!hits[i].hit) continue;
+    const int side = sides[i];
+    if (legs[side].planted) {
+      // A side, not a slope rising toward the hip.
+      toe_beside_step_[side] = std::abs(hits[i].normal.y) < kSideNormalY;
+      continue;
+    }
     const float along = glm::length(sweeps[i].to - sweeps[i].from);
     const float reach = std::max(0.0f, hits[i].fraction * along - kToeSweepRadius);
-    toe_meets_[sides[i]] = reach / (along - kToeSweepRadius);
+    toe_meets_[side] = reach / (along - kToeSweepRadius);
   }
 }
 
@@ -359,6 +387,71 @@ float FootPlacement::drop_goal(const FootPlacementSettings& settings,
     drop = std::max(drop, below_hip - reachable);
   }
   return std::clamp(drop, 0.0f, settings.max_pelvis_drop);
+}
+
+// The least pelvis drop, no less than `from`, that keeps a planted toe within its leg's reach:
+// the ankle, turned about the toe toward the hip by at most kMaxHeelRise (the foot lock's heel
+// rise), no farther from the hip than kMaxLegExtension of the leg. The toe stands on its ground,
+// the ankle where the animation has it above the toe. max_pelvis_drop where even that is short.
+float FootPlacement::reach_drop(int side, const PlacementLeg& leg, float body_ground, float from,
+                                float max_drop) const {
+  const glm::vec3 toe = leg.toe + glm::vec3(0.0f, feet_[side].ground.toe - body_ground, 0.0f);
+  const glm::vec3 foot = leg.ankle - leg.toe;
+  const float reach = kMaxLegExtension * leg.length;
+  const float foot_length = glm::length(foot);
+  // The ankle's nearest approach to the hip lowered by `d`: the toe-to-ankle line turned toward
+  // the toe-to-hip line, in their plane, by up to the heel's limit (law of cosines).
+  const auto reached = [&](float d) {
+    const glm::vec3 to_hip = leg.hip - glm::vec3(0.0f, d, 0.0f) - toe;
+    const float h = glm::length(to_hip);
+    if (foot_length < 1e-4f || h < 1e-4f) return h <= reach;
+    const float angle =
+        std::acos(std::clamp(glm::dot(foot, to_hip) / (foot_length * h), -1.0f, 1.0f));
+    const float left = std::max(0.0f, angle - kMaxHeelRise);
+    return foot_length * foot_length + h * h - 2.0f * foot_length * h * std::cos(left) <=
+           reach * reach;
+  };
+  if (reached(from)) return from;
+  if (!reached(max_drop)) return max_drop;
+  // Lowering the hip toward a toe below it brings the ankle nearer: the least drop that reaches
+  // lies between one that does not and one that does.
+  float low = from, high = max_drop;
+  for (int i = 0; i < kReachDropBisections; ++i) {
+    const float middle = 0.5f * (low + high);
+    (reached(middle) ? high : low) = middle;
+  }
+  return high;
+}
+
+// The pelvis drop kept from falling behind what a planted toe beside a step's side needs, off the
+// springs: the body climbing the step would otherwise pull the toe off its point, toward the hip
+// and into the side. Only there: elsewhere (up a ramp) the leg's reach releases the toe to step
+// (the foot lock's out_of_reach), and a pelvis held down for it kept the lock past its time. A toe planted out of reach (landing farther down
+// than the springs have lowered the pelvis) keeps that shortfall, which only shrinks as the
+// springs catch up: held at once, the pelvis fell a whole step in an update.
+void FootPlacement::keep_planted_toes_reached(const FootPlacementSettings& settings,
+                                              std::span<const PlacementLeg, 2> legs,
+                                              float body_ground, float drop_before, float dt) {
+  const float sprung = pelvis_drop_;
+  float floor = 0.0f;
+  for (int side = 0; side < 2; ++side) {
+    Foot& foot = feet_[side];
+    if (!legs[side].planted || !toe_beside_step_[side]) {
+      foot.reach_planted = false;
+      continue;
+    }
+    const float need = reach_drop(side, legs[side], body_ground, sprung, settings.max_pelvis_drop);
+    const float shortfall = need - sprung;
+    foot.reach_shortfall =
+        foot.reach_planted ? std::min(foot.reach_shortfall, shortfall) : shortfall;
+    foot.reach_planted = true;
+    floor = std::max(floor, need - foot.reach_shortfall);
+  }
+  if (floor > pelvis_drop_) {
+    // It goes on from there with the speed it came down at.
+    pelvis_drop_velocity_ = dt > 0.0f ? (floor - drop_before) / dt : 0.0f;
+    pelvis_drop_ = floor;
+  }
 }
 
 glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) const {

@@ -418,7 +418,8 @@ TEST(FootPlacement, GarbageAnswersAreIgnoredAndCounted) {
   const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.2f),
                                          standing_leg(0.1f, 0.0f, 0.2f)};
   settle(p, world, mover, legs, 0.2f);
-  EXPECT_EQ(mover.rejected(), 180 * FootPlacement::kQueries);
+  // Every probe and both planted toes' sweeps toward their hips.
+  EXPECT_EQ(mover.rejected(), 180 * (FootPlacement::kQueries + 2));
   for (int side = 0; side < 2; ++side) {
     EXPECT_EQ(p.ground(side).heel, 0.2f);
     EXPECT_EQ(p.ground(side).toe, 0.2f);
@@ -449,6 +450,98 @@ TEST(FootPlacement, ThePelvisComesDownSoThatTheLowerFootReachesWithinItsLimit) {
   settings.max_pelvis_drop = 0.2f;
   settle(p, world, mover, legs, 0.0f, settings);
   EXPECT_FLOAT_EQ(p.pelvis_drop(), 0.2f);
+}
+
+// Whether the hip lowered by `drop` reaches a planted toe on `toe_ground` with a leg of at most
+// 0.97 of its length: the ankle turned about the toe, toward the hip, by any heel rise up to
+// FootPlacement::kMaxHeelRise, tried in small steps.
+bool toe_in_reach(const PlacementLeg& leg, float toe_ground, float body_ground, float drop) {
+  const glm::vec3 toe = leg.toe + glm::vec3(0.0f, toe_ground - body_ground, 0.0f);
+  const glm::vec3 hip = leg.hip - glm::vec3(0.0f, drop, 0.0f);
+  const glm::vec3 axis = glm::normalize(glm::cross(leg.ankle - leg.toe, hip - toe));
+  for (int k = 0; k <= 100; ++k) {
+    const glm::quat rise = glm::angleAxis(FootPlacement::kMaxHeelRise * k / 100.0f, axis);
+    const glm::vec3 ankle = toe + rise * (leg.ankle - leg.toe);
+    if (glm::length(hip - ankle) <= 0.97f * leg.length + 1e-3f) return true;
+  }
+  return false;
+}
+
+// A leg planted on the floor with its toe 5 cm before a step's side (at z = 0.3, the step
+// beyond it toward -Z), pointing at it, its hip over the step: a step up onto a box begun beside
+// it. Heights above `body_ground`, where the animation has them.
+PlacementLeg planted_before_a_step(float body_ground) {
+  PlacementLeg leg;
+  leg.ankle = glm::vec3(0.1f, body_ground + 0.08f, 0.5f);
+  leg.toe = glm::vec3(0.1f, body_ground + 0.03f, 0.35f);
+  leg.hip = glm::vec3(0.1f, body_ground + 0.93f, 0.25f);
+  leg.length = 1.0f;
+  leg.planted = leg.near_ground = true;
+  return leg;
+}
+
+// The body climbing a 30 cm step at 1 m/s beside a toe planted on the floor before it: the
+// pelvis comes down as fast as the toe needs to stay within its leg's reach, at every rate. On
+// its springs alone it fell 16 cm behind and the leg dragged the toe toward the hip, into the
+// step's side (the second course, random-long from x = 39.05). The same toe with no step in the
+// way (a ramp's slope does not count) is left to the springs.
+TEST(FootPlacement, AToePlantedBeforeAStepTheBodyClimbsStaysWithinReach) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    for (const bool step : {true, false}) {
+      AnalyticWorld world;
+      if (step) {
+        world.boxes.push_back(
+            AnalyticBox{glm::vec2(0.0f, 0.3f - 2.0f), glm::vec2(5.0f, 2.0f), 0.0f, 0.3f});
+      }
+      CharacterMover mover;
+      FootPlacement p;
+      p.reset(0.0f);
+      int short_updates = 0;
+      for (int f = 0;; ++f) {
+        const float body_ground = std::min(0.3f, f * dt * 1.0f);
+        std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, body_ground),
+                                         planted_before_a_step(body_ground)};
+        legs[0].planted = false;
+        p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, body_ground,
+                 glm::vec3(0.0f), dt);
+        ASSERT_NEAR(p.ground(1).toe, 0.0f, 1e-4f) << dt;
+        if (!toe_in_reach(legs[1], 0.0f, body_ground, p.pelvis_drop())) ++short_updates;
+        if (body_ground >= 0.3f) break;
+      }
+      if (step) {
+        EXPECT_EQ(short_updates, 0) << dt;
+      } else {
+        EXPECT_GT(short_updates, 0) << dt;
+      }
+    }
+  }
+}
+
+// A toe landing farther below than the springs have lowered the pelvis (a foot put down off a
+// tread, onto the floor 25 cm below, before the tread's side) keeps its shortfall: the pelvis
+// comes down on its springs, not a whole step in an update.
+TEST(FootPlacement, AToeLandingOutOfReachLowersThePelvisOnItsSprings) {
+  AnalyticWorld world;
+  world.boxes.push_back(
+      AnalyticBox{glm::vec2(0.0f, 0.3f - 2.0f), glm::vec2(5.0f, 2.0f), 0.0f, 0.25f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.25f), planted_before_a_step(0.25f)};
+  legs[1].hip.z = 0.1f;  // farther over the tread: out of reach of the floor
+  legs[1].planted = legs[1].near_ground = false;
+  settle(p, world, mover, legs, 0.25f);
+  ASSERT_EQ(p.pelvis_drop(), 0.0f);
+  ASSERT_FALSE(toe_in_reach(legs[1], 0.0f, 0.25f, 0.0f));
+  legs[1].planted = legs[1].near_ground = true;
+  float drop = 0.0f;
+  for (int f = 0; f < 60; ++f) {
+    p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.25f, glm::vec3(0.0f),
+             kDt);
+    EXPECT_LE(p.pelvis_drop() - drop, 0.02f) << f;
+    drop = p.pelvis_drop();
+  }
+  // Settled, the foot reaches its ground.
+  EXPECT_TRUE(toe_in_reach(legs[1], 0.0f, 0.25f, p.pelvis_drop()));
 }
 
 // Walking up and down a slope, a planted foot stands on it as on flat ground: its toe and its

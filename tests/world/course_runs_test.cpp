@@ -78,6 +78,23 @@ TEST(CourseRuns, AToeHeldOnALandingBesideItsDropStaysAboveTheLanding) {
   }
 }
 
+// A toe planted on the floor before a step's side while the body climbs the step (the second
+// course's box_35 walked onto; its stairs_20_25 turned on at the first riser): the pelvis came
+// down on its springs only, too slowly, and the leg, short of the held toe, pulled it toward the
+// hip into the side (0.9 cm into the box's side, read 18.5 cm below its top; 8.6 cm below the
+// first tread). The pelvis now comes down as far as such a toe needs at once
+// (FootPlacement::keep_planted_toes_reached).
+TEST(CourseRuns, AToePlantedBeforeAStepTheBodyClimbsStaysOutOfItsSide) {
+  const CourseRun runs[] = {
+      {"data/levels/course2.glb", "random-long.txt", {39.05, 2.0}, 1.0f / 60.0f},
+      {"data/levels/course2.glb", "stand-turns.txt", {11.5, 2.0}, 1.0f / 30.0f}};
+  for (const CourseRun& r : runs) {
+    const EvaluationMetrics m = run(r);
+    EXPECT_GE(m.ground.toe_clearance_cm_min, 1.0) << r.course << " " << r.script;
+    EXPECT_EQ(m.ground.foot_penetration_cm_max, 0.0) << r.course << " " << r.script;
+  }
+}
+
 // Sliding along a turned wall (the first course's wall_30 strafed into, the second's wall_60
 // zigzagged along): the simulation object's yield toward the character (synchronize) gave the
 // whole slide back each update, the clip played not sliding, and the character stood still

@@ -6,7 +6,8 @@
 // before foot locking, FootPlacement
 // 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
 //    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes,
-//    and sweeps each swinging toe's own way ahead at its height in one more call (two sweeps);
+//    and sweeps each swinging toe's own way ahead at its height, and each planted toe's way
+//    toward its hip, in one more call (two sweeps);
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
@@ -16,7 +17,10 @@
 //    quick spring), the toe's never lagging under the ground probed under it now;
 // 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
 //    their ground reaches it without straightening its leg further than the animation did (or
-//    than kMaxLegExtension of its length, if that is further).
+//    than kMaxLegExtension of its length, if that is further); and at once, off the spring, as
+//    far as a planted toe with a step's side between it and its hip needs to stay within its
+//    leg's reach (the heel lifted as far as the foot lock lifts it, kMaxHeelRise) once it was:
+//    the body climbing the step would otherwise pull the toe off its point, into the side.
 // The foot lock then takes each toe's target from the animation raised or lowered by its
 // ground's offset from the body's ground, holds the planted point in 3-D, keeps a toe above
 // its own ground, and pitches the foot so that heel and toe each keep their height above their
@@ -83,6 +87,9 @@ class FootPlacement {
   // A leg may straighten to this share of its length to reach a lower foot's ground before
   // the pelvis has to drop.
   static constexpr float kMaxLegExtension = 0.97f;
+  // The most (radians) a held foot's heel lifts about its toe for a leg that falls short of it
+  // (the foot lock's reach, controller.cpp).
+  static constexpr float kMaxHeelRise = 0.5f;
 
   // Every foot's ground at `ground`, the pelvis not dropped: a placement or a new world.
   void reset(float ground);
@@ -118,6 +125,10 @@ class FootPlacement {
     glm::vec3 toe{0.0f};  // the toe's position last update, and its horizontal velocity
     glm::vec3 toe_velocity{0.0f};
     bool has_toe = false;
+    // While planted: how far the pelvis drop fell short of keeping the toe reached (m), only
+    // ever shrinking (keep_planted_toes_reached).
+    float reach_shortfall = 0.0f;
+    bool reach_planted = false;
   };
   void probe(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
              const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
@@ -135,6 +146,11 @@ class FootPlacement {
   float toe_time_to_step(int side) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                   float body_ground) const;
+  float reach_drop(int side, const PlacementLeg& leg, float body_ground, float from,
+                   float max_drop) const;
+  void keep_planted_toes_reached(const FootPlacementSettings& settings,
+                                 std::span<const PlacementLeg, 2> legs, float body_ground,
+                                 float drop_before, float dt);
 
   std::array<Foot, 2> feet_{};
   float pelvis_drop_ = 0.0f;
@@ -147,6 +163,8 @@ class FootPlacement {
   std::array<glm::vec3, kProbes> probe_grounds_{};
   // Per toe, the share of its look-ahead its sweep got (sweep_toes; 1: it met nothing).
   std::array<float, 2> toe_meets_{1.0f, 1.0f};
+  // Per planted toe, whether a step's side stands between it and its hip (sweep_toes).
+  std::array<bool, 2> toe_beside_step_{false, false};
 };
 
 }  // namespace mm
