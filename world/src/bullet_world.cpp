@@ -49,6 +49,25 @@ bool overlaps(const Culled& culled, const btVector3& low, const btVector3& high)
          low.y() <= culled.high.y() && culled.low.z() <= high.z() && low.z() <= culled.high.z();
 }
 
+// The closest hit of a convex sweep, leaving out contacts the shape moves away from (Bullet's
+// normal points from the obstacle toward the shape; along the motion, the shape leaves the
+// surface it touches). A capsule starting against a wall and stepping back from it got a hit at
+// fraction 0, its normal turned against the motion into the wall, and the controller took that
+// for a wall behind the character (the second course's wall_60, the body then pushed 6 cm into
+// the real one).
+struct ApproachingConvexResult : btCollisionWorld::ClosestConvexResultCallback {
+  using ClosestConvexResultCallback::ClosestConvexResultCallback;
+  btScalar addSingleResult(btCollisionWorld::LocalConvexResult& result,
+                           bool normal_in_world_space) override {
+    const btVector3 normal =
+        normal_in_world_space
+            ? result.m_hitNormalLocal
+            : result.m_hitCollisionObject->getWorldTransform().getBasis() * result.m_hitNormalLocal;
+    if (normal.dot(m_convexToWorld - m_convexFromWorld) > 0) return m_closestHitFraction;
+    return ClosestConvexResultCallback::addSingleResult(result, normal_in_world_space);
+  }
+};
+
 }  // namespace
 
 // Declared so that the collision world is destroyed first (it removes every object's proxy from
@@ -228,7 +247,7 @@ void BulletWorld::sweep(const glm::dvec3& origin, std::span<const ShapeSweep> sw
     btTransform to_transform;
     to_transform.setIdentity();
     to_transform.setOrigin(centre_to);
-    btCollisionWorld::ClosestConvexResultCallback result(centre_from, centre_to);
+    ApproachingConvexResult result(centre_from, centre_to);
     const btVector3 extent(sweep.radius, static_cast<btScalar>(0.5 * height), sweep.radius);
     btVector3 low = centre_from;
     btVector3 high = centre_from;
@@ -248,10 +267,7 @@ void BulletWorld::sweep(const glm::dvec3& origin, std::span<const ShapeSweep> sw
     const double length = glm::length(normal);
     const double fraction = static_cast<double>(result.m_closestHitFraction);
     if (!(length > 1e-6) || !std::isfinite(length) || !std::isfinite(fraction)) continue;
-    normal /= length;
-    // Out of the obstacle: against the motion (Bullet gives the normal on the obstacle, toward
-    // the capsule; this only guards the sign).
-    if (glm::dot(normal, to - from) > 0.0) normal = -normal;
+    normal /= length;  // out of the obstacle, against the motion (ApproachingConvexResult)
     hit.hit = true;
     hit.fraction = static_cast<float>(std::clamp(fraction, 0.0, 1.0));
     hit.normal = glm::vec3(normal);
