@@ -540,7 +540,7 @@ void Controller::desired_motion(const ControllerInput& input) {
   style_ = input.style >= 0 && input.style < shared_->style_count() ? input.style : -1;
   debug_.requested_style = style_;
   const bool released = glm::length(move) == 0.0f;
-  stopping_ = (released || held_by_obstacle()) && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
+  stopping_ = released && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
               glm::length(sim_velocity_) < settings_.stop_speed;
   debug_.desired_velocity = desired_velocity_;
   debug_.desired_rotation = desired_rotation_;

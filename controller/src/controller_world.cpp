@@ -176,24 +176,6 @@ void Controller::face_along_obstacle() {
   desired_rotation_ = glm::angleAxis(std::atan2(along.x, along.z), glm::vec3(0.0f, 1.0f, 0.0f));
 }
 
-// Pushed head-on into the wall the simulation object stands against, or toward the edge of the
-// ledge it stopped at, the character stands (with less than kSlideFacingShare of the stick's
-// velocity left along it, the facing does not turn along it either): nothing of the stick's
-// velocity moves it. Searched among locomotion as if walking, the best match for standing still
-// was a walk's first steps, played over and over, the toes shuffling on the spot.
-bool Controller::held_by_obstacle() const {
-  if (!world_) return false;
-  const auto head_on = [this](const glm::vec3& n) {
-    const float into = glm::dot(desired_velocity_, n);
-    if (glm::length(n) < 0.5f || into >= 0.0f) return false;
-    return glm::length(desired_velocity_ - n * into) <
-           kSlideFacingShare * glm::length(desired_velocity_);
-  };
-  const bool beside =
-      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) <= kBesideObstacle;
-  return (beside && head_on(obstacle_normal_)) || head_on(edge_normal_);
-}
-
 void Controller::set_simulation_position_world(const glm::dvec3& position) {
   if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) {
     return;

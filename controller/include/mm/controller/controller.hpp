@@ -549,7 +549,6 @@ class Controller {
   glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
   void face_along_obstacle();
-  bool held_by_obstacle() const;
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
