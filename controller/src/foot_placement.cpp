@@ -426,9 +426,10 @@ float FootPlacement::reach_drop(int side, const PlacementLeg& leg, float body_gr
 // The pelvis drop kept from falling behind what a planted toe beside a step's side needs, off the
 // springs: the body climbing the step would otherwise pull the toe off its point, toward the hip
 // and into the side. Only there: elsewhere (up a ramp) the leg's reach releases the toe to step
-// (the foot lock's out_of_reach), and a pelvis held down for it kept the lock past its time. A toe planted out of reach (landing farther down
-// than the springs have lowered the pelvis) keeps that shortfall, which only shrinks as the
-// springs catch up: held at once, the pelvis fell a whole step in an update.
+// (the foot lock's out_of_reach), and a pelvis held down for it kept the lock past its time. A toe
+// planted out of reach (landing farther down than the springs have lowered the pelvis) keeps that
+// shortfall, which only shrinks as the springs catch up: held at once, the pelvis fell a whole step
+// in an update.
 void FootPlacement::keep_planted_toes_reached(const FootPlacementSettings& settings,
                                               std::span<const PlacementLeg, 2> legs,
                                               float body_ground, float drop_before, float dt) {

@@ -51,10 +51,10 @@ bool overlaps(const Culled& culled, const btVector3& low, const btVector3& high)
 
 // The closest hit of a convex sweep, leaving out contacts the shape moves away from (Bullet's
 // normal points from the obstacle toward the shape; along the motion, the shape leaves the
-// surface it touches). A capsule starting against a wall and stepping back from it got a hit at
-// fraction 0, its normal turned against the motion into the wall, and the controller took that
-// for a wall behind the character (the second course's wall_60, the body then pushed 6 cm into
-// the real one).
+// surface it touches). A capsule touching a wall and moving along it (parallel to within 1e-5)
+// got a hit at fraction 0 whose normal pointed a hair along the motion; turned against the
+// motion, into the wall, it was taken for a wall behind the character (the second course's
+// wall_60: the body then pushed 6 cm into the real one).
 struct ApproachingConvexResult : btCollisionWorld::ClosestConvexResultCallback {
   using ClosestConvexResultCallback::ClosestConvexResultCallback;
   btScalar addSingleResult(btCollisionWorld::LocalConvexResult& result,
