@@ -475,6 +475,7 @@ void Controller::update(float dt, const ControllerInput& input) {
                                 rotation_vector_rate_to_angular_velocity(
                                     root_offsets_.rotations[0], root_offsets_.rotation_rates[0]);
   simulate(dt);
+  if (world_) track_held_by_obstacle(dt);
   if (world_) collide_root_motion(dt);
   synchronize(dt);
   limit_body_turn(dt);
@@ -535,12 +536,16 @@ void Controller::desired_motion(const ControllerInput& input) {
   const glm::vec3 scaled(local.x * sideways, 0.0f, local.z * (local.z > 0.0f ? forward : backward));
   desired_velocity_ = desired_rotation_ * scaled;
   if (world_ && !input.strafe && !facing_given) face_along_obstacle();
+  // Standing at an obstacle the stick pushes into, nothing of its velocity is asked for: the
+  // prediction (and the body's ground taken from it) is of standing.
+  stick_velocity_ = desired_velocity_;
+  if (standing_at_obstacle()) desired_velocity_ = glm::vec3(0.0f);
 
   tag_bits_ = input.tag_bits ? *input.tag_bits : shared_->tag_bits(input.tag);
   style_ = input.style >= 0 && input.style < shared_->style_count() ? input.style : -1;
   debug_.requested_style = style_;
   const bool released = glm::length(move) == 0.0f;
-  stopping_ = released && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
+  stopping_ = (released || standing_at_obstacle()) && shared_->idle_tags() != 0 && tag_bits_ == 0 &&
               glm::length(sim_velocity_) < settings_.stop_speed;
   debug_.desired_velocity = desired_velocity_;
   debug_.desired_rotation = desired_rotation_;

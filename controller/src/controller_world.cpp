@@ -22,6 +22,10 @@ constexpr float kNearGroundHeight = 0.1f;
 // Pushing into a wall, the share of the desired speed that must be left along it for the
 // character to turn and walk along it rather than stand facing the wall.
 constexpr float kSlideFacingShare = 0.3f;
+// Held head-on at an obstacle (held_by_obstacle) below this speed (m/s) for this long (s), the
+// character stands.
+constexpr float kHeldSpeed = 0.1f;
+constexpr float kHeldDelay = 0.3f;
 // The simulation object is still beside the wall it last met while no farther from it than
 // this (m).
 constexpr float kBesideObstacle = 0.05f;
@@ -49,6 +53,7 @@ void Controller::set_world(const WorldQueries* world) {
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = edge_normal_ = glm::vec3(0.0f);
+  held_time_ = 0.0f;
   root_contacts_.clear();
   wall_push_ = wall_push_velocity_ = 0.0f;
   // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
@@ -176,6 +181,39 @@ void Controller::face_along_obstacle() {
   desired_rotation_ = glm::angleAxis(std::atan2(along.x, along.z), glm::vec3(0.0f, 1.0f, 0.0f));
 }
 
+// Pushed head-on into the wall the simulation object stands against, or toward the edge of the
+// ledge it stopped at (less than kSlideFacingShare of the stick's velocity left along it, where
+// the facing does not turn along it either): nothing of the stick's velocity moves it.
+bool Controller::held_by_obstacle() const {
+  if (!world_) return false;
+  const auto head_on = [this](const glm::vec3& n) {
+    const float into = glm::dot(stick_velocity_, n);
+    if (glm::length(n) < 0.5f || into >= 0.0f) return false;
+    return glm::length(stick_velocity_ - n * into) <
+           kSlideFacingShare * glm::length(stick_velocity_);
+  };
+  const bool beside =
+      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) <= kBesideObstacle;
+  return (beside && head_on(obstacle_normal_)) || head_on(edge_normal_);
+}
+
+// How long the simulation object has been held so (held_by_obstacle). Held kHeldDelay, the
+// character stands: the search looks among the idle clips, as with the stick released.
+// Searched among locomotion, the best match for standing still was a walk's first steps, played
+// over and over with the toes shuffling on the spot; standing at once, a stick sweeping past a
+// wall (the circle script) flickered into the idle for a few frames.
+// Until then the object must also be nearly at rest (kHeldSpeed); standing, only the stick can
+// end it (the standing simulation object moves toward the character).
+void Controller::track_held_by_obstacle(float dt) {
+  const bool held =
+      held_by_obstacle() && (standing_at_obstacle() || glm::length(sim_velocity_) < kHeldSpeed);
+  held_time_ = held ? held_time_ + dt : 0.0f;
+}
+
+bool Controller::standing_at_obstacle() const {
+  return held_time_ >= kHeldDelay;
+}
+
 void Controller::set_simulation_position_world(const glm::dvec3& position) {
   if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) {
     return;
@@ -250,6 +288,7 @@ void Controller::settle_on_ground() {
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);
+  held_time_ = 0.0f;
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
   std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
   wall_push_ = wall_push_velocity_ = 0.0f;

@@ -549,6 +549,9 @@ class Controller {
   glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
   void face_along_obstacle();
+  bool held_by_obstacle() const;
+  void track_held_by_obstacle(float dt);
+  bool standing_at_obstacle() const;
   void desired_motion(const ControllerInput& input);
   void simulate(float dt);
   void stand_turn(float dt);
@@ -844,6 +847,9 @@ class Controller {
   glm::vec3 obstacle_normal_{0.0f};
   glm::vec3 edge_normal_{0.0f};  // the ledge edge the simulation stands at, or zero
   glm::vec3 obstacle_point_{0.0f};
+  float held_time_ = 0.0f;  // how long the simulation has been held at it (s)
+  // The velocity the stick asks for (desired_velocity_ before standing at an obstacle).
+  glm::vec3 stick_velocity_{0.0f};
   // How far (m) the body above the root is moved back from that wall, its rate, and along what.
   float wall_push_ = 0.0f;
   float wall_push_velocity_ = 0.0f;
