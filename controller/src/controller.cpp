@@ -131,7 +131,6 @@ constexpr float kMinSoftSpan = 0.01f;
 // hips by ten degrees in under half a second.
 constexpr float kMaxHipsAlign = 0.2f;
 constexpr float kHipsAlignHalflife = 0.05f;
-constexpr float kMaxHeelRise = FootPlacement::kMaxHeelRise;
 // Halflife (s) of the easing between keeping the animation's extension (standing) and not.
 constexpr float kStandingReachHalflife = 0.1f;
 // The width (m) of the smooth maximum that keeps a toe target above the data's lowest toe: the
@@ -183,10 +182,10 @@ glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, flo
   return hip_to_ankle * (reached / d);
 }
 
-// The turn (radians, at most kMaxHeelRise) about the held toe that brings the ankle to `distance`
-// from the hip, turning the toe-to-ankle line toward the toe-to-hip line about `axis` so that the
-// heel lifts; 0 where the ankle is already that close. `axis` is left as it was where the lines
-// give none (a turn easing out keeps its last axis).
+// The turn (radians, at most FootPlacement::kMaxHeelRise) about the held toe that brings the ankle
+// to `distance` from the hip, turning the toe-to-ankle line toward the toe-to-hip line about `axis`
+// so that the heel lifts; 0 where the ankle is already that close. `axis` is left as it was where
+// the lines give none (a turn easing out keeps its last axis).
 float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::vec3& hip,
                       float distance, glm::vec3& axis) {
   const glm::vec3 a = ankle - toe, h = hip - toe;
@@ -210,7 +209,7 @@ float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::v
   // A turn that would lower the heel (the hip below the foot) is no heel rise: the axis is
   // perpendicular to a, so a turns to a cos + (axis x a) sin.
   if (a.y * turn_cos + glm::cross(axis, a).y * turn_sin <= a.y) return 0.0f;
-  return std::clamp(atan2_polynomial(turn_sin, turn_cos), 0.0f, kMaxHeelRise);
+  return std::clamp(atan2_polynomial(turn_sin, turn_cos), 0.0f, FootPlacement::kMaxHeelRise);
 }
 
 // The root (joint 0) and the body (joints 1..) of a pose and its velocities: transitions treat
@@ -475,8 +474,10 @@ void Controller::update(float dt, const ControllerInput& input) {
                                 rotation_vector_rate_to_angular_velocity(
                                     root_offsets_.rotations[0], root_offsets_.rotation_rates[0]);
   simulate(dt);
-  if (world_) track_held_by_obstacle(dt);
-  if (world_) collide_root_motion(dt);
+  if (world_) {
+    track_held_by_obstacle(dt);
+    collide_root_motion(dt);
+  }
   synchronize(dt);
   limit_body_turn(dt);
   turn_chest_to_facing(dt);
