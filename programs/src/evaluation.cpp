@@ -138,6 +138,10 @@ struct EvaluationAccumulator::State {
 
   // Plain metrics.
   PercentileHistogram skate, accelerations, hips_rates;
+  // The largest transition accelerations, a min-heap of at most transition_capacity.
+  std::vector<TransitionSample> transition_top;
+  size_t transition_capacity = 0;
+  void keep_largest(const EvaluationFrame& r, int windows);
   RunningMean skate_mean, distance, facing, updates, searches, stand_root, stand_foot;
   double distance_max = 0.0;
   int transitions = 0;
@@ -426,8 +430,29 @@ void EvaluationAccumulator::State::measure_transition_accel(const EvaluationFram
     for (int i = 0; i < count; ++i) {
       joint_accelerations(positions[0], positions[1], r.joints, dt, accelerations);
     }
+    if (count > 0 && transition_capacity > 0) keep_largest(r, count);
   }
   transition_bits = (transition_bits << 1) | (r.transition ? 1u : 0u);
+}
+
+// The previous frame's joint accelerations (as measure_transition_accel takes them) into the
+// largest kept, each counted in `windows` transitions' windows.
+void EvaluationAccumulator::State::keep_largest(const EvaluationFrame& r, int windows) {
+  const auto larger = [](const TransitionSample& a, const TransitionSample& b) {
+    return a.acceleration > b.acceleration;
+  };
+  for (size_t j = 1; j < r.joints.size(); ++j) {
+    const double a =
+        glm::length(r.joints[j] - 2.0f * positions[1][j] + positions[0][j]) / (dt * dt);
+    if (transition_top.size() == transition_capacity) {
+      if (!(a > transition_top.front().acceleration)) continue;
+      std::pop_heap(transition_top.begin(), transition_top.end(), larger);
+      transition_top.pop_back();
+    }
+    transition_top.push_back(
+        {a, previous.t, static_cast<int>(j), windows, previous.clip, previous.frame});
+    std::push_heap(transition_top.begin(), transition_top.end(), larger);
+  }
 }
 
 // This frame becomes the previous one: its scalars and a copy of its joints.
@@ -437,6 +462,21 @@ void EvaluationAccumulator::State::remember(const EvaluationFrame& r) {
   previous = r;
   previous.joints = positions[1];
   ++frames;
+}
+
+void EvaluationAccumulator::keep_transition_samples(int count) {
+  State& s = *state_;
+  s.transition_capacity = static_cast<size_t>(std::max(count, 0));
+  s.transition_top.clear();
+  s.transition_top.reserve(s.transition_capacity);
+}
+
+std::vector<TransitionSample> EvaluationAccumulator::transition_samples() const {
+  std::vector<TransitionSample> sorted = state_->transition_top;
+  std::sort(sorted.begin(), sorted.end(), [](const TransitionSample& a, const TransitionSample& b) {
+    return a.acceleration > b.acceleration;
+  });
+  return sorted;
 }
 
 EvaluationMetrics EvaluationAccumulator::metrics() const {
@@ -793,6 +833,10 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   if (!std::isfinite(options.start.x) || !std::isfinite(options.start.y)) {
     return Error{"evaluation: the start position must be finite"};
   }
+  if (options.transition_report < 0 || options.transition_report > kMaxTransitionReport) {
+    return Error{"evaluation: transition_report must be in [0, " +
+                 std::to_string(kMaxTransitionReport) + "]"};
+  }
   const float dt = options.dt;
   const float seconds = options.seconds > 0.0f ? options.seconds : script.duration() + 2.0f;
   const Result<int> frame_count = scripted_run_frames(seconds, dt);
@@ -812,6 +856,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
 
   if (options.dump) *options.dump << csv_header(db) << "\n";
   EvaluationAccumulator accumulator(db.roles(), joints, dt);
+  accumulator.keep_transition_samples(options.transition_report);
   std::vector<glm::vec3> positions(joints);
   WorldReadings world(options.world, db.roles(), joints);
   PlayedAcceleration played(db, dt, options.settings.cubic_playback);
@@ -831,6 +876,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   }
   EvaluationResult result;
   result.metrics = accumulator.metrics();
+  result.transition_samples = accumulator.transition_samples();
   compare_with_database(*database, options, result.metrics);
   compare_skating_with_database(*database, dt, result.metrics);
   EvaluationMetrics& m = result.metrics;

@@ -454,6 +454,59 @@ TEST(Evaluation, StyleResponseIsTheMeanAndTheSlowestOfTheRequests) {
   EXPECT_NEAR(m.style_match, (7.0 + 2.0) / 20.0, 1e-9);
 }
 
+// The largest accelerations the transition metric counts, kept for a report: a transition at
+// frame 10 opens a 10-frame window; the head raised 1 cm at frame 12 alone accelerates by
+// 2 cm / dt^2 there and 1 cm / dt^2 on the frames either side; a larger jolt at frame 40, in no
+// window, is not among them.
+TEST(Evaluation, TheTransitionReportListsTheLargestAccelerationsInTheWindows) {
+  EvaluationAccumulator accumulator(synthetic_roles(), kJointCount, kDt);
+  accumulator.keep_transition_samples(3);
+  for (int i = 0; i < 60; ++i) {
+    Pose pose;
+    if (i == 12) pose.head.y += 0.01f;
+    if (i == 40) pose.head.y += 0.05f;
+    const std::vector<glm::vec3> joints = joints_of(pose);
+    EvaluationFrame f;
+    f.t = static_cast<float>(i + 1) * kDt;
+    f.transition = i == 10;
+    f.clip = 3;
+    f.frame = 100 + i;
+    f.joints = joints;
+    accumulator.add(f);
+  }
+  const std::vector<TransitionSample> top = accumulator.transition_samples();
+  ASSERT_EQ(top.size(), 3u);
+  EXPECT_EQ(top[0].joint, kHead);
+  EXPECT_NEAR(top[0].acceleration, 0.02 / (kDt * kDt), 0.5);
+  EXPECT_NEAR(top[0].t, 13.0f * kDt, 1e-6f);
+  EXPECT_EQ(top[0].windows, 1);
+  EXPECT_EQ(top[0].clip, 3);
+  EXPECT_EQ(top[0].frame, 112);
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_EQ(top[k].joint, kHead);
+    EXPECT_NEAR(top[k].acceleration, 0.01 / (kDt * kDt), 0.5);
+    EXPECT_TRUE(top[k].frame == 111 || top[k].frame == 113) << top[k].frame;
+  }
+  // The transition metric itself counts the window's samples all the same.
+  EXPECT_GT(accumulator.metrics().transition_accel_p99, 0.0);
+}
+
+// Nothing is kept unless asked for.
+TEST(Evaluation, NoTransitionReportUnlessAsked) {
+  EvaluationAccumulator accumulator(synthetic_roles(), kJointCount, kDt);
+  for (int i = 0; i < 20; ++i) {
+    Pose pose;
+    if (i == 12) pose.head.y += 0.01f;
+    const std::vector<glm::vec3> joints = joints_of(pose);
+    EvaluationFrame f;
+    f.t = static_cast<float>(i + 1) * kDt;
+    f.transition = i == 10;
+    f.joints = joints;
+    accumulator.add(f);
+  }
+  EXPECT_TRUE(accumulator.transition_samples().empty());
+}
+
 TEST(Evaluation, NothingMeasuredGivesZeroesAndZeroCounts) {
   EvaluationAccumulator empty(synthetic_roles(), kJointCount, kDt);
   const EvaluationMetrics m = empty.metrics();

@@ -220,13 +220,50 @@ TEST(ControllerCli, EvalUsageErrorsExitWith2) {
        {std::string("eval --script '") + script.string() + "'",
         eval_arguments(script, "--ik maybe"), eval_arguments(script, "--dt 0"),
         eval_arguments(script, "--set warp_speed=9"),
-        eval_arguments(script, "--set inertialization_halflife=-1")}) {
+        eval_arguments(script, "--set inertialization_halflife=-1"),
+        eval_arguments(script, "--transition-report -1"),
+        eval_arguments(script, "--transition-report 10001")}) {
     const CommandRun run = run_mm(arguments);
     EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
   }
   const CommandRun missing = run_mm(eval_arguments(dir / "none.txt", ""));
   EXPECT_EQ(missing.exit_code, 1) << missing.output;
   EXPECT_NE(missing.output.find("none.txt"), std::string::npos) << missing.output;
+}
+
+// --transition-report lists the largest accelerations the transition metric counts, largest
+// first, on the terminal and in the JSON, each a joint of the skeleton in a playing clip; the
+// metrics are the same run's.
+TEST(ControllerCli, EvalReportsTheLargestTransitionAccelerations) {
+  const fs::path dir = test::scratch_dir();
+  const fs::path script = write_script(dir, "walk.txt", kScript);
+  const fs::path plain = dir / "plain.json", reported = dir / "reported.json";
+  const CommandRun without = run_mm(eval_arguments(script, "--json '" + plain.string() + "'"));
+  const CommandRun with =
+      run_mm(eval_arguments(script, "--transition-report 5 --json '" + reported.string() + "'"));
+  ASSERT_EQ(without.exit_code, 0) << without.output;
+  ASSERT_EQ(with.exit_code, 0) << with.output;
+  const nlohmann::json a = nlohmann::json::parse(read_text(plain));
+  const nlohmann::json b = nlohmann::json::parse(read_text(reported));
+  EXPECT_FALSE(a.contains("transition_accel_largest"));
+  ASSERT_TRUE(b.contains("transition_accel_largest"));
+  const nlohmann::json& list = b["transition_accel_largest"];
+  ASSERT_EQ(list.size(), 5u);
+  for (size_t i = 0; i < list.size(); ++i) {
+    EXPECT_FALSE(list[i]["joint"].get<std::string>().empty());
+    EXPECT_FALSE(list[i]["clip"].get<std::string>().empty());
+    EXPECT_GE(list[i]["windows"].get<int>(), 1);
+    if (i > 0) {
+      EXPECT_GE(list[i - 1]["m_s2"].get<double>(), list[i]["m_s2"].get<double>());
+    }
+  }
+  // The 99th percentile is no larger than the largest sample it is taken over.
+  EXPECT_LE(b["transition_accel_p99_m_s2"].get<double>(), list[0]["m_s2"].get<double>() + 1e-3);
+  EXPECT_EQ(a["transition_accel_ratio"], b["transition_accel_ratio"]);
+  EXPECT_NE(with.output.find("largest joint accelerations in the transitions' windows"),
+            std::string::npos)
+      << with.output;
+  EXPECT_NE(with.output.find(list[0]["joint"].get<std::string>()), std::string::npos);
 }
 
 // The rows of a --dump file as numbers, the header skipped.

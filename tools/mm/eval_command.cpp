@@ -34,6 +34,45 @@ struct Arguments {
   std::string style;  // --style: the style of every script line without one
 };
 
+// `--transition-report`: the largest accelerations transition_accel_ratio is taken over, with
+// the joint, the time and what played.
+void print_transition_samples(const std::string& name, const EvaluationResult& result,
+                              const Database& db) {
+  const EvaluationMetrics& m = result.metrics;
+  std::printf(
+      "largest joint accelerations in the transitions' windows%s%s (and as a multiple of "
+      "the database's p99, %.1f m/s^2):\n",
+      name.empty() ? "" : ", ", name.c_str(), m.database_accel_p99);
+  for (const TransitionSample& s : result.transition_samples) {
+    std::string clip = "-";
+    int clip_frame = -1;
+    if (s.clip >= 0 && static_cast<size_t>(s.clip) < db.clips().size()) {
+      const ClipRange& c = db.clips()[static_cast<size_t>(s.clip)];
+      clip = c.name;
+      clip_frame = s.frame - c.start;
+    }
+    std::printf("  t %9.4f s  %-16s %9.1f m/s^2  %6.2f x  windows %d  clip %s frame %d\n", s.t,
+                db.skeleton().name(s.joint).c_str(), s.acceleration,
+                m.database_accel_p99 > 0.0 ? s.acceleration / m.database_accel_p99 : 0.0, s.windows,
+                clip.c_str(), clip_frame);
+  }
+}
+
+nlohmann::json transition_samples_json(const EvaluationResult& result, const Database& db) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const TransitionSample& s : result.transition_samples) {
+    const bool known = s.clip >= 0 && static_cast<size_t>(s.clip) < db.clips().size();
+    list.push_back(
+        {{"t", s.t},
+         {"joint", db.skeleton().name(s.joint)},
+         {"m_s2", s.acceleration},
+         {"windows", s.windows},
+         {"clip", known ? db.clips()[static_cast<size_t>(s.clip)].name : ""},
+         {"clip_frame", known ? s.frame - db.clips()[static_cast<size_t>(s.clip)].start : -1}});
+  }
+  return list;
+}
+
 // --start farther than this (m) is a typo, not a world: even a planet is smaller.
 constexpr double kMaxStartMetres = 1e7;
 
@@ -84,6 +123,12 @@ int parse_arguments(const std::vector<std::string>& args, Arguments& out) {
                  "global position, then the ground under the toes and the hips, the wall depth (m) "
                  "and whether the simulation was stuck")
       ->type_name("FILE");
+  app.add_option("--transition-report", out.options.transition_report,
+                 "list the N largest joint accelerations transition_accel_ratio is taken over "
+                 "(time, joint, m/s^2, times the database's p99, the clip playing); in the JSON "
+                 "as transition_accel_largest")
+      ->type_name("N")
+      ->check(CLI::Range(0, kMaxTransitionReport));
   if (const int code = parse_command_line(app, args); code >= 0) return code;
   if (const auto start = parse_number_pair(out.start)) {
     out.options.start = glm::dvec2(start->first, start->second);
@@ -249,6 +294,7 @@ int run_eval(const std::vector<std::string>& args) {
   if (table) print_table_header();
   nlohmann::json runs = nlohmann::json::array();
   std::vector<std::pair<std::string, EvaluationMetrics>> rows;
+  std::vector<std::pair<std::string, EvaluationResult>> reports;
   nlohmann::json single;
   int default_style = -1;
   if (!arguments.style.empty()) {
@@ -285,9 +331,14 @@ int run_eval(const std::vector<std::string>& args) {
     const std::string name = std::filesystem::path(path).stem().string();
     nlohmann::json json = evaluation_run_json(result->metrics, path, arguments.options);
     if (world) json["world"] = arguments.world_path;
+    const Database& db = (*shared)->database();
+    if (arguments.options.transition_report > 0) {
+      json["transition_accel_largest"] = transition_samples_json(*result, db);
+    }
     if (table) {
       print_table_row(name, result->metrics);
       rows.emplace_back(name, result->metrics);
+      if (arguments.options.transition_report > 0) reports.emplace_back(name, *result);
       runs.push_back(json);
     } else {
       std::printf("script %s, dt %.5f s, IK %s, %d frames (%.1f s)%s%s\n", path.c_str(),
@@ -295,6 +346,7 @@ int run_eval(const std::vector<std::string>& args) {
                   result->metrics.frames, result->metrics.seconds, world ? ", world " : "",
                   world ? arguments.world_path.c_str() : "");
       print_metrics(result->metrics);
+      if (arguments.options.transition_report > 0) print_transition_samples("", *result, db);
       single = json;
     }
     if (!arguments.dump_path.empty()) {
@@ -309,6 +361,10 @@ int run_eval(const std::vector<std::string>& args) {
     std::printf("\n");
     print_body_table_header();
     for (const auto& [name, metrics] : rows) print_body_table_row(name, metrics);
+    for (const auto& [name, result] : reports) {
+      std::printf("\n");
+      print_transition_samples(name, result, (*shared)->database());
+    }
   }
   if (!arguments.json_path.empty()) {
     std::ofstream file(arguments.json_path);

@@ -249,6 +249,18 @@ struct EvaluationFrame {
   float pelvis_drop = 0.0f;
 };
 
+// One joint's acceleration among those transition_accel_p99 is taken over: which joint, when
+// (the frame it is the second difference at) and what played then, and how many transitions'
+// 10-frame windows counted it.
+struct TransitionSample {
+  double acceleration = 0.0;  // m/s^2
+  float t = 0.0f;             // s
+  int joint = -1;
+  int windows = 0;
+  int clip = -1;   // the playing clip (index into the database's clips), or -1
+  int frame = -1;  // the database frame
+};
+
 // The metrics of a run, fed one frame at a time. Holds the previous frames it needs, running
 // sums and fixed-size histograms for the percentiles (foot_skate_cm_s_p95,
 // transition_accel_p99, body_turn_rate_deg_s_p99: nearest rank, within 0.05 % of the exact
@@ -267,6 +279,11 @@ class EvaluationAccumulator {
   // The metrics of the frames so far, events still open closed at the last frame. The database
   // figures (database_accel_p99*, the ratios) are left 0: evaluate_script fills them.
   EvaluationMetrics metrics() const;
+  // Keeps the `count` largest of the joint accelerations transition_accel_p99 is taken over
+  // (memory for them reserved now; 0: none), for transition_samples(). Call before add().
+  void keep_transition_samples(int count);
+  // Those kept so far, largest first.
+  std::vector<TransitionSample> transition_samples() const;
 
  private:
   struct State;
@@ -294,13 +311,19 @@ struct EvaluationOptions {
   // (the record's joints are valid during the call only): how a caller other than the CSV dump
   // (the Python module's run_script) keeps the run frame by frame.
   std::function<void(const EvaluationFrame&)> on_frame;
+  // How many of the largest accelerations the transition metric counts to list in the result
+  // (`mm eval --transition-report N`): where a transition_accel_ratio comes from.
+  int transition_report = 0;  // at most kMaxTransitionReport
 };
+
+inline constexpr int kMaxTransitionReport = 10000;
 
 // Desired speeds above this count as moving for style_match (m/s).
 inline constexpr float kStyleMovingSpeed = 0.1f;
 
 struct EvaluationResult {
   EvaluationMetrics metrics;
+  std::vector<TransitionSample> transition_samples;  // EvaluationOptions::transition_report
 };
 
 // The database's own joint acceleration, 99th percentile (m/s^2): every clip that carries none
