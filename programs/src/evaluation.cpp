@@ -50,11 +50,14 @@ int frames_for(float seconds, float dt) {
 
 // Acceleration magnitudes (second differences) of every joint but joint 0 from three
 // consecutive frames' joint positions.
+double joint_acceleration(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                          std::span<const glm::vec3> c, size_t j, float dt) {
+  return glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt);
+}
+
 void joint_accelerations(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
                          std::span<const glm::vec3> c, float dt, PercentileHistogram& out) {
-  for (size_t j = 1; j < b.size(); ++j) {
-    out.add(glm::length(c[j] - 2.0f * b[j] + a[j]) / (dt * dt));
-  }
+  for (size_t j = 1; j < b.size(); ++j) out.add(joint_acceleration(a, b, c, j, dt));
 }
 
 // How long a value has stayed within a tolerance of the value it was last held at.
@@ -442,8 +445,7 @@ void EvaluationAccumulator::State::keep_largest(const EvaluationFrame& r, int wi
     return a.acceleration > b.acceleration;
   };
   for (size_t j = 1; j < r.joints.size(); ++j) {
-    const double a =
-        glm::length(r.joints[j] - 2.0f * positions[1][j] + positions[0][j]) / (dt * dt);
+    const double a = joint_acceleration(positions[0], positions[1], r.joints, j, dt);
     if (transition_top.size() == transition_capacity) {
       if (!(a > transition_top.front().acceleration)) continue;
       std::pop_heap(transition_top.begin(), transition_top.end(), larger);

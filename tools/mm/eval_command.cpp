@@ -34,6 +34,13 @@ struct Arguments {
   std::string style;  // --style: the style of every script line without one
 };
 
+// A sample's clip name and frame within it (empty and -1 when none played).
+std::pair<std::string, int> clip_and_frame(const TransitionSample& s, const Database& db) {
+  if (s.clip < 0 || static_cast<size_t>(s.clip) >= db.clips().size()) return {"", -1};
+  const ClipRange& c = db.clips()[static_cast<size_t>(s.clip)];
+  return {c.name, s.frame - c.start};
+}
+
 // `--transition-report`: the largest accelerations transition_accel_ratio is taken over, with
 // the joint, the time and what played.
 void print_transition_samples(const std::string& name, const EvaluationResult& result,
@@ -44,31 +51,24 @@ void print_transition_samples(const std::string& name, const EvaluationResult& r
       "the database's p99, %.1f m/s^2):\n",
       name.empty() ? "" : ", ", name.c_str(), m.database_accel_p99);
   for (const TransitionSample& s : result.transition_samples) {
-    std::string clip = "-";
-    int clip_frame = -1;
-    if (s.clip >= 0 && static_cast<size_t>(s.clip) < db.clips().size()) {
-      const ClipRange& c = db.clips()[static_cast<size_t>(s.clip)];
-      clip = c.name;
-      clip_frame = s.frame - c.start;
-    }
+    const auto [clip, clip_frame] = clip_and_frame(s, db);
     std::printf("  t %9.4f s  %-16s %9.1f m/s^2  %6.2f x  windows %d  clip %s frame %d\n", s.t,
                 db.skeleton().name(s.joint).c_str(), s.acceleration,
                 m.database_accel_p99 > 0.0 ? s.acceleration / m.database_accel_p99 : 0.0, s.windows,
-                clip.c_str(), clip_frame);
+                clip.empty() ? "-" : clip.c_str(), clip_frame);
   }
 }
 
 nlohmann::json transition_samples_json(const EvaluationResult& result, const Database& db) {
   nlohmann::json list = nlohmann::json::array();
   for (const TransitionSample& s : result.transition_samples) {
-    const bool known = s.clip >= 0 && static_cast<size_t>(s.clip) < db.clips().size();
-    list.push_back(
-        {{"t", s.t},
-         {"joint", db.skeleton().name(s.joint)},
-         {"m_s2", s.acceleration},
-         {"windows", s.windows},
-         {"clip", known ? db.clips()[static_cast<size_t>(s.clip)].name : ""},
-         {"clip_frame", known ? s.frame - db.clips()[static_cast<size_t>(s.clip)].start : -1}});
+    const auto [clip, clip_frame] = clip_and_frame(s, db);
+    list.push_back({{"t", s.t},
+                    {"joint", db.skeleton().name(s.joint)},
+                    {"m_s2", s.acceleration},
+                    {"windows", s.windows},
+                    {"clip", clip},
+                    {"clip_frame", clip_frame}});
   }
   return list;
 }
