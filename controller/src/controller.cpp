@@ -1535,16 +1535,22 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
     }
   }
   ankle_target = hip_position + reached;
-  // The knee bends toward where it points now; a nearly straight leg has no such direction
+  // The knee turns about its hinge in the data (ControllerDatabase::knee_hinge), the chain
+  // keeping the animation's twist. Without one it bends toward where it points now, the pole;
+  // a nearly straight leg has no such direction
   // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
-  // so the character's forward breaks the tie.
-  const glm::vec3 pole = globals_[static_cast<size_t>(knee)].translation -
-                         0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation) +
-                         kKneeForwardBias * rotated(globals_[0].rotation, kForward);
+  // so the character's forward breaks the tie. A knee behind that line (a leg straight or
+  // overstretched in the data) points nowhere a knee bends: only its sideways part counts, or
+  // as it crosses the line the bend would turn over, the knee jumping to the back of the leg.
+  const glm::vec3 forward = rotated(globals_[0].rotation, kForward);
+  glm::vec3 bend = globals_[static_cast<size_t>(knee)].translation -
+                   0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation);
+  bend -= std::min(0.0f, glm::dot(bend, forward)) * forward;
+  const glm::vec3 pole = bend + kKneeForwardBias * forward;
   // The foot's subtree is refreshed once, below, after its rotation is set.
-  const TwoBoneIkResult solved =
-      apply_two_bone_ik_above_end(parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip,
-                                  knee, foot, ankle_target, pole);
+  const TwoBoneIkResult solved = apply_two_bone_ik_above_end(
+      parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip, knee, foot, ankle_target,
+      pole, rotated(globals_[static_cast<size_t>(knee)].rotation, shared_->knee_hinge(side)));
   // A heel on the ground (no lift at all) leaves the foot its turned rotation and the toe its
   // local one: the toe's turn below is then the foot's rotation undone by itself.
   const bool heel_lifted = heel_rise != glm::quat(1.0f, 0.0f, 0.0f, 0.0f);

@@ -100,6 +100,32 @@ float lowest_height(const Database& db, int joint) {
   return std::isfinite(lowest) ? lowest : 0.0f;
 }
 
+// A knee's bend axis in its own frame (ControllerDatabase::knee_hinge): the mean of its local
+// rotations' axes (turned to w >= 0) over the frames it is bent more than kHingeBend, kept when
+// they agree (their mean at least kHingeAgreement long, a spread of about 25 degrees at most).
+// The bend limits it from an overstretched knee's turn the other way, which the mean would mix in.
+constexpr float kHingeBend = 0.3f;  // radians
+constexpr float kHingeAgreement = 0.9f;
+constexpr int kHingeMinFrames = 10;
+
+glm::vec3 measure_knee_hinge(const Database& db, int knee) {
+  glm::vec3 sum(0.0f);
+  int count = 0;
+  const float min_sine = std::sin(0.5f * kHingeBend);
+  for (int f = 0; f < db.frame_count(); ++f) {
+    glm::quat q = db.local_rotation(f, knee);
+    if (q.w < 0.0f) q = -q;
+    const glm::vec3 axis(q.x, q.y, q.z);
+    const float sine = glm::length(axis);  // of half the angle
+    if (!(sine > min_sine)) continue;
+    sum += axis / sine;
+    ++count;
+  }
+  if (count < kHingeMinFrames) return glm::vec3(0.0f);
+  const glm::vec3 mean = sum / static_cast<float>(count);
+  return glm::length(mean) >= kHingeAgreement ? glm::normalize(mean) : glm::vec3(0.0f);
+}
+
 }  // namespace
 
 Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
@@ -164,6 +190,8 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   for (int side = 0; side < 2; ++side) {
     const bool toe = toes[side] >= 0 && db.skeleton().parent(toes[side]) == feet[side];
     out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
+    const int knee = db.skeleton().parent(feet[side]);
+    if (knee > 0) out->knee_hinge_[side] = measure_knee_hinge(db, knee);
   }
   return std::shared_ptr<const ControllerDatabase>(std::move(out));
 }

@@ -23,7 +23,7 @@ struct Angle {
   float sin = 0.0f;
 };
 
-// The angle whose cosine and sine are proportional to d and c (c >= 0).
+// The angle whose cosine and sine are proportional to d and c.
 Angle angle_from(float d, float c) {
   const float r = std::sqrt(d * d + c * c);
   return r > 0.0f ? Angle{d / r, c / r} : Angle{};
@@ -122,19 +122,49 @@ bool input_finite(const TwoBoneIkInput& in) {
 #if defined(__SSE2__)
   const __m128 zero = _mm_setzero_ps();
   __m128 sum = _mm_mul_ps(sse::load(in.root.rotation), zero);
-  for (const __m128 value : {sse::load(in.mid.rotation), sse::load(in.root_parent_rotation),
-                             sse::load(in.root.translation), sse::load(in.mid.translation),
-                             sse::load(in.end.translation), sse::load(in.target),
-                             sse::load(in.pole), _mm_set_ss(in.extension_epsilon)}) {
+  for (const __m128 value :
+       {sse::load(in.mid.rotation), sse::load(in.root_parent_rotation),
+        sse::load(in.root.translation), sse::load(in.mid.translation),
+        sse::load(in.end.translation), sse::load(in.target), sse::load(in.pole),
+        sse::load(in.hinge), _mm_set_ss(in.extension_epsilon)}) {
     sum = _mm_add_ps(sum, _mm_mul_ps(value, zero));
   }
   return _mm_movemask_ps(_mm_cmpunord_ps(sum, sum)) == 0;
 #else
   return finite(in.root.translation) && finite(in.mid.translation) && finite(in.end.translation) &&
-         finite(in.target) && finite(in.pole) && finite(in.root.rotation) &&
+         finite(in.target) && finite(in.pole) && finite(in.hinge) && finite(in.root.rotation) &&
          finite(in.mid.rotation) && finite(in.root_parent_rotation) &&
          std::isfinite(in.extension_epsilon);
 #endif
+}
+
+// The solve about a hinge (TwoBoneIkInput::hinge): the knee turns about it to the interior angle
+// that makes the hip-ankle distance `reach`, then the chain swings the least way onto the line
+// to the target. The axis is taken square to the thigh, about which the knee turns; a shin not
+// square to it turns on a cone, whose part across the axis is the triangle's side. False where
+// there is no hinge, or it lies along the thigh: the pole's solve then.
+bool hinge_turns(const TwoBoneIkInput& in, const glm::vec3& ab, const glm::vec3& bc, float reach,
+                 const glm::vec3& direction, ChainTurns& out) {
+  const float upper = glm::length(ab);
+  // Bending closes the knee: its interior angle opens about the hinge's opposite.
+  glm::vec3 axis = -(in.hinge - glm::dot(in.hinge, ab) / (upper * upper) * ab);
+  const float axis_length = glm::length(axis);
+  if (!(axis_length > 1e-3f * glm::length(in.hinge))) return false;
+  axis /= axis_length;
+  const glm::vec3 shin_across = bc - glm::dot(bc, axis) * axis;
+  const float across = glm::length(shin_across);
+  if (!(across > 1e-6f * upper)) return false;
+  // The interior angle now, signed: past 180 degrees (its sine negative) for a knee
+  // overstretched backward, which so unbends through straight instead of bending further back.
+  const Angle now = angle_from(glm::dot(-ab, shin_across), glm::dot(axis, glm::cross(-ab, bc)));
+  const float along = glm::dot(bc, axis);
+  const float cosine = std::clamp(
+      (upper * upper + across * across + along * along - reach * reach) / (2.0f * upper * across),
+      -1.0f, 1.0f);
+  const Angle wanted{cosine, std::sqrt(std::max(0.0f, 1.0f - cosine * cosine))};
+  out.knee_bend = rotation_about(wanted, now, axis);
+  out.hip_turn = quat_between(ab + rotate(out.knee_bend, bc), direction);
+  return true;
 }
 
 // False for zero-length bones or non-finite input (the chain is then left as it is).
@@ -171,6 +201,9 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
   if (!(direction_length > 1e-6f * total)) direction = ab;
   direction = glm::normalize(direction);
 
+  out.reached = target_distance >= min_reach && target_distance <= max_reach;
+  if (hinge_turns(in, ab, c - b, reach, direction, out)) return true;
+
   // 1. Bend about the current bend axis: the knee's interior angle goes to the one that makes
   // the hip-ankle distance `reach`, and the hip turns so the ankle stays on its old line.
   glm::vec3 bend_axis = glm::cross(ac, ab);
@@ -185,22 +218,32 @@ bool solve_turns(const TwoBoneIkInput& in, ChainTurns& out) {
     // Straight or folded limb: no plane yet. Bend toward the pole; step 3 settles the twist.
     bend_axis = glm::normalize(glm::cross(ab, perpendicular(ab, in.pole)));
   }
-  const Angle knee_angle_now = angle_between(a - b, c - b);
+  Angle knee_angle_now = angle_between(a - b, c - b);
+  const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
+  const float pole_across_length = glm::length(pole_across);
+  // A limb bent away from the pole (a knee overstretched backward, as standing actors' knees
+  // are) unbends through straight toward it, as a hinge does: its angles are taken about the
+  // other way round axis, the knee's past 180 degrees. Twisted round the hip-target line
+  // instead, the thigh and shin would turn half a turn about themselves, the knee's front to
+  // the back.
+  if (has_plane && glm::dot(bend_axis, glm::cross(direction, pole_across)) < 0.0f) {
+    bend_axis = -bend_axis;
+    hip_angle_now.sin = -hip_angle_now.sin;
+    knee_angle_now.sin = -knee_angle_now.sin;
+  }
   const Angle hip_angle = triangle_angle(upper, reach, lower);
   const glm::quat knee_bend =
       rotation_about(triangle_angle(upper, lower, reach), knee_angle_now, bend_axis);
   out.knee_bend = knee_bend;
-  out.reached = target_distance >= min_reach && target_distance <= max_reach;
 
   // Where the three steps below end, written down at once: the knee bent, the hip-to-ankle line
-  // lies along the direction and the bend axis (ac x ab, whose sign the bends keep: both are
-  // about it and keep the triangle's angles inside (0, pi)) is direction x the pole's side of it,
-  // so the knee is on that side. The hip's turn takes the bent chain's hip-to-ankle line and the
-  // bend axis to those, so the ankle lands on the line to the target whatever the rounding of the
-  // bend (as the swing of step 2 makes it). Taken where the limb has a plane, the knee leaves the
-  // line and the pole leaves the direction; the steps themselves handle the degenerate cases.
-  const glm::vec3 pole_across = in.pole - glm::dot(in.pole, direction) * direction;
-  const float pole_across_length = glm::length(pole_across);
+  // lies along the direction and the bend axis (ac x ab, turned round above if need be, whose
+  // sign the bends keep: both are about it and end with the triangle's angles inside (0, pi)) is
+  // direction x the pole's side of it, so the knee is on that side. The hip's turn takes the
+  // bent chain's hip-to-ankle line and the bend axis to those, so the ankle lands on the line to
+  // the target whatever the rounding of the bend (as the swing of step 2 makes it). Taken where the
+  // limb has a plane, the knee leaves the line and the pole leaves the direction; the steps
+  // themselves handle the degenerate cases.
   if (has_plane && hip_angle.sin > 1e-6f && pole_across_length > 1e-6f) {
     const glm::vec3 side = pole_across / pole_across_length;
     const glm::vec3 bent_ankle = ab + rotate(knee_bend, c - b);
@@ -270,7 +313,7 @@ namespace {
 TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform> local,
                                std::span<Transform> global, int root, int mid, int end,
                                const glm::vec3& target, const glm::vec3& pole,
-                               float extension_epsilon) {
+                               const glm::vec3& hinge, float extension_epsilon) {
   MM_ASSERT(parents.size() == local.size() && parents.size() == global.size());
   MM_ASSERT(root >= 0 && mid >= 0 && end >= 0 && static_cast<size_t>(end) < parents.size());
   MM_ASSERT(parents[mid] == root && parents[end] == mid);
@@ -284,6 +327,7 @@ TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform
                                              : glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
   in.target = target;
   in.pole = pole;
+  in.hinge = hinge;
   in.extension_epsilon = extension_epsilon;
   TwoBoneIkResult result;
   ChainTurns t;
@@ -324,9 +368,9 @@ TwoBoneIkResult solve_in_place(std::span<const int> parents, std::span<Transform
 TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
                                   std::span<Transform> global, int root, int mid, int end,
                                   const glm::vec3& target, const glm::vec3& pole,
-                                  float extension_epsilon) {
-  const TwoBoneIkResult r =
-      solve_in_place(parents, local, global, root, mid, end, target, pole, extension_epsilon);
+                                  const glm::vec3& hinge, float extension_epsilon) {
+  const TwoBoneIkResult r = solve_in_place(parents, local, global, root, mid, end, target, pole,
+                                           hinge, extension_epsilon);
   // Parents come first, so one pass from the root on refreshes every descendant. Only the root's
   // descendants move: every other joint's global already is the FK of its unchanged local.
   for (size_t i = static_cast<size_t>(root) + 1; i < parents.size(); ++i) {
@@ -341,10 +385,11 @@ TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
                                             std::span<const int> subtree_sizes,
                                             std::span<Transform> local, std::span<Transform> global,
                                             int root, int mid, int end, const glm::vec3& target,
-                                            const glm::vec3& pole, float extension_epsilon) {
+                                            const glm::vec3& pole, const glm::vec3& hinge,
+                                            float extension_epsilon) {
   MM_ASSERT(subtree_sizes.size() == parents.size());
-  const TwoBoneIkResult r =
-      solve_in_place(parents, local, global, root, mid, end, target, pole, extension_epsilon);
+  const TwoBoneIkResult r = solve_in_place(parents, local, global, root, mid, end, target, pole,
+                                           hinge, extension_epsilon);
   // The root's descendants are the joints right after it; the end's subtree is left to the
   // caller, which changes the end's local and refreshes it then (refreshed here too, it would
   // be computed twice and the first thrown away).

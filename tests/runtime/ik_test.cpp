@@ -242,8 +242,8 @@ TEST(TwoBoneIk, AnyNonFiniteInputComponentLeavesTheChain) {
     for (glm::quat* q : {&in.root.rotation, &in.mid.rotation, &in.root_parent_rotation}) {
       for (int i = 0; i < 4; ++i) c.push_back(&(*q)[i]);
     }
-    for (glm::vec3* v :
-         {&in.root.translation, &in.mid.translation, &in.end.translation, &in.target, &in.pole}) {
+    for (glm::vec3* v : {&in.root.translation, &in.mid.translation, &in.end.translation, &in.target,
+                         &in.pole, &in.hinge}) {
       for (int i = 0; i < 3; ++i) c.push_back(&(*v)[i]);
     }
     c.push_back(&in.extension_epsilon);
@@ -289,6 +289,122 @@ TEST(TwoBoneIk, StraightStartingLimbBendsTowardThePole) {
   const KneePlacement k = knee_placement(hip, r.mid_position, target, pole);
   EXPECT_LT(k.off_plane, 1e-4f);
   EXPECT_GT(k.pole_side, 0.0f);
+}
+
+// The angle (radians) of the rotation q.
+float rotation_angle(const glm::quat& q) {
+  return 2.0f * std::atan2(glm::length(glm::vec3(q.x, q.y, q.z)), std::abs(q.w));
+}
+
+// The Leg's knee bends (a negative turn about its local x axis) toward -z, its front here: its
+// hinge, bending a positive turn about it, is -x in the knee's frame.
+glm::vec3 leg_hinge(const Leg& leg) {
+  return leg.global[Leg::kKnee].rotation * glm::vec3(-1.0f, 0.0f, 0.0f);
+}
+
+// The knee's offset from the hip-ankle line toward `forward` (positive: bent forward).
+float knee_forward(const std::vector<Transform>& g, const glm::vec3& forward) {
+  const glm::vec3 hip = g[Leg::kHip].translation;
+  const glm::vec3 line = glm::normalize(g[Leg::kAnkle].translation - hip);
+  const glm::vec3 k = g[Leg::kKnee].translation - hip;
+  return glm::dot(k - glm::dot(k, line) * line, forward);
+}
+
+// With its hinge the knee turns about that axis alone, whatever the target: its new local
+// rotation is the old one turned about the hinge, the knee stays bent forward, and the pole is
+// not read (a pole would twist the leg to its side).
+TEST(TwoBoneIk, WithAHingeTheKneeTurnsAboutItAlone) {
+  for (int trial = 0; trial < 200; ++trial) {
+    const float upper = test::uniform(0.3f, 0.5f);
+    const float lower = test::uniform(0.3f, 0.5f);
+    const Leg leg(upper, lower, true);
+    const glm::vec3 hip = leg.global[Leg::kHip].translation;
+    const float lo = std::abs(upper - lower) + 0.05f;
+    const float hi = (upper + lower) * 0.99f;
+    const glm::vec3 target = hip + test::uniform(lo, hi) * test::random_unit_vec3();
+    TwoBoneIkInput in = leg.input(target, test::random_unit_vec3());
+    in.hinge = leg_hinge(leg);
+    const TwoBoneIkResult r = solve_two_bone_ik(in);
+    ASSERT_TRUE(finite_result(r));
+    EXPECT_TRUE(r.reached);
+    EXPECT_TRUE(near_vec3(r.end_position, target, 1e-4f)) << trial;
+    const std::vector<Transform> g = leg.posed(r);
+    EXPECT_TRUE(near_vec3(g[Leg::kAnkle].translation, target, 1e-4f)) << trial;
+    EXPECT_NEAR(glm::distance(g[Leg::kHip].translation, g[Leg::kKnee].translation), upper, 1e-5f);
+    EXPECT_NEAR(glm::distance(g[Leg::kKnee].translation, g[Leg::kAnkle].translation), lower, 1e-5f);
+    // The knee's turn, in its parent's frame, is about the local x axis (the hinge).
+    const glm::quat turn = r.mid_local * glm::conjugate(leg.local[Leg::kKnee].rotation);
+    const glm::vec3 axis(turn.x, turn.y, turn.z);
+    EXPECT_LT(std::hypot(axis.y, axis.z), 1e-4f) << trial;
+    // Still bent forward: a negative turn about x.
+    const glm::quat knee = r.mid_local.w < 0.0f ? -r.mid_local : r.mid_local;
+    EXPECT_LT(knee.x, 0.0f) << trial;
+    in.pole = -in.pole;
+    const TwoBoneIkResult other = solve_two_bone_ik(in);
+    EXPECT_EQ(other.root_local, r.root_local) << trial;
+    EXPECT_EQ(other.mid_local, r.mid_local) << trial;
+  }
+}
+
+// A knee overstretched backward (as standing actors' knees are, a few degrees past straight in
+// the Bandai data) asked for a slightly shorter leg: with its hinge it unbends through straight
+// and bends forward; without one, toward a forward pole. Either way the knee comes forward by
+// turning about its hinge, and the thigh turns by what the bend and the ankle's move need (half
+// the knee's 37 degrees and the ankle's 2 here). Twisted half a turn about the hip-ankle line
+// instead (as the pole's solve did), the thigh and shin turn their fronts backward: a skinned leg
+// is wrung at the hip and the ankle.
+TEST(TwoBoneIk, AnOverstretchedKneeUnbendsThroughStraight) {
+  Leg leg(0.42f, 0.42f, false);
+  leg.local[Leg::kKnee].rotation = glm::angleAxis(0.15f, glm::vec3(1, 0, 0));  // past straight
+  forward_kinematics(leg.parents, leg.local, leg.global);
+  const glm::vec3 forward(0.0f, 0.0f, -1.0f);
+  ASSERT_LT(knee_forward(leg.global, forward), -0.03f);  // the knee 3.1 cm behind the line
+  const glm::vec3 hip = leg.global[Leg::kHip].translation;
+  const glm::vec3 ankle = leg.global[Leg::kAnkle].translation;
+  const glm::vec3 target = hip + 0.97f * (ankle - hip) + glm::vec3(0.0f, 0.0f, -0.03f);
+  for (const bool hinged : {true, false}) {
+    SCOPED_TRACE(hinged ? "hinge" : "pole");
+    TwoBoneIkInput in = leg.input(target, forward);
+    if (hinged) in.hinge = leg_hinge(leg);
+    const TwoBoneIkResult r = solve_two_bone_ik(in);
+    ASSERT_TRUE(finite_result(r));
+    const std::vector<Transform> g = leg.posed(r);
+    EXPECT_TRUE(near_vec3(g[Leg::kAnkle].translation, target, 1e-4f));
+    EXPECT_GT(knee_forward(g, forward), 0.02f);
+    const glm::quat knee_turn = r.mid_local * glm::conjugate(leg.local[Leg::kKnee].rotation);
+    EXPECT_LT(std::hypot(knee_turn.y, knee_turn.z), 1e-4f);
+    EXPECT_LT(rotation_angle(r.root_local * glm::conjugate(leg.local[Leg::kHip].rotation)),
+              glm::radians(25.0f));
+  }
+}
+
+// The target drawn in from the overstretched knee's full length to a deep bend, 2 mm a step:
+// the knee comes forward at the first solve and from there moves a little per step (no turning
+// over of the bend on the way), and the thigh's turn grows smoothly.
+TEST(TwoBoneIk, AHingedKneeDrawnInBendsContinuously) {
+  Leg leg(0.42f, 0.42f, false);
+  leg.local[Leg::kKnee].rotation = glm::angleAxis(0.15f, glm::vec3(1, 0, 0));
+  forward_kinematics(leg.parents, leg.local, leg.global);
+  const glm::vec3 hip = leg.global[Leg::kHip].translation;
+  const glm::vec3 down = glm::normalize(leg.global[Leg::kAnkle].translation - hip);
+  glm::vec3 previous_knee;
+  glm::quat previous_hip;
+  for (int step = 0; step <= 200; ++step) {
+    const float reach = 0.838f - 0.002f * static_cast<float>(step);  // 83.8 cm to 43.8 cm
+    TwoBoneIkInput in = leg.input(hip + reach * down, glm::vec3(0, 0, -1));
+    in.hinge = leg_hinge(leg);
+    const TwoBoneIkResult r = solve_two_bone_ik(in);
+    ASSERT_TRUE(finite_result(r));
+    EXPECT_GT(knee_forward(leg.posed(r), glm::vec3(0, 0, -1)), 0.02f) << step;
+    if (step > 0) {
+      // Near straight the triangle's apex moves 1.2 cm per 2 mm of reach, less after.
+      EXPECT_LT(glm::distance(r.mid_position, previous_knee), 0.015f) << step;
+      EXPECT_LT(rotation_angle(r.root_local * glm::conjugate(previous_hip)), glm::radians(2.0f))
+          << step;
+    }
+    previous_knee = r.mid_position;
+    previous_hip = r.root_local;
+  }
 }
 
 TEST(TwoBoneIk, ApplyOnAPoseUpdatesLocalsAndGlobals) {

@@ -120,6 +120,11 @@ class ControllerDatabase {
   // left, 1 right) comes above the ground in any frame of the data (m): foot IK never puts it
   // lower, so feet do not sink where the data's never do.
   float lowest_foot_end(int side) const { return lowest_foot_end_[side != 0 ? 1 : 0]; }
+  // The axis each knee bends about in the data (index 0 left, 1 right), in the knee's own frame
+  // (a unit vector; bending is a positive turn about it): the mean axis of the knee's local
+  // rotations where it is bent, the data's knees bending far further forward than back. Zero
+  // where a knee does not turn about one axis (foot IK then bends it toward a pole).
+  glm::vec3 knee_hinge(int side) const { return knee_hinge_[side != 0 ? 1 : 0]; }
 
   // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
   uint64_t action_tags() const { return action_tags_; }
@@ -165,6 +170,7 @@ class ControllerDatabase {
   std::vector<uint8_t> candidates_;
   Speeds speeds_;
   float lowest_foot_end_[2] = {0.0f, 0.0f};
+  glm::vec3 knee_hinge_[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
   uint64_t action_tags_ = 0;
   uint64_t idle_tags_ = 0;
   std::vector<uint64_t> style_tags_;  // per style id

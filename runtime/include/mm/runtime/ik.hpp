@@ -2,16 +2,20 @@
 // Analytic two-bone inverse kinematics (hip -> knee -> ankle, or shoulder -> elbow -> wrist).
 //
 // The solve works on global (model-space) transforms and returns new local rotations for the
-// upper (root) and middle joints; bone lengths never change because only rotations do. In
-// order: the knee bends about the current bend axis until the hip-to-ankle distance equals the
-// (clamped) target distance, with the hip turning by the matching angle; the chain swings so
-// the ankle points at the target; finally it twists about the hip->target line so the knee
-// lies in the half-plane of the pole direction. Reach limits: a target farther than
-// (1 - extension_epsilon) * (upper + lower length) is clamped to that distance on the line
-// toward it (a nearly straight limb keeps a hint of bend, so its bend plane stays defined);
-// one closer than |upper - lower| + extension_epsilon * (upper + lower) is pushed out to that.
-// Degenerate inputs (zero-length bones, target at the hip, pole along the hip->target line,
-// straight or folded limbs) never produce NaN.
+// upper (root) and middle joints; bone lengths never change because only rotations do. Given
+// the knee's hinge (TwoBoneIkInput::hinge), the knee turns about it to the angle that makes the
+// hip-to-ankle distance the (clamped) target distance and the chain swings the least way onto
+// the line to the target. Without one, in order: the knee bends about the current bend axis until
+// the hip-to-ankle distance equals the (clamped) target distance, with the hip turning by the
+// matching angle; the chain swings so the ankle points at the target; finally it twists about the
+// hip->target line so the knee lies in the half-plane of the pole direction. A limb bent away from
+// the pole (a knee overstretched backward) unbends through straight toward it, as a hinge, instead
+// of twisting half a turn about the hip->target line. Reach limits: a target farther than (1 -
+// extension_epsilon) * (upper + lower length) is clamped to that distance on the line toward it (a
+// nearly straight limb keeps a hint of bend, so its bend plane stays defined); one closer than
+// |upper - lower| + extension_epsilon * (upper + lower) is pushed out to that. Degenerate inputs
+// (zero-length bones, target at the hip, pole along the hip->target line, straight or folded limbs)
+// never produce NaN.
 
 #include <span>
 
@@ -27,6 +31,11 @@ struct TwoBoneIkInput {
   glm::quat root_parent_rotation{1.0f, 0.0f, 0.0f, 0.0f};  // global rotation of the hip's parent
   glm::vec3 target{0.0f};                                  // where the end joint should go
   glm::vec3 pole{0.0f, 0.0f, 1.0f};                        // direction the knee should bend toward
+  // The knee's own bend axis, when known (a hinge; bending is a positive turn about it): the
+  // knee turns about it alone, an overstretched knee through straight, and the chain swings
+  // the least way onto the target line, so the thigh and shin keep their twist. The pole is
+  // then not read (but where the axis lies along the thigh). Zero: no hinge.
+  glm::vec3 hinge{0.0f};
   float extension_epsilon = 1e-4f;  // fraction of full reach kept as a minimal bend
 };
 
@@ -53,6 +62,7 @@ TwoBoneIkResult solve_two_bone_ik(const TwoBoneIkInput& input);
 TwoBoneIkResult apply_two_bone_ik(std::span<const int> parents, std::span<Transform> local,
                                   std::span<Transform> global, int root, int mid, int end,
                                   const glm::vec3& target, const glm::vec3& pole,
+                                  const glm::vec3& hinge = glm::vec3(0.0f),
                                   float extension_epsilon = 1e-4f);
 
 // apply_two_bone_ik for a caller that sets the end joint's local rotation after the solve (a foot
@@ -64,6 +74,8 @@ TwoBoneIkResult apply_two_bone_ik_above_end(std::span<const int> parents,
                                             std::span<const int> subtree_sizes,
                                             std::span<Transform> local, std::span<Transform> global,
                                             int root, int mid, int end, const glm::vec3& target,
-                                            const glm::vec3& pole, float extension_epsilon = 1e-4f);
+                                            const glm::vec3& pole,
+                                            const glm::vec3& hinge = glm::vec3(0.0f),
+                                            float extension_epsilon = 1e-4f);
 
 }  // namespace mm
