@@ -43,8 +43,10 @@ constexpr float kStepRise = 0.02f;
 // Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
 constexpr float kEdgeRise = 0.01f;
 // A foot whose heel-to-toe line's horizontal extent is at least this share of its length is
-// tilted fully (tilt()).
-constexpr float kTiltFullShare = 0.5f;
+// tilted fully, one under kTiltNoneShare not at all (tilt()). The data's planted feet stand at
+// 0.77 (median), 0.70 or more in 98 % of their frames.
+constexpr float kTiltFullShare = 0.7f;
+constexpr float kTiltNoneShare = 0.45f;
 // Halvings of the pelvis drop's range that find the least drop reaching a planted toe
 // (reach_drop): 0.35 m to well under a millimetre.
 constexpr int kReachDropBisections = 12;
@@ -471,11 +473,15 @@ glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) 
   const float h1 =
       (-s * y0 + std::sqrt(std::max(0.0f, s * s * y0 * y0 - a * (y0 * y0 - length * length)))) / a;
   const float y1 = s * h1 + y0;
-  // A foot pitched past kTiltFullShare of its length toward vertical is tilted less, none at
-  // vertical: passing it (a toe-off's heel swinging over the toe) turns the tilt's axis round, and
-  // a tilt kept to the end turned the foot from one side of it to the other in an update (the
-  // knee moved 9 cm, on a ramp's slope).
-  const float fade = std::min(1.0f, h0 / (kTiltFullShare * length));
+  // A foot pitched steeper than it stands (a toe-off, a toe-first landing) is tilted less, none
+  // from kTiltNoneShare on. Keeping its heel's height over its own ground takes a turn of the
+  // grounds' difference over the foot's horizontal extent, which a steep foot makes large: on the
+  // rough patch, grounds under heel and toe 2 cm apart turned a toe-first foot 25 degrees in an
+  // update (the knee 6 cm; random-long from x = 8.7 of the second course at 1/144 s, t = 63.37
+  // s). Toward vertical the tilt's axis turns round as the heel swings over the toe: kept to
+  // the end, it turned the foot from one side to the other in an update (a ramp's slope).
+  const float fade =
+      std::clamp((h0 / length - kTiltNoneShare) / (kTiltFullShare - kTiltNoneShare), 0.0f, 1.0f);
   const float angle =
       fade * std::clamp(std::atan2(y1, h1) - std::atan2(y0, h0), -max_tilt, max_tilt);
   return glm::angleAxis(angle, glm::normalize(glm::cross(level, glm::vec3(0.0f, 1.0f, 0.0f))));

@@ -128,6 +128,38 @@ TEST(FootPlacement, AFootTurningThroughVerticalOnASlopeIsTiltedContinuously) {
   }
 }
 
+// The tilt keeps the heel's height above its own ground; a foot pitched steeply toe-down (a
+// toe-off, a toe-first landing) needs a turn of the grounds' difference over its short
+// horizontal extent for that: over the rough patch's bumps, grounds 2 cm apart turned such a
+// foot 25 degrees in an update. Feet steeper than the data's planted ones are tilted less, and
+// from under 0.45 of their length across not at all; the tilt fades in without a jump.
+TEST(FootPlacement, AFootPitchedSteeplyToeDownIsNotTilted) {
+  AnalyticWorld world;
+  make_slope(world, 20.0f);
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs = standing_legs();
+  settle(p, world, mover, legs, 0.0f);
+  ASSERT_TRUE(p.tilted(0));
+  const float length = glm::length(legs[0].toe - legs[0].ankle);
+  const float max_tilt = FootPlacementSettings{}.max_foot_tilt;
+  const auto tilt_angle = [&](float across) {  // the horizontal share of the foot's length
+    const glm::vec3 along = length * glm::vec3(0.0f, -std::sqrt(1.0f - across * across), across);
+    const glm::quat q = p.tilt(0, along, max_tilt);
+    return 2.0f * std::atan2(glm::length(glm::vec3(q.x, q.y, q.z)), std::abs(q.w));
+  };
+  // The rough patch's foot stood at 0.39-0.43 across.
+  for (const float across : {0.1f, 0.25f, 0.39f, 0.43f}) EXPECT_EQ(tilt_angle(across), 0.0f);
+  // A planted foot of the data (0.77 across) on the slope is tilted as the slope asks.
+  EXPECT_GT(tilt_angle(0.77f), glm::radians(18.0f));
+  float previous = tilt_angle(0.4f);
+  for (float across = 0.41f; across < 0.96f; across += 0.01f) {
+    const float angle = tilt_angle(across);
+    EXPECT_LT(std::abs(angle - previous), glm::radians(2.5f)) << across;
+    previous = angle;
+  }
+}
+
 TEST(FootPlacement, AFootOverAStairsEdgeRestsOnTheStepNeverInsideIt) {
   AnalyticWorld world;
   // A 17 cm step whose edge is at z = 0.1: the heel is below it, the toe over it.
