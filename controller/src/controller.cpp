@@ -1319,6 +1319,8 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     f.position = f.target;
     f.lock_ground = toe_ground(side);
     f.offset = f.offset_velocity = glm::vec3(0.0f);
+    // The target held already has the walls' push in it.
+    f.wall_push = f.wall_push_velocity = glm::vec3(0.0f);
   } else if (f.locked) {
     // The lock holds its point, but its height rides on the ground found under it: a foot that
     // swung up toward a step it then landed short of comes down onto the tread it is over.
@@ -1376,7 +1378,12 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   // off is no longer planted, and held down it would have that height to catch up on release.
   if (f.locked) target = glm::vec3(f.position.x, std::max(f.position.y, on_ground.y), f.position.z);
   target += f.offset;
-  if (world_) keep_toe_off_wall(side, target);
+  if (world_) {
+    // Out of the walls as place_feet put it (its ground probed there), eased where one let go;
+    // a held toe stays at its point, out of the walls already when it was taken.
+    if (!f.locked) target += f.wall_push;
+    keep_toe_off_wall(side, target);
+  }
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would
   // otherwise sink a toe into the ground. A smooth maximum: a hard one would stop a descending
   // toe dead at the floor, a jerk the legs show.

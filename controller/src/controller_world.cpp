@@ -40,6 +40,9 @@ constexpr float kMaxWallPush = 0.1f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
+// Halflife (s) of a toe's way back onto the animation when a wall that kept it out lets go:
+// 11 cm (a ledge's side that becomes a step) come back in about 0.2 s, at most about 30 m/s^2.
+constexpr float kToeWallPushHalflife = 0.08f;
 // How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
 // the skin's thickness through it).
 constexpr float kArmMargin = 0.01f;
@@ -449,6 +452,24 @@ void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
   if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
 }
 
+// How far walls keep a toe at `toe` out (FootLock::wall_push): where a wall lets go (a ledge
+// that becomes a step as the body rises a centimetre, the end of a wall), the push comes back
+// onto the animation on a spring (kToeWallPushHalflife) instead of at once, the toe's ground then
+// probed where the eased toe is; where one pushes, the toe is out of it at once.
+void Controller::ease_wall_push(int side, const glm::vec3& toe, float dt) {
+  FootLock& f = feet_[side];
+  // A held toe is kept out of the walls where it is, as when it was taken: nothing to ease.
+  if (f.locked) f.wall_push = f.wall_push_velocity = glm::vec3(0.0f);
+  critical_spring_apply(f.wall_push, f.wall_push_velocity, glm::vec3(0.0f),
+                        foot_springs_[side].wall_push.step(kToeWallPushHalflife, dt));
+  glm::vec3 kept = toe + f.wall_push;
+  keep_toe_off_wall(side, kept);
+  const glm::vec3 push(kept.x - toe.x, 0.0f, kept.z - toe.z);
+  // A wall pushed the eased toe back out: the push is held there, at rest.
+  if (glm::length(push - f.wall_push) > 1e-6f) f.wall_push_velocity = glm::vec3(0.0f);
+  f.wall_push = push;
+}
+
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the
 // foot lock: the probes, the pelvis drop applied to everything above the root (the root stays
 // on the body's ground), and each toe's offset from where the animation puts it, which the
@@ -486,11 +507,9 @@ void Controller::place_feet(float dt) {
   find_walls(legs);
   for (int side = 0; side < 2; ++side) {
     PlacementLeg& p = legs[static_cast<size_t>(side)];
-    glm::vec3 kept = p.toe;
-    keep_toe_off_wall(side, kept);
-    const glm::vec3 moved(kept.x - p.toe.x, 0.0f, kept.z - p.toe.z);
-    p.toe += moved;
-    p.ankle += moved;
+    ease_wall_push(side, p.toe, dt);
+    p.toe += feet_[side].wall_push;
+    p.ankle += feet_[side].wall_push;
   }
   FootPlacementSettings placement;
   placement.max_pelvis_drop = settings_.max_pelvis_drop;

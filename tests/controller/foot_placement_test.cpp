@@ -101,19 +101,28 @@ TEST(FootPlacement, OnSlopesUpAndDownHeelAndToeKeepTheirHeightAboveTheSurface) {
   }
 }
 
+// Both legs standing on a 20 degree slope, the placement settled.
+struct StandingOnASlope {
+  AnalyticWorld world;
+  CharacterMover mover;
+  FootPlacement placement;
+  std::array<PlacementLeg, 2> legs = standing_legs();
+  StandingOnASlope() {
+    make_slope(world, 20.0f);
+    settle(placement, world, mover, legs, 0.0f);
+  }
+  float foot_length() const { return glm::length(legs[0].toe - legs[0].ankle); }
+};
+
 // A foot turning through vertical (a toe-off's heel swinging over the toe) on a 20 degree slope,
 // its heel and toe grounds apart: the tilt's axis turns round there, and a tilt kept to the end
 // threw the toe from one side to the other (9 cm at the knee in a course run). Faded out toward
 // vertical, the tilted foot line turns as smoothly as the animated one.
 TEST(FootPlacement, AFootTurningThroughVerticalOnASlopeIsTiltedContinuously) {
-  AnalyticWorld world;
-  make_slope(world, 20.0f);
-  CharacterMover mover;
-  FootPlacement p;
-  const std::array<PlacementLeg, 2> legs = standing_legs();
-  settle(p, world, mover, legs, 0.0f);
+  const StandingOnASlope stand;
+  const FootPlacement& p = stand.placement;
   ASSERT_TRUE(p.tilted(0));
-  const float length = glm::length(legs[0].toe - legs[0].ankle);
+  const float length = stand.foot_length();
   const float max_tilt = FootPlacementSettings{}.max_foot_tilt;
   glm::vec3 previous(0.0f);
   for (int k = -20; k <= 20; ++k) {  // 10 degrees either side of straight down, 0.5 a step
@@ -134,14 +143,10 @@ TEST(FootPlacement, AFootTurningThroughVerticalOnASlopeIsTiltedContinuously) {
 // foot 25 degrees in an update. Feet steeper than the data's planted ones are tilted less, and
 // from under 0.45 of their length across not at all; the tilt fades in without a jump.
 TEST(FootPlacement, AFootPitchedSteeplyToeDownIsNotTilted) {
-  AnalyticWorld world;
-  make_slope(world, 20.0f);
-  CharacterMover mover;
-  FootPlacement p;
-  const std::array<PlacementLeg, 2> legs = standing_legs();
-  settle(p, world, mover, legs, 0.0f);
+  const StandingOnASlope stand;
+  const FootPlacement& p = stand.placement;
   ASSERT_TRUE(p.tilted(0));
-  const float length = glm::length(legs[0].toe - legs[0].ankle);
+  const float length = stand.foot_length();
   const float max_tilt = FootPlacementSettings{}.max_foot_tilt;
   const auto tilt_angle = [&](float across) {  // the horizontal share of the foot's length
     const glm::vec3 along = length * glm::vec3(0.0f, -std::sqrt(1.0f - across * across), across);

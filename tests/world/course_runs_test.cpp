@@ -198,5 +198,16 @@ TEST(CourseRuns, ARunningLegStaysSoftenedAsItsGroundOffsetFades) {
   EXPECT_LT(largest_acceleration(r, knee, 6.8f, 7.0f), 200.0f);
 }
 
+// Walking back and forth over stairs_20_25's landing (0.8 m), a toe the landing's side kept out
+// while it stood 0.36 m over the body's ground (a wall: higher than a step) went onto it in one
+// update when the body rose a centimetre and it became a step: 11 cm forward (2,441 m/s^2 at
+// 9.08 s on the tests' database). What walls push a toe out by now comes back onto the
+// animation on a spring, its ground probed where the eased toe is.
+TEST(CourseRuns, AToeAWallLetsGoComesBackOnASpring) {
+  const int toe = test::normal_controller_database()->database().roles().left_toe;
+  const CourseRun r{"data/levels/course2.glb", "reversals.txt", {11.5, 2.0}, 0.00694444f};
+  EXPECT_LT(largest_acceleration(r, toe, 8.8f, 9.4f), 600.0f);
+}
+
 }  // namespace
 }  // namespace mm

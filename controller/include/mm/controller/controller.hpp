@@ -552,6 +552,7 @@ class Controller {
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
+  void ease_wall_push(int side, const glm::vec3& toe, float dt);
   glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
   void face_along_obstacle();
@@ -648,7 +649,7 @@ class Controller {
   // The same for the springs the feet and the chest run every update, per foot: the release
   // offset, the step's lift, the heading offset, the heel's rise; and the chest's twist.
   struct FootSprings {
-    CriticalSpringStepCache offset;
+    CriticalSpringStepCache offset, wall_push;
     CriticalSpringScalarCache lift, heading, heel;
   };
   FootSprings foot_springs_[2];
@@ -808,6 +809,10 @@ class Controller {
     float speed = 0.0f;
     bool has_animated = false;
     bool low_and_slow = false;
+    // How far (horizontally) walls keep the toe out this update (place_feet), and its rate: it
+    // comes back onto the animation on a spring when a wall lets go, at once when one pushes.
+    glm::vec3 wall_push{0.0f};
+    glm::vec3 wall_push_velocity{0.0f};
   };
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
