@@ -1544,12 +1544,15 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   }
   ankle_target = hip_position + reached;
   // The knee turns about its hinge in the data (ControllerDatabase::knee_hinge), the chain
-  // keeping the animation's twist. Without one it bends toward where it points now, the pole;
-  // a nearly straight leg has no such direction
-  // (its knee lies on the hip-ankle line and the bend plane would flip from frame to frame),
-  // so the character's forward breaks the tie. A knee behind that line (a leg straight or
-  // overstretched in the data) points nowhere a knee bends: only its sideways part counts, or
-  // as it crosses the line the bend would turn over, the knee jumping to the back of the leg.
+  // keeping the animation's twist. Without one it bends toward the pole, where it points now; a
+  // nearly straight leg has no such direction (its knee lies on the hip-ankle line and the bend
+  // plane would flip from frame to frame), so the character's forward breaks the tie. A knee
+  // behind that line (a leg straight or overstretched in the data) points nowhere a knee bends:
+  // only its sideways part counts, or as it crosses the line the bend would turn over, the knee
+  // jumping to the back of the leg.
+  // (The pole is kept with a hinge too: the solve falls back on it where the hinge would lie
+  // along the thigh.)
+  const glm::vec3 hinge = shared_->knee_hinge(side);
   const glm::vec3 forward = rotated(globals_[0].rotation, kForward);
   glm::vec3 bend = globals_[static_cast<size_t>(knee)].translation -
                    0.5f * (hip_position + globals_[static_cast<size_t>(foot)].translation);
@@ -1558,7 +1561,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // The foot's subtree is refreshed once, below, after its rotation is set.
   const TwoBoneIkResult solved = apply_two_bone_ik_above_end(
       parents, db_->skeleton().subtree_sizes(), locals_, globals_, hip, knee, foot, ankle_target,
-      pole, rotated(globals_[static_cast<size_t>(knee)].rotation, shared_->knee_hinge(side)));
+      pole, rotated(globals_[static_cast<size_t>(knee)].rotation, hinge));
   // A heel on the ground (no lift at all) leaves the foot its turned rotation and the toe its
   // local one: the toe's turn below is then the foot's rotation undone by itself.
   const bool heel_lifted = heel_rise != glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
