@@ -40,6 +40,9 @@ constexpr float kMaxWallPush = 0.1f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
+// The least horizontal share of a face's normal that makes it a riser a toe waits at (a face
+// steeper than about 64 degrees).
+constexpr float kRiserNormal = 0.9f;
 // Halflife (s) of a toe's way back onto the animation when a wall that kept it out lets go:
 // 11 cm (a ledge's side that becomes a step) come back in about 0.2 s, at most about 30 m/s^2.
 constexpr float kToeWallPushHalflife = 0.08f;
@@ -293,6 +296,7 @@ void Controller::settle_on_ground() {
   obstacle_normal_ = glm::vec3(0.0f);
   held_time_ = 0.0f;
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
+  std::fill(std::begin(riser_walls_), std::end(riser_walls_), WallHit{});
   std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
   wall_push_ = wall_push_velocity_ = 0.0f;
 }
@@ -396,23 +400,40 @@ glm::vec3 Controller::without_slide_back(const glm::vec3& step, float dt) const 
 
 // Walls near the feet and the arms: a small sphere swept from the root's vertical line out to
 // each toe a step above the body's ground (lower things are steps the feet stand on, not
-// walls), and to each hand, elbow and the head at their own height when higher than a step.
-// One batched call. The capsule keeps only the root a radius from a wall; these reach past it.
+// walls), along each toe in the air's way (risers), and to each hand, elbow and the head at
+// their own height when higher than a step. One batched call. The capsule keeps only the root a
+// radius from a wall; these reach past it.
 void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
   const JointRoleIndices& roles = db_->roles();
   const int reaching[kReachingJoints] = {roles.left_hand, roles.right_hand, roles.left_lower_arm,
                                          roles.right_lower_arm, roles.head};
   const glm::vec3 root = locals_[0].translation;
   const float step = ground_height_ + settings_.step_height;
-  std::array<ShapeSweep, 2 + kReachingJoints> sweeps;
-  std::array<SweepHit, 2 + kReachingJoints> hits;
-  std::array<WallHit*, 2 + kReachingJoints> out;
+  std::array<ShapeSweep, 4 + kReachingJoints> sweeps;
+  std::array<SweepHit, 4 + kReachingJoints> hits;
+  std::array<WallHit*, 4 + kReachingJoints> out;
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
     out[count] = &toe_walls_[side];
     sweeps[count++] = ShapeSweep{glm::vec3(root.x, step, root.z), glm::vec3(toe.x, step, toe.z),
                                  kWallProbeRadius, 2.0f * kWallProbeRadius};
+  }
+  // A toe in the air, from where it was to where it goes, at its height over its ground: the
+  // side of a step it is not yet above (a riser) is a wall to it until it is. Without it the
+  // toe went on into the riser and was lifted onto the tread in the update it got there (20 cm
+  // in an update).
+  for (int side = 0; side < 2; ++side) {
+    riser_walls_[side] = WallHit{};
+    const FootLock& f = feet_[side];
+    if (f.locked || !f.has_target) continue;
+    const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
+    const float height =
+        std::max(f.target.y, toe.y + foot_placement_.ground(side).toe - ground_height_);
+    const glm::vec3 from(f.target.x, height, f.target.z), to(toe.x, height, toe.z);
+    if (glm::length(to - from) < 1e-4f) continue;
+    out[count] = &riser_walls_[side];
+    sweeps[count++] = ShapeSweep{from, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
   for (int k = 0; k < kReachingJoints; ++k) {
     body_walls_[k] = WallHit{};
@@ -429,7 +450,9 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
   for (size_t i = 0; i < count; ++i) {
     WallHit& wall = *out[i];
     const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
-    wall.found = hits[i].hit && glm::length(n) > 0.5f;
+    // A riser is a side, not a ramp's slope the toe's sweep runs into.
+    const bool riser = out[i] == &riser_walls_[0] || out[i] == &riser_walls_[1];
+    wall.found = hits[i].hit && glm::length(n) > (riser ? kRiserNormal : 0.5f);
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.
@@ -440,7 +463,9 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
 
 // A toe target is kept a margin out of the walls found between the body and the toes, and out of
 // the one the simulation object stands against: a step to the side or ahead would put the foot
-// into it (the capsule keeps only the root a radius away).
+// into it (the capsule keeps only the root a radius away). A toe in the air is kept out of the
+// riser it met, which it waits at while its ground rises (FootPlacement, PlacementLeg's
+// held_at_step).
 void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
   const auto push_out = [&target](const glm::vec3& wall, const glm::vec3& n) {
     const float depth = glm::dot(wall - target, n) + kWallProbeRadius;
@@ -450,6 +475,8 @@ void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
   if (wall_beside(wall, n)) push_out(wall, n);
   const WallHit& toe_wall = toe_walls_[side];
   if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
+  const WallHit& riser = riser_walls_[side];
+  if (riser.found && !feet_[side].locked) push_out(riser.point, riser.normal);
 }
 
 // How far walls keep a toe at `toe` out (FootLock::wall_push): where a wall lets go (a ledge
@@ -510,6 +537,9 @@ void Controller::place_feet(float dt) {
     ease_wall_push(side, p.toe, dt);
     p.toe += feet_[side].wall_push;
     p.ankle += feet_[side].wall_push;
+    // Held at a riser, the toe looks where the animation takes it, over the step.
+    p.shift += feet_[side].wall_push;
+    p.held_at_step = riser_walls_[side].found;
   }
   FootPlacementSettings placement;
   placement.max_pelvis_drop = settings_.max_pelvis_drop;

@@ -144,7 +144,8 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     // ankle cross the edge, and a heel lifted at once popped the leg straight.
     follow_ground(foot.ground.heel, foot.velocity.heel, g.heel,
                   std::numeric_limits<float>::infinity(), dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, toe_time_to_step(side), dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, toe_time_to_step(side, legs[side]),
+                  dt);
     // The ground under the toe now is a floor the height never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
@@ -264,7 +265,8 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
   for (int side = 0; side < 2; ++side) {
     const FootGround& g = feet_[side].ground;
     top[side] = std::max({body_ground, g.heel, g.toe}) + settings.step_height + kProbeMargin;
-    reach[side] = top[side] - (body_ground - settings.max_step_down - kProbeMargin);
+    reach[side] =
+        top[side] - (below_foot(side, body_ground) - settings.max_step_down - kProbeMargin);
   }
   for (int side = 0; side < 2; ++side) {
     const PlacementLeg& leg = legs[side];
@@ -297,17 +299,32 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
 glm::vec3 FootPlacement::own_lookahead(int side, const PlacementLeg& leg) const {
   const glm::vec3 ahead = feet_[side].toe_velocity * kToeLookahead;
   const glm::vec3 back(-leg.shift.x, 0.0f, -leg.shift.z);
+  // Held at a riser, over the step: sliding along its face, the toe's own way looked beside it.
+  if (leg.held_at_step) return back;
   return glm::dot(back, back) > glm::dot(ahead, ahead) ? back : ahead;
 }
 
-// The ground query `i` found. Deeper below the body than the body steps down (a step and the
-// mover's kStepClearance, character_mover.hpp), it is over a ledge: a foot out over it stays
+// What a foot's steps down and ledges are measured from: the body's ground, or the foot's own
+// where it is lower. A foot still on the floor the body has climbed more than a step above (the
+// body rises up the stairs ahead of a foot about to leave the floor) stands on a floor, not over
+// a ledge: measured from the body alone, its ground jumped up to the body's in an update (35 cm
+// over the floor, with the toe at the first riser).
+float FootPlacement::below_foot(int side, float body_ground) const {
+  const FootGround& own = feet_[side].ground;
+  return std::min({body_ground, own.heel, own.toe});
+}
+
+// The ground query `i` found. Deeper below the body (or the foot's own ground: below_foot) than
+// the body steps down (a step and the mover's kStepClearance, character_mover.hpp), it is over a
+// ledge: a foot out over it stays
 // level with the body, so that swinging back it passes over the edge instead of through the
 // ledge's side. (With the step alone, a foot beside stairs_12_35's 0.36 m side, which the body
 // steps down, was held level with the body 43 cm over the floor.)
 float FootPlacement::found(int i, float body_ground, const FootPlacementSettings& settings) const {
   const GroundHit& hit = hits_[static_cast<size_t>(i)];
-  const float deepest = body_ground - settings.step_height - CharacterMover::kStepClearance;
+  const int side = i < kProbes ? i / kPerSide : (i - kProbes) / kFootprint;
+  const float deepest =
+      below_foot(side, body_ground) - settings.step_height - CharacterMover::kStepClearance;
   return hit.hit && hit.point.y >= deepest ? hit.point.y : body_ground;
 }
 
@@ -365,7 +382,9 @@ FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
 // How soon (s) the toe meets ground a step above its own: at once where it is over it now; where
 // its sweep stops (sweep_toes), at that share of its own look-ahead; else (a step it is above, or
 // only the body's look-ahead sees) at the end of the body's.
-float FootPlacement::toe_time_to_step(int side) const {
+float FootPlacement::toe_time_to_step(int side, const PlacementLeg& leg) const {
+  // A toe held at a riser waits there: it meets the step only once it is up.
+  if (leg.held_at_step) return std::numeric_limits<float>::infinity();
   if (probe_grounds_[slot(side, kToe)].y > feet_[side].ground.toe + kStepRise) return 0.0f;
   return toe_meets_[side] < 1.0f ? toe_meets_[side] * kToeLookahead : kLookahead;
 }

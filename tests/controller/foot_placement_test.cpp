@@ -381,6 +381,56 @@ TEST(FootPlacement, AToeLiftingOffBesideABoxsSideRisesAtOnce) {
   EXPECT_EQ(risen(0.2f), 0.0f);     // beyond its look-ahead: not yet seen
 }
 
+// A toe held at a riser's face (controller_world.cpp keeps a toe in the air out of the riser it
+// meets, PlacementLeg::held_at_step) waits there while its ground rises to the tread's: at
+// about kStepAcceleration, at every update rate. Taken for a toe that meets the step at once, it
+// rose on the quick spring (here 100, 172 and 274 m/s^2 at 1/30, 1/60 and 1/144 s).
+TEST(FootPlacement, AToeHeldAtARiserRisesWithBoundedAcceleration) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    AnalyticWorld world;
+    add_riser(world, 0.2f, 0.2f);
+    CharacterMover mover;
+    FootPlacement p;
+    // The toe 3 cm before the riser, the animation's toe 10 cm past it (its shift back to it).
+    std::array<PlacementLeg, 2> legs = left_swinging(0.02f);
+    legs[0].held_at_step = true;
+    legs[0].shift = glm::vec3(0.0f, 0.0f, -0.13f);
+    p.reset(0.0f);
+    std::array<float, 3> heights{0.0f, 0.0f, 0.0f};  // at rest on the floor before
+    float largest = 0.0f;
+    for (int updates = 1; updates * dt <= 0.5f; ++updates) {
+      p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+               dt);
+      heights = {heights[1], heights[2], p.ground(0).toe};
+      largest =
+          std::max(largest, std::abs(heights[2] - 2.0f * heights[1] + heights[0]) / (dt * dt));
+    }
+    EXPECT_NEAR(p.ground(0).toe, 0.2f, 1e-3f) << dt;  // up, on the tread's height
+    // kStepAcceleration, and a little more in the update that lands on the tread.
+    EXPECT_LE(largest, 46.0f) << dt;
+  }
+}
+
+// The body rises up stairs ahead of a foot still on the floor before them, more than a step
+// above it: that floor is the foot's own, not a ledge below the body (measured from the body's
+// ground alone, the foot's ground jumped up to the body's in an update, 35 cm).
+TEST(FootPlacement, AFootStillOnTheFloorTheBodyClimbedAboveStandsOnThatFloor) {
+  AnalyticWorld world;
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs = standing_legs();
+  settle(p, world, mover, legs, 0.0f);
+  for (int f = 1; f <= 30; ++f) {
+    const float body = 0.5f * static_cast<float>(f) / 30.0f;  // 0.5 m up in half a second
+    p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, body, glm::vec3(0.0f),
+             kDt);
+    for (int side = 0; side < 2; ++side) {
+      EXPECT_NEAR(p.ground(side).toe, 0.0f, 1e-4f) << f;
+      EXPECT_NEAR(p.ground(side).heel, 0.0f, 1e-4f) << f;
+    }
+  }
+}
+
 // On a circle or a step to the side the swinging toe heads where the body does not, and
 // farther in the body's 0.2 s than in its own 0.1 s: looking only the farther way, the toe met
 // the riser it swung into (the course off its lanes, circle at 1/144: 12 cm into the stairs).

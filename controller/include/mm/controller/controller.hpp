@@ -875,6 +875,7 @@ class Controller {
   };
   static constexpr int kReachingJoints = 5;
   WallHit toe_walls_[2];
+  WallHit riser_walls_[2];
   WallHit body_walls_[kReachingJoints];
   glm::vec3 body_shift_{0.0f};  // what moved the body above the root this update
   float ground_offset_[2] = {0.0f, 0.0f};

@@ -26,7 +26,8 @@
 // its own ground, and pitches the foot so that heel and toe each keep their height above their
 // ground (tilt()).
 //
-// A probe that misses, finds ground farther than a step above or below the body's ground, or
+// A probe that misses, finds ground farther than a step above or below the body's ground (below
+// the foot's own where that is lower: a foot still on the floor the body climbed above), or
 // returns garbage (rejected by CharacterMover's checks, counted in world_rejected) falls back to
 // the body's ground, the capsule's floor: the animation as recorded.
 
@@ -53,6 +54,8 @@ struct PlacementLeg {
   float length = 0.0f;       // upper plus lower leg (m)
   bool planted = false;      // locked or in contact: its probes look only where it is
   bool near_ground = false;  // planted or about to be: its reach counts for the pelvis
+  // Held back by the side of a step it is not yet above (a riser): it waits there while it rises.
+  bool held_at_step = false;
 };
 
 struct FootPlacementSettings {
@@ -136,6 +139,7 @@ class FootPlacement {
   void place_probes(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                     float body_ground, const glm::vec3& body_velocity);
   glm::vec3 own_lookahead(int side, const PlacementLeg& leg) const;
+  float below_foot(int side, float body_ground) const;
   float found(int i, float body_ground, const FootPlacementSettings& settings) const;
   void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
   void keep_steps_ahead();
@@ -143,7 +147,7 @@ class FootPlacement {
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
   void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
                   std::span<const PlacementLeg, 2> legs, float body_ground);
-  float toe_time_to_step(int side) const;
+  float toe_time_to_step(int side, const PlacementLeg& leg) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                   float body_ground) const;
   float reach_drop(int side, const PlacementLeg& leg, float body_ground, float from,
