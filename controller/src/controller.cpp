@@ -1429,7 +1429,12 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
   if (dt > 0.0f && f.has_animated) {
     f.velocity = (on_ground - f.animated) / dt;
     const float speed = std::hypot(f.velocity.x, f.velocity.z);
-    f.low_and_slow = on_ground.y - toe_ground(side) < kPlantedHeight && speed < kPlantedSpeed;
+    // Low over the ground under it now, not over the foot's ground, which the look-ahead raises
+    // before a step: a toe released at a riser, its ground already rising, was held again a few
+    // centimetres up and came down with the ground as the held foot stopped looking ahead (the
+    // knee 391 m/s^2 at 1/60 s, stand-turns.txt from x = 11.5 on the second course).
+    const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
+    f.low_and_slow = on_ground.y - under < kPlantedHeight && speed < kPlantedSpeed;
     // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
     // jitter over a few milliseconds is no sweep.
     f.speed += (speed - f.speed) * sweep_pull_.of(kSweepHalflife, dt);

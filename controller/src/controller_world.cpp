@@ -521,6 +521,7 @@ void Controller::place_feet(float dt) {
     p.toe += moved;
     p.ankle += moved;
     p.length = leg_length(side);
+    p.lowest = shared_->lowest_foot_end(side);
     // A foot stepping while its frame says contact is in the air, and so is a toe sweeping
     // along under its label: they look ahead like any other.
     p.planted = f.locked || (contact_label_holds(side) && !f.stepping);

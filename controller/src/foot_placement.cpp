@@ -19,20 +19,18 @@ namespace {
 // it); across a step (a tread's edge: the foot would pop) down on a spring, up with an
 // acceleration of kStepAcceleration, arriving at rest. A spring answers a step with its largest
 // acceleration at once (a 20 cm riser at a 0.03 s halflife: over 600 m/s^2, where the data's
-// locomotion p99 is about 60), and the foot's joints carry it. Only a toe that meets the step
-// sooner than that rise takes (a riser met late in a swing, a box's side a toe lifts off
-// beside; sweep_toes) rises on the spring. The goal's change is measured as a speed, so that
-// the same ground is followed the same way at every update rate (6 cm an update at 1/30 s; the
+// locomotion p99 is about 60), and the foot's joints carry it. A toe that meets the step sooner
+// than that rise takes waits at its riser (the controller keeps it out, as a wall), and one
+// already over the step is kept above it (stay_above). The goal's change is measured as a speed, so
+// that the same ground is followed the same way at every update rate (6 cm an update at 1/30 s; the
 // same 6 cm at 1/144 s is a step).
 constexpr float kStepChangeSpeed = 1.8f;    // m/s: a step, not a slope
 constexpr float kStepAcceleration = 40.0f;  // m/s^2
-constexpr float kRiseHalflife = 0.03f;      // s
 constexpr float kFallHalflife = 0.06f;      // s
-// The sphere swept along a swinging toe's way at its height (m), to find when it meets a step's
-// side (sweep_toes).
+// The sphere swept from a planted toe toward its hip (m, sweep_toes), how far toward its hip (m)
+// it looks for a step's side its leg would drag it into, and the largest vertical share of a
+// normal that is such a side (a slope's is larger).
 constexpr float kToeSweepRadius = 0.02f;
-// How far toward its hip (m) a planted toe looks for a step's side its leg would drag it into,
-// and the largest vertical share of a normal that is such a side (a slope's is larger).
 constexpr float kBesideStepReach = 0.1f;
 constexpr float kSideNormalY = 0.5f;
 // How far above the highest walkable step a probe starts (m): the point it starts from is
@@ -87,8 +85,7 @@ void approach(float& x, float& velocity, float goal, float acceleration, float d
   x += velocity * dt;
 }
 
-// `seconds`: how soon the foot meets the ground it rises to.
-void follow_ground(float& height, float& velocity, float goal, float seconds, float dt) {
+void follow_ground(float& height, float& velocity, float goal, float dt) {
   if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
   if (std::abs(goal - height) <= step_change && std::abs(velocity) <= kStepAcceleration * dt) {
@@ -98,8 +95,6 @@ void follow_ground(float& height, float& velocity, float goal, float seconds, fl
   }
   if (goal < height) {
     critical_spring_update(height, velocity, goal, kFallHalflife, dt);
-  } else if (2.0f * std::sqrt((goal - height) / kStepAcceleration) > seconds) {
-    critical_spring_update(height, velocity, goal, kRiseHalflife, dt);
   } else {
     approach(height, velocity, goal, kStepAcceleration, dt);
   }
@@ -125,7 +120,6 @@ void FootPlacement::reset(float ground) {
     foot.reach_planted = false;
   }
   pelvis_drop_ = pelvis_drop_velocity_ = drop_goal_ = drop_goal_velocity_ = 0.0f;
-  toe_meets_.fill(1.0f);
   toe_beside_step_.fill(false);
   probe_grounds_.fill(glm::vec3(0.0f, ground, 0.0f));
 }
@@ -140,19 +134,20 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
     const FootGround g = goal(side, settings, foot_length);
     Foot& foot = feet_[side];
-    // The heel never rises on the spring: a foot turning on its toe at a tread's edge has its
-    // ankle cross the edge, and a heel lifted at once popped the leg straight.
-    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel,
-                  std::numeric_limits<float>::infinity(), dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, toe_time_to_step(side, legs[side]),
-                  dt);
-    // The ground under the toe now is a floor the height never lags under. Across a step the
+    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
+    // The ground under the toe now is a floor the toe never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
-    // update it is over it, and the height left it inside the tread's side (up to 3.9 cm). Not
-    // the heel's: a foot turning on its toe at a tread's edge has its ankle cross the edge, and
-    // the heel's ground jumped a whole step in an update, popping the leg straight.
-    stay_above(foot.ground.toe, foot.velocity.toe, probe_grounds_[slot(side, kToe)].y);
+    // update it is over it, and the height left it inside the tread's side (up to 3.9 cm). A toe
+    // in the air is kept the data's lowest above it, its ground lifted only as far as that
+    // needs: lifted onto the tread, a toe the animation had above it already popped up by the
+    // difference (a toe let go at a riser's top edge, 4.6 cm in 1/144 s). Not the heel's: a foot
+    // turning on its toe at a tread's edge has its ankle cross the edge, and the heel's ground
+    // jumped a whole step in an update, popping the leg straight.
+    const PlacementLeg& leg = legs[side];
+    const float lifted = leg.planted ? 0.0f : std::max(0.0f, leg.toe.y - body_ground - leg.lowest);
+    stay_above(foot.ground.toe, foot.velocity.toe, probe_grounds_[slot(side, kToe)].y - lifted);
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.
@@ -197,13 +192,10 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   sweep_toes(world, origin, mover, legs, body_ground);
 }
 
-// Each swinging toe's way ahead (its own look-ahead) swept with a small sphere at the toe's
-// height as placed (the animation's height over the body's ground, over the toe's ground
-// instead), never lower than a step above that ground: where it stops is where the toe would
-// meet the side of a step it is not yet above (a toe lifting off beside a box meets it at once).
-// Each planted toe's way toward its hip swept the same way, kBesideStepReach long: a step's
-// side there is one that the leg's reach would drag the toe into (keep_planted_toes_reached).
-// One call for both.
+// Each planted toe's way toward its hip swept with a small sphere at the toe's height as placed
+// (the animation's height over the body's ground, over the toe's ground instead), never lower
+// than a step above that ground, kBesideStepReach long: a step's side there is one that the
+// leg's reach would drag the toe into (keep_planted_toes_reached). One call for both.
 void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& origin,
                                CharacterMover& mover, std::span<const PlacementLeg, 2> legs,
                                float body_ground) {
@@ -211,15 +203,12 @@ void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& orig
   size_t count = 0;
   std::array<int, 2> sides{};
   for (int side = 0; side < 2; ++side) {
-    toe_meets_[side] = 1.0f;
     toe_beside_step_[side] = false;
     const PlacementLeg& leg = legs[side];
-    glm::vec3 way = probe_points_[slot(side, kToeOwn)] - probe_points_[slot(side, kToe)];
-    if (leg.planted) {
-      const glm::vec3 to_hip(leg.hip.x - leg.toe.x, 0.0f, leg.hip.z - leg.toe.z);
-      const float across = glm::length(to_hip);
-      way = across > 1e-3f ? to_hip * (kBesideStepReach / across) : glm::vec3(0.0f);
-    }
+    if (!leg.planted) continue;
+    const glm::vec3 to_hip(leg.hip.x - leg.toe.x, 0.0f, leg.hip.z - leg.toe.z);
+    const float across = glm::length(to_hip);
+    const glm::vec3 way = across > 1e-3f ? to_hip * (kBesideStepReach / across) : glm::vec3(0.0f);
     const float length = glm::length(way);
     if (length < 1e-3f) continue;
     const glm::vec3& toe = leg.toe;
@@ -236,16 +225,8 @@ void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& orig
   std::array<SweepHit, 2> hits;
   mover.sweep(world, origin, std::span(sweeps).first(count), std::span(hits).first(count));
   for (size_t i = 0; i < count; ++i) {
-    if (!hits[i].hit) continue;
-    const int side = sides[i];
-    if (legs[side].planted) {
-      // A side, not a slope rising toward the hip.
-      toe_beside_step_[side] = std::abs(hits[i].normal.y) < kSideNormalY;
-      continue;
-    }
-    const float along = glm::length(sweeps[i].to - sweeps[i].from);
-    const float reach = std::max(0.0f, hits[i].fraction * along - kToeSweepRadius);
-    toe_meets_[side] = reach / (along - kToeSweepRadius);
+    // A side, not a slope rising toward the hip.
+    if (hits[i].hit) toe_beside_step_[sides[i]] = std::abs(hits[i].normal.y) < kSideNormalY;
   }
 }
 
@@ -379,16 +360,6 @@ FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
   return FootGround{std::max(heel, toe - rise), toe >= heel - rise ? toe : heel};
 }
 
-// How soon (s) the toe meets ground a step above its own: at once where it is over it now; where
-// its sweep stops (sweep_toes), at that share of its own look-ahead; else (a step it is above, or
-// only the body's look-ahead sees) at the end of the body's.
-float FootPlacement::toe_time_to_step(int side, const PlacementLeg& leg) const {
-  // A toe held at a riser waits there: it meets the step only once it is up.
-  if (leg.held_at_step) return std::numeric_limits<float>::infinity();
-  if (probe_grounds_[slot(side, kToe)].y > feet_[side].ground.toe + kStepRise) return 0.0f;
-  return toe_meets_[side] < 1.0f ? toe_meets_[side] * kToeLookahead : kLookahead;
-}
-
 // How far the pelvis must come down so that every leg near its ground reaches the ground under
 // its heel: the ankle, lowered by its ground's depth below the body's, no farther from the hip
 // than the animation had it or than kMaxLegExtension of the leg, whichever is farther.
@@ -474,6 +445,10 @@ void FootPlacement::keep_planted_toes_reached(const FootPlacementSettings& setti
     pelvis_drop_velocity_ = dt > 0.0f ? (floor - drop_before) / dt : 0.0f;
     pelvis_drop_ = floor;
   }
+}
+
+float FootPlacement::ground_under_toe(int side) const {
+  return probe_grounds_[slot(side != 0 ? 1 : 0, kToe)].y;
 }
 
 glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) const {

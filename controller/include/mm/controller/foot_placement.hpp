@@ -6,15 +6,16 @@
 // before foot locking, FootPlacement
 // 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
 //    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes,
-//    and sweeps each swinging toe's own way ahead at its height, and each planted toe's way
-//    toward its hip, in one more call (two sweeps);
+//    and sweeps each planted toe's way toward its hip, in one more call (two sweeps);
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
 //    tilted at most max_foot_tilt, the other end hanging over; a toe whose ground that tilt does
 //    not reach, level with the heel), each falling on a spring and
-//    rising with a bounded acceleration (a toe that meets the step sooner than that allows, on a
-//    quick spring), the toe's never lagging under the ground probed under it now;
+//    rising with a bounded acceleration (a toe that meets the step sooner than that allows waits
+//    at its riser: the controller keeps it out as a wall, held_at_step), a toe in the air never
+//    lower than the data's lowest above the ground probed under it now, a planted one's ground
+//    never under it;
 // 3. lowers the pelvis (at most max_pelvis_drop, on a spring) so that the lower of the feet near
 //    their ground reaches it without straightening its leg further than the animation did (or
 //    than kMaxLegExtension of its length, if that is further); and at once, off the spring, as
@@ -48,13 +49,15 @@ struct PlacementLeg {
   glm::vec3 hip{0.0f};
   glm::vec3 ankle{0.0f};
   glm::vec3 toe{0.0f};
-  // The toe's horizontal shift from the animated toe: a lock's hold, or a released foot's
-  // offset, which decays back to none.
+  // The toe's horizontal shift from the animated toe: a lock's hold, a released foot's offset,
+  // which decays back to none, or a wall's push.
   glm::vec3 shift{0.0f};
   float length = 0.0f;       // upper plus lower leg (m)
+  float lowest = 0.0f;       // the data's lowest toe height above its floor (m)
   bool planted = false;      // locked or in contact: its probes look only where it is
   bool near_ground = false;  // planted or about to be: its reach counts for the pelvis
-  // Held back by the side of a step it is not yet above (a riser): it waits there while it rises.
+  // Held back by the side of a step it is not yet above (a riser): it waits there while it
+  // rises, looking for its ground over the step.
   bool held_at_step = false;
 };
 
@@ -105,6 +108,9 @@ class FootPlacement {
 
   const FootGround& ground(int side) const { return feet_[side != 0 ? 1 : 0].ground; }
   float pelvis_drop() const { return pelvis_drop_; }
+  // The ground probed under the toe now (its footprint's edge included), without the look-ahead
+  // that raises a foot's ground before a step.
+  float ground_under_toe(int side) const;
 
   // The rotation that pitches a foot whose heel-to-toe line is `along` (the animated one, after
   // any heading swivel) so that heel and toe each keep their animated height above their own
@@ -147,7 +153,6 @@ class FootPlacement {
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
   void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
                   std::span<const PlacementLeg, 2> legs, float body_ground);
-  float toe_time_to_step(int side, const PlacementLeg& leg) const;
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                   float body_ground) const;
   float reach_drop(int side, const PlacementLeg& leg, float body_ground, float from,
@@ -165,8 +170,6 @@ class FootPlacement {
   std::array<GroundHit, kQueries> hits_{};
   std::array<glm::vec3, kProbes> probe_points_{};
   std::array<glm::vec3, kProbes> probe_grounds_{};
-  // Per toe, the share of its look-ahead its sweep got (sweep_toes; 1: it met nothing).
-  std::array<float, 2> toe_meets_{1.0f, 1.0f};
   // Per planted toe, whether a step's side stands between it and its hip (sweep_toes).
   std::array<bool, 2> toe_beside_step_{false, false};
 };
