@@ -487,13 +487,22 @@ void Controller::ease_wall_push(int side, const glm::vec3& toe, float dt) {
   FootLock& f = feet_[side];
   // A held toe is kept out of the walls where it is, as when it was taken: nothing to ease.
   if (f.locked) f.wall_push = f.wall_push_velocity = glm::vec3(0.0f);
+  const glm::vec3 before = f.wall_push;
   critical_spring_apply(f.wall_push, f.wall_push_velocity, glm::vec3(0.0f),
                         foot_springs_[side].wall_push.step(kToeWallPushHalflife, dt));
   glm::vec3 kept = toe + f.wall_push;
   keep_toe_off_wall(side, kept);
   const glm::vec3 push(kept.x - toe.x, 0.0f, kept.z - toe.z);
-  // A wall pushed the eased toe back out: the push is held there, at rest.
-  if (glm::length(push - f.wall_push) > 1e-6f) f.wall_push_velocity = glm::vec3(0.0f);
+  const bool pushing = glm::length(push - f.wall_push) > 1e-6f;
+  // A wall pushed the eased toe back out: the push is held there, growing as the wall holds the
+  // toe against the animation's way, so that when the wall lets go the toe starts from the rest
+  // it was at, not at once with the animation's speed (a toe held at a riser then went on at 1.8
+  // m/s in an update: 110 m/s^2). The first update of a push holds it at rest: a wall found late
+  // pushes at once, and its depth is no speed to go on with.
+  if (pushing) {
+    f.wall_push_velocity = f.wall_pushing && dt > 0.0f ? (push - before) / dt : glm::vec3(0.0f);
+  }
+  f.wall_pushing = pushing;
   f.wall_push = push;
 }
 

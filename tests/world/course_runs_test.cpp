@@ -228,14 +228,17 @@ TEST(CourseRuns, AToeLiftingOffBeforeARiserWaitsAtItWhileItRises) {
 // the rest of the way onto the tread where the riser's top edge let it go (the toe 210 m/s^2).
 // The plant is judged over the ground under the toe now, every toe rises at the bounded
 // acceleration, and a toe in the air is lifted only as far as the data's lowest above the tread.
+// Let go by the riser, the toe went on with the animation's speed at once (92 m/s^2 at 41.45 s):
+// the wall's push, held at rest while it grew, now goes on growing at the rate it did and eases
+// back from there.
 TEST(CourseRuns, ALegLeavingTheFloorUpStairsRisesWithoutAPop) {
   const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
   const int knee =
       test::normal_controller_database()->database().skeleton().parent(roles.left_foot);
   const CourseRun r{"data/levels/course2.glb", "stand-turns.txt", {11.5, 2.0}, 1.0f / 60.0f};
   // The flat data's locomotion p99 at 1/60 s is about 60 m/s^2.
-  EXPECT_LT(largest_acceleration(r, knee, 41.2f, 41.7f), 120.0f);
-  EXPECT_LT(largest_acceleration(r, roles.left_toe, 41.2f, 41.7f), 120.0f);
+  EXPECT_LT(largest_acceleration(r, knee, 41.2f, 41.7f), 100.0f);
+  EXPECT_LT(largest_acceleration(r, roles.left_toe, 41.2f, 41.7f), 80.0f);
 }
 
 }  // namespace

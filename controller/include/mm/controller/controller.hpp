@@ -813,6 +813,7 @@ class Controller {
     // comes back onto the animation on a spring when a wall lets go, at once when one pushes.
     glm::vec3 wall_push{0.0f};
     glm::vec3 wall_push_velocity{0.0f};
+    bool wall_pushing = false;  // a wall pushed the toe out on the last update
   };
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
