@@ -88,7 +88,11 @@ void approach(float& x, float& velocity, float goal, float acceleration, float d
 void follow_ground(float& height, float& velocity, float goal, float dt) {
   if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
-  if (std::abs(goal - height) <= step_change && std::abs(velocity) <= kStepAcceleration * dt) {
+  // A rise under way lands on its own (approach): followed at once within an update's reach of
+  // its goal, a climb was cut short, the rest in one update.
+  const bool rising = goal > height && velocity > 0.0f;
+  if (!rising && std::abs(goal - height) <= step_change &&
+      std::abs(velocity) <= kStepAcceleration * dt) {
     height = goal;
     velocity = 0.0f;
     return;

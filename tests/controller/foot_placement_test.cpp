@@ -385,6 +385,34 @@ TEST(FootPlacement, AToeHeldAtARiserLooksOverTheStepAndRisesOntoIt) {
   }
 }
 
+// A rise a little more than an update's reach (kStepChangeSpeed, 1.8 m/s, times the update)
+// under a foot is climbed at the bounded acceleration all the way, at every update rate: within
+// reach of its goal after its first update, the climb was cut short by following the goal at
+// once, the rest in one update (a heel 2.9 cm at 1/60 s, stand-turns from x = 8.7 on the second
+// course: the knee 280 m/s^2).
+TEST(FootPlacement, ARiseJustBeyondAnUpdatesReachIsClimbedWithBoundedAcceleration) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    const float rise = 1.8f * dt + 20.0f * dt * dt;  // reach, and half an update at 40 m/s^2
+    AnalyticWorld world;
+    CharacterMover mover;
+    FootPlacement p;
+    const std::array<PlacementLeg, 2> legs = standing_legs();
+    settle(p, world, mover, legs, 0.0f);
+    world.boxes.push_back(AnalyticBox{glm::vec2(0.0f), glm::vec2(2.0f), 0.0f, rise});
+    std::array<float, 3> heels{0.0f, 0.0f, 0.0f};  // at rest on the floor before
+    float largest = 0.0f;
+    for (int updates = 1; updates * dt <= 0.5f; ++updates) {
+      p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+               dt);
+      heels = {heels[1], heels[2], p.ground(0).heel};
+      largest = std::max(largest, std::abs(heels[2] - 2.0f * heels[1] + heels[0]) / (dt * dt));
+    }
+    EXPECT_NEAR(p.ground(0).heel, rise, 1e-5f) << dt;
+    // kStepAcceleration, and a little more in the update that lands.
+    EXPECT_LE(largest, 46.0f) << dt;
+  }
+}
+
 // The body rises up stairs ahead of a foot still on the floor before them, more than a step
 // above it: that floor is the foot's own, not a ledge below the body (measured from the body's
 // ground alone, the foot's ground jumped up to the body's in an update, 35 cm).
