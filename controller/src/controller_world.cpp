@@ -412,6 +412,9 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
   std::array<ShapeSweep, 4 + kReachingJoints> sweeps;
   std::array<SweepHit, 4 + kReachingJoints> hits;
   std::array<WallHit*, 4 + kReachingJoints> out;
+  // The least horizontal share of a face's normal that makes it a wall to each sweep.
+  std::array<float, 4 + kReachingJoints> least_share;
+  least_share.fill(0.5f);
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
@@ -433,6 +436,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
     const glm::vec3 from(f.target.x, height, f.target.z), to(toe.x, height, toe.z);
     if (glm::length(to - from) < 1e-4f) continue;
     out[count] = &riser_walls_[side];
+    least_share[count] = kRiserNormal;  // a riser is a side, not a ramp's slope run into
     sweeps[count++] = ShapeSweep{from, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
   for (int k = 0; k < kReachingJoints; ++k) {
@@ -450,9 +454,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
   for (size_t i = 0; i < count; ++i) {
     WallHit& wall = *out[i];
     const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
-    // A riser is a side, not a ramp's slope the toe's sweep runs into.
-    const bool riser = out[i] == &riser_walls_[0] || out[i] == &riser_walls_[1];
-    wall.found = hits[i].hit && glm::length(n) > (riser ? kRiserNormal : 0.5f);
+    wall.found = hits[i].hit && glm::length(n) > least_share[i];
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.

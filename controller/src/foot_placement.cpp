@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
