@@ -177,8 +177,11 @@ CrowdResult summarize(CrowdTimes& times, size_t n, size_t window, size_t replay_
   for (size_t f = warm; f < steady; ++f) frame_seconds += times.frame_seconds[f];
   const double frame_mean = frame_seconds / static_cast<double>(steady - warm);
   result.frame_ms_mean = frame_mean * 1e3;
-  result.frame_ms_p99 =
-      p99(std::span<double>(times.frame_seconds.data() + warm, steady - warm)) * 1e3;
+  // p99 reorders what it is given: the frames' own order is kept for frame_ms and the records.
+  std::vector<double> frames_seconds(
+      times.frame_seconds.begin() + static_cast<std::ptrdiff_t>(warm),
+      times.frame_seconds.begin() + static_cast<std::ptrdiff_t>(steady));
+  result.frame_ms_p99 = p99(std::span<double>(frames_seconds)) * 1e3;
   result.max_characters_60hz =
       clamped_integer<int>(std::floor(static_cast<double>(n) * (1.0 / 60.0) / frame_mean));
   if (sampled) {
