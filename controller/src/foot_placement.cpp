@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mm/runtime/approach.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
 
@@ -23,9 +24,10 @@ namespace {
 // already over the step is kept above it (stay_above). The goal's change is measured as a speed, so
 // that the same ground is followed the same way at every update rate (6 cm an update at 1/30 s; the
 // same 6 cm at 1/144 s is a step).
-constexpr float kStepChangeSpeed = 1.8f;    // m/s: a step, not a slope
-constexpr float kStepAcceleration = 40.0f;  // m/s^2
-constexpr float kFallHalflife = 0.06f;      // s
+constexpr float kStepChangeSpeed = 1.8f;           // m/s: a step, not a slope
+constexpr float kStepAcceleration = 40.0f;         // m/s^2
+constexpr float kPlantedHeelAcceleration = 20.0f;  // m/s^2: a planted foot's heel
+constexpr float kFallHalflife = 0.06f;             // s
 // The sphere swept from a planted toe toward its hip (m, sweep_toes), how far toward its hip (m)
 // it looks for a step's side its leg would drag it into, and the largest vertical share of a
 // normal that is such a side (a slope's is larger).
@@ -61,30 +63,7 @@ constexpr int now_of(int which) {
   return which % 2;
 }
 
-// Toward `goal` as fast as an acceleration of at most `acceleration` allows, arriving at rest:
-// each update the velocity turns by at most acceleration * dt toward the fastest one that can
-// still stop at the goal braking at that rate in updates of dt (v^2 / 2a + v dt / 2 = distance).
-void approach(float& x, float& velocity, float goal, float acceleration, float dt) {
-  const float change = acceleration * dt;
-  const float distance = goal - x;
-  if (std::abs(distance) <= change * dt && std::abs(velocity) <= change) {
-    x = goal;
-    velocity = 0.0f;
-    return;
-  }
-  const float braking =
-      std::sqrt(0.25f * change * change + 2.0f * acceleration * std::abs(distance)) - 0.5f * change;
-  velocity += std::clamp(std::copysign(braking, distance) - velocity, -change, change);
-  // A step of more than an update's reach (acceleration * dt^2 above the distance) lands on it.
-  if (velocity * distance > 0.0f && std::abs(velocity * dt) >= std::abs(distance)) {
-    x = goal;
-    velocity = 0.0f;
-    return;
-  }
-  x += velocity * dt;
-}
-
-void follow_ground(float& height, float& velocity, float goal, float dt) {
+void follow_ground(float& height, float& velocity, float goal, float acceleration, float dt) {
   if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
   // A rise under way lands on its own (approach): followed at once within an update's reach of
@@ -99,7 +78,7 @@ void follow_ground(float& height, float& velocity, float goal, float dt) {
   if (goal < height) {
     critical_spring_update(height, velocity, goal, kFallHalflife, dt);
   } else {
-    approach(height, velocity, goal, kStepAcceleration, dt);
+    approach(height, velocity, goal, acceleration, dt);
   }
 }
 
@@ -137,8 +116,12 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
     const FootGround g = goal(side, settings, foot_length);
     Foot& foot = feet_[side];
-    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, dt);
+    // A planted foot's heel crossing a tread's edge (its ankle passing the edge by millimetres
+    // as the foot turns on its held toe) rises more gently: the foot pivots about the held toe,
+    // and the leg carried the whole rise into the knee (docs/world.md, session 23).
+    const float heel_rise = legs[side].planted ? kPlantedHeelAcceleration : kStepAcceleration;
+    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, heel_rise, dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, kStepAcceleration, dt);
     // The ground under the toe now is a floor the toe never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
