@@ -1381,7 +1381,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   if (world_) {
     // Out of the walls as place_feet put it (its ground probed there), eased where one let go;
     // a held toe stays at its point, out of the walls already when it was taken.
-    if (!f.locked) target += f.wall_push;
+    if (!f.locked) target += toe_push(side);
     keep_toe_off_wall(side, target);
   }
   // Never lower than the data's own feet go: blends, offsets and locks taken mid-stride would

@@ -9,6 +9,7 @@
 
 #include "mm/controller/arm_off_wall.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/runtime/approach.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
 
@@ -46,6 +47,11 @@ constexpr float kRiserNormal = 0.9f;
 // Halflife (s) of a toe's way back onto the animation when a wall that kept it out lets go:
 // 11 cm (a ledge's side that becomes a step) come back in about 0.2 s, at most about 30 m/s^2.
 constexpr float kToeWallPushHalflife = 0.08f;
+// The most a ledge's edge accelerates a toe it brings back over the ledge (m/s^2, along each
+// horizontal axis): 19 cm in about 0.11 s.
+constexpr float kLedgePushAcceleration = 60.0f;
+// Edges' normals this close (cosine) are one edge.
+constexpr float kSameEdge = 0.99f;
 // How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
 // the skin's thickness through it).
 constexpr float kArmMargin = 0.01f;
@@ -59,6 +65,7 @@ void Controller::set_world(const WorldQueries* world) {
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = edge_normal_ = glm::vec3(0.0f);
+  obstacle_edge_ = false;
   held_time_ = 0.0f;
   root_contacts_.clear();
   wall_push_ = wall_push_velocity_ = 0.0f;
@@ -90,6 +97,7 @@ void Controller::collide_simulation(const glm::vec3& before) {
   if (m.blocked && glm::length(m.normal) > 0.5f) {
     obstacle_normal_ = m.normal;
     obstacle_point_ = sim_position_;
+    obstacle_edge_ = m.edge;
   }
   if (m.no_ground) {
     sim_velocity_ = sim_acceleration_ = glm::vec3(0.0f);
@@ -294,6 +302,7 @@ void Controller::settle_on_ground() {
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);
+  obstacle_edge_ = false;
   held_time_ = 0.0f;
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
   std::fill(std::begin(riser_walls_), std::end(riser_walls_), WallHit{});
@@ -474,7 +483,8 @@ void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
     if (depth > 0.0f) target += n * depth;
   };
   glm::vec3 wall, n;
-  if (wall_beside(wall, n)) push_out(wall, n);
+  // A ledge's edge is no face the toe could go into: ease_ledge_push brings it back over.
+  if (!obstacle_edge_ && wall_beside(wall, n)) push_out(wall, n);
   const WallHit& toe_wall = toe_walls_[side];
   if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
   const WallHit& riser = riser_walls_[side];
@@ -506,6 +516,41 @@ void Controller::ease_wall_push(int side, const glm::vec3& toe, float dt) {
   }
   f.wall_pushing = pushing;
   f.wall_push = push;
+}
+
+// A toe swung out over the ledge's edge the simulation object stands at is brought back over it,
+// and let go again, with at most kLedgePushAcceleration: the object stops at the edge when the
+// toe is already out there, and pushed out at once (as a wall's face does) the toe moved back a
+// foot's width in an update (docs/world.md, session 23). A held toe stays where it was taken.
+void Controller::ease_ledge_push(int side, const glm::vec3& toe, float dt) {
+  FootLock& f = feet_[side];
+  if (f.locked) {
+    f.ledge_push = f.ledge_lag = f.ledge_lag_velocity = f.ledge_need = f.ledge_normal =
+        glm::vec3(0.0f);
+    return;
+  }
+  glm::vec3 need(0.0f), edge, n(0.0f);
+  if (!obstacle_edge_ || !wall_beside(edge, n)) n = glm::vec3(0.0f);
+  if (n != glm::vec3(0.0f)) {
+    need = n * std::max(0.0f, glm::dot(edge - (toe + f.wall_push), n) + kWallProbeRadius);
+  }
+  // Along the same edge the push is the need, as a wall's face's is: a toe swinging out there
+  // stops at it. Where the need jumps (an edge found with the toe already out over it, another
+  // edge at a corner, the edge gone) the push stays where it was and the jump is made up with
+  // a bounded acceleration, each horizontal axis alone.
+  if (!(glm::dot(n, f.ledge_normal) > kSameEdge)) f.ledge_lag += need - f.ledge_need;
+  for (const int axis : {0, 2}) {
+    approach(f.ledge_lag[axis], f.ledge_lag_velocity[axis], 0.0f, kLedgePushAcceleration, dt);
+  }
+  f.ledge_push = need - f.ledge_lag;
+  f.ledge_need = need;
+  f.ledge_normal = n;
+}
+
+// Everything the walls and a ledge's edge move a toe by this update (horizontal, m).
+glm::vec3 Controller::toe_push(int side) const {
+  const FootLock& f = feet_[side];
+  return f.wall_push + f.ledge_push;
 }
 
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the
@@ -547,10 +592,12 @@ void Controller::place_feet(float dt) {
   for (int side = 0; side < 2; ++side) {
     PlacementLeg& p = legs[static_cast<size_t>(side)];
     ease_wall_push(side, p.toe, dt);
-    p.toe += feet_[side].wall_push;
-    p.ankle += feet_[side].wall_push;
+    ease_ledge_push(side, p.toe, dt);
+    const glm::vec3 push = toe_push(side);
+    p.toe += push;
+    p.ankle += push;
     // Held at a riser, the toe looks where the animation takes it, over the step.
-    p.shift += feet_[side].wall_push;
+    p.shift += push;
     p.held_at_step = riser_walls_[side].found;
   }
   FootPlacementSettings placement;

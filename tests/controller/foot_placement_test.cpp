@@ -413,6 +413,38 @@ TEST(FootPlacement, ARiseJustBeyondAnUpdatesReachIsClimbedWithBoundedAcceleratio
   }
 }
 
+// A planted foot's heel onto a step rises at half the bounded acceleration (a foot turning on its
+// held toe has its ankle cross a tread's edge, and the leg carried the whole rise into the knee:
+// the lower leg 156 m/s^2 at 1/60 s on the first course's stairs); a foot in the air rises at
+// the whole of it.
+TEST(FootPlacement, APlantedHeelRisesOntoAStepMoreGentlyThanAFootInTheAir) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    for (const bool planted : {true, false}) {
+      AnalyticWorld world;
+      CharacterMover mover;
+      FootPlacement p;
+      std::array<PlacementLeg, 2> legs = standing_legs();
+      legs[0].planted = planted;
+      settle(p, world, mover, legs, 0.0f);
+      world.boxes.push_back(AnalyticBox{glm::vec2(0.0f), glm::vec2(2.0f), 0.0f, 0.1f});
+      std::array<float, 3> heels{0.0f, 0.0f, 0.0f};
+      float largest = 0.0f;
+      for (int updates = 1; updates * dt <= 0.5f; ++updates) {
+        p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f,
+                 glm::vec3(0.0f), dt);
+        heels = {heels[1], heels[2], p.ground(0).heel};
+        largest = std::max(largest, std::abs(heels[2] - 2.0f * heels[1] + heels[0]) / (dt * dt));
+      }
+      EXPECT_NEAR(p.ground(0).heel, 0.1f, 1e-5f) << dt << " " << planted;
+      if (planted) {
+        EXPECT_LE(largest, 23.0f) << dt;  // 20 m/s^2, a little more in the update that lands
+      } else {
+        EXPECT_GT(largest, 38.0f) << dt;
+      }
+    }
+  }
+}
+
 // The body rises up stairs ahead of a foot still on the floor before them, more than a step
 // above it: that floor is the foot's own, not a ledge below the body (measured from the body's
 // ground alone, the foot's ground jumped up to the body's in an update, 35 cm).

@@ -553,6 +553,8 @@ class Controller {
   void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
   void ease_wall_push(int side, const glm::vec3& toe, float dt);
+  void ease_ledge_push(int side, const glm::vec3& toe, float dt);
+  glm::vec3 toe_push(int side) const;
   glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
   void face_along_obstacle();
@@ -814,6 +816,15 @@ class Controller {
     glm::vec3 wall_push{0.0f};
     glm::vec3 wall_push_velocity{0.0f};
     bool wall_pushing = false;  // a wall pushed the toe out on the last update
+    // How far (horizontally, m) the toe is kept back over the ledge's edge the simulation object
+    // stands at; how much of what the edge needs is still to come (a jump in the need made up
+    // with a bounded acceleration) and its rate; what the edge needed and its normal (zero:
+    // none) last update (ease_ledge_push).
+    glm::vec3 ledge_push{0.0f};
+    glm::vec3 ledge_lag{0.0f};
+    glm::vec3 ledge_lag_velocity{0.0f};
+    glm::vec3 ledge_need{0.0f};
+    glm::vec3 ledge_normal{0.0f};
   };
   FootLock feet_[2];
   // How much of a standing pose's own leg extension foot IK keeps (0 to 1, eased).
@@ -859,7 +870,8 @@ class Controller {
   glm::vec3 obstacle_normal_{0.0f};
   glm::vec3 edge_normal_{0.0f};  // the ledge edge the simulation stands at, or zero
   glm::vec3 obstacle_point_{0.0f};
-  float held_time_ = 0.0f;  // how long the simulation has been held at it (s)
+  bool obstacle_edge_ = false;  // that obstacle is a ledge's edge (a drop), not a wall's face
+  float held_time_ = 0.0f;      // how long the simulation has been held at it (s)
   // The velocity the stick asks for (desired_velocity_ before standing at an obstacle).
   glm::vec3 stick_velocity_{0.0f};
   // How far (m) the body above the root is moved back from that wall, its rate, and along what.
