@@ -525,13 +525,11 @@ void Controller::ease_wall_push(int side, const glm::vec3& toe, float dt) {
 void Controller::ease_ledge_push(int side, const glm::vec3& toe, float dt) {
   FootLock& f = feet_[side];
   if (f.locked) {
-    f.ledge_push = f.ledge_lag = f.ledge_lag_velocity = f.ledge_need = f.ledge_normal =
-        glm::vec3(0.0f);
+    f.ledge_lag = f.ledge_lag_velocity = f.ledge_need = f.ledge_normal = glm::vec3(0.0f);
     return;
   }
-  glm::vec3 need(0.0f), edge, n(0.0f);
-  if (!obstacle_edge_ || !wall_beside(edge, n)) n = glm::vec3(0.0f);
-  if (n != glm::vec3(0.0f)) {
+  glm::vec3 need(0.0f), edge, n(0.0f);  // n stays zero without an edge
+  if (obstacle_edge_ && wall_beside(edge, n)) {
     need = n * std::max(0.0f, glm::dot(edge - (toe + f.wall_push), n) + kWallProbeRadius);
   }
   // Along the same edge the push is the need, as a wall's face's is: a toe swinging out there
@@ -542,7 +540,6 @@ void Controller::ease_ledge_push(int side, const glm::vec3& toe, float dt) {
   for (const int axis : {0, 2}) {
     approach(f.ledge_lag[axis], f.ledge_lag_velocity[axis], 0.0f, kLedgePushAcceleration, dt);
   }
-  f.ledge_push = need - f.ledge_lag;
   f.ledge_need = need;
   f.ledge_normal = n;
 }
@@ -550,7 +547,7 @@ void Controller::ease_ledge_push(int side, const glm::vec3& toe, float dt) {
 // Everything the walls and a ledge's edge move a toe by this update (horizontal, m).
 glm::vec3 Controller::toe_push(int side) const {
   const FootLock& f = feet_[side];
-  return f.wall_push + f.ledge_push;
+  return f.wall_push + f.ledge_need - f.ledge_lag;
 }
 
 // Feet on the ground under them (foot_placement.hpp), after forward kinematics and before the
@@ -581,8 +578,7 @@ void Controller::place_feet(float dt) {
     // A foot stepping while its frame says contact is in the air, and so is a toe sweeping
     // along under its label: they look ahead like any other.
     p.planted = f.locked || (contact_label_holds(side) && !f.stepping);
-    p.near_ground =
-        p.planted || p.toe.y - ground_height_ - shared_->lowest_foot_end(side) < kNearGroundHeight;
+    p.near_ground = p.planted || p.toe.y - ground_height_ - p.lowest < kNearGroundHeight;
   }
   // A toe a wall keeps out (keep_toe_off_wall) is probed where it is kept, not where the
   // animation would put it past the wall: held on a ledge's top while the animation swings it

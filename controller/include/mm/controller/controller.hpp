@@ -816,11 +816,10 @@ class Controller {
     glm::vec3 wall_push{0.0f};
     glm::vec3 wall_push_velocity{0.0f};
     bool wall_pushing = false;  // a wall pushed the toe out on the last update
-    // How far (horizontally, m) the toe is kept back over the ledge's edge the simulation object
-    // stands at; how much of what the edge needs is still to come (a jump in the need made up
-    // with a bounded acceleration) and its rate; what the edge needed and its normal (zero:
-    // none) last update (ease_ledge_push).
-    glm::vec3 ledge_push{0.0f};
+    // The ledge's edge the simulation object stands at keeps the toe back over it by
+    // ledge_need - ledge_lag (horizontal, m): what the edge needs, less what of a jump in that
+    // need is still to come (made up with a bounded acceleration) at its rate; and the edge's
+    // normal (zero: none) (ease_ledge_push).
     glm::vec3 ledge_lag{0.0f};
     glm::vec3 ledge_lag_velocity{0.0f};
     glm::vec3 ledge_need{0.0f};
