@@ -419,6 +419,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   sim_rotation_ = desired_rotation_ = simulation_goal_rotation_ = warp_facing_ = rotation;
   warp_facing_reached_ = true;
   desired_velocity_ = glm::vec3(0.0f);
+  climb_pace_.reset();
   clear_transitions();
   for (FootLock& f : feet_) f = FootLock{};
   standing_reach_ = 0.0f;
@@ -453,6 +454,7 @@ void Controller::update(float dt, const ControllerInput& input) {
   debug_.search_seconds = 0.0f;
 
   desired_motion(input);
+  if (world_) pace_to_ground(dt);
   search_timer_ += dt;
   since_transition_ += dt;
   if (should_search()) {
@@ -564,6 +566,20 @@ void Controller::desired_motion(const ControllerInput& input) {
   simulation_goal_rotation_ = warped_facing();
 }
 
+// Steep ground ahead slows the clip and the desired velocity alike (climb_pace.hpp). The grade is
+// read off the last update's prediction, collided with the world: the ground the character is
+// about to walk on, found before it gets there.
+void Controller::pace_to_ground(float dt) {
+  const std::span<const glm::vec3> ahead(debug_.predicted_positions,
+                                         static_cast<size_t>(debug_.trajectory_count));
+  const float speed = std::hypot(desired_velocity_.x, desired_velocity_.z);
+  climb_pace_.update(grade_ahead(sim_position_, ahead), speed, settings_.max_climb_speed,
+                     settings_.min_playback_rate, dt);
+  desired_velocity_ *= climb_pace_.rate();
+  debug_.desired_velocity = desired_velocity_;
+  debug_.playback_rate = climb_pace_.rate();
+}
+
 bool Controller::should_search() const {
   if (force_search_) return true;
   // Periodic searches wait a little after a transition: the query keeps drifting while the
@@ -616,7 +632,10 @@ void Controller::build_query() {
     if (t.direction) {
       v = inverse * (debug_.predicted_rotations[t.time_index] * kForward);
     } else {
-      v = inverse * (debug_.predicted_positions[t.time_index] - root.translation);
+      // At the clip's slowed rate it covers the prediction's ground in as many clip seconds as
+      // the stick's own speed would: the search matches the gait asked for.
+      v = inverse * (debug_.predicted_positions[t.time_index] - root.translation) /
+          climb_pace_.rate();
     }
     const size_t c = static_cast<size_t>(t.column);
     query_[c] = (v.x - db.feature_offset()[c]) / db.feature_scale()[c];
@@ -789,7 +808,7 @@ float Controller::clip_duration() const {
 
 void Controller::advance_playback(float dt) {
   const float end = clip_duration();
-  clip_time_ = std::min(clip_time_ + dt, end);
+  clip_time_ = std::min(clip_time_ + dt * climb_pace_.rate(), end);
   if (clip_time_ >= end) force_search_ = true;
 }
 
@@ -872,8 +891,8 @@ void Controller::sample_playback_root(std::span<Transform> local, std::span<glm:
   local[0].translation =
       map * (local[0].translation - transition_dst_position_) + transition_src_position_;
   local[0].rotation = glm::normalize(map * local[0].rotation);
-  velocities[0] = map * velocities[0];
-  angular_velocities[0] = map * angular_velocities[0];
+  velocities[0] = map * velocities[0] * climb_pace_.rate();
+  angular_velocities[0] = map * angular_velocities[0] * climb_pace_.rate();
 }
 
 // The body's (joints 1..) velocities at a playback point, folded like sample_playback folds the
@@ -884,6 +903,13 @@ void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::
   const size_t joints = static_cast<size_t>(db.joint_count());
   pose_velocity_mix(db.frame_pose_lanes(at.frame0), db.frame_pose_lanes(at.frame1), at.weight, 1,
                     velocities.first(joints), angular_velocities.first(joints));
+  // In the world's time: the clip plays at the climbing pace's rate.
+  if (const float rate = climb_pace_.rate(); rate != 1.0f) {
+    for (size_t j = 1; j < joints; ++j) {
+      velocities[j] *= rate;
+      angular_velocities[j] *= rate;
+    }
+  }
   for (const int j : folded_joints_) {
     const glm::quat folded = sample_joint(at, static_cast<size_t>(j)).rotation;
     const glm::vec3 v = velocities[static_cast<size_t>(j)];

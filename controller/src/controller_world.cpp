@@ -50,6 +50,15 @@ constexpr float kToeWallPushHalflife = 0.08f;
 // The most a ledge's edge accelerates a toe it brings back over the ledge (m/s^2, along each
 // horizontal axis): 19 cm in about 0.11 s.
 constexpr float kLedgePushAcceleration = 60.0f;
+// A trajectory sample's move goes on from where a step stopped it at most this many times (a
+// second's walk up a stair of 25 cm treads crosses five risers; two or three per move), and
+// only where it ended this much higher or lower than it started (m): a wall leaves it where
+// it was.
+constexpr int kTrajectoryClimbs = 4;
+constexpr float kClimbedHeight = 0.01f;
+// Only a move stopped on level ground (a tread; the up vector's share of its normal at least
+// this) goes on: one stopped on a ramp met its own slope, not a step.
+constexpr float kTreadNormalY = 0.99f;
 // Edges' normals this close (cosine) are one edge.
 constexpr float kSameEdge = 0.99f;
 // How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
@@ -129,8 +138,48 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
   }
   mover_.collide(*world_, origin_, character_shape(), std::span(starts).first(n), positions,
                  std::span(moved).first(n));
+  climb_trajectory(positions, starts, moved);
   for (size_t i = 0; i < n; ++i) positions[i] = moved[i].position;
   debug_.world_rejected = mover_.rejected();
+}
+
+// A sample's move climbs one step at most: the capsule is swept lifted by step_height, and up a
+// stair the second riser stands higher than that above where the move started, a wall. The
+// trajectory stopped a tread or two ahead (and, down a stair, at the first drop deeper than a
+// step), the search matched a stop, and the character climbed stairs in a string of starts and
+// stops. A sample stopped on other ground than it started from moves on from there toward its
+// goal, as the simulation object itself would over the next updates: a wall stops it at once,
+// a stair only after the flight.
+void Controller::climb_trajectory(std::span<const glm::vec3> goals,
+                                  std::span<glm::vec3, CharacterMover::kMaxMoves> starts,
+                                  std::span<MoveResult, CharacterMover::kMaxMoves> moved) {
+  std::array<glm::vec3, CharacterMover::kMaxMoves> from, to;
+  std::array<MoveResult, CharacterMover::kMaxMoves> again;
+  std::array<size_t, CharacterMover::kMaxMoves> which;
+  for (int pass = 0; pass < kTrajectoryClimbs; ++pass) {
+    size_t count = 0;
+    for (size_t i = 0; i < goals.size(); ++i) {
+      const MoveResult& m = moved[i];
+      const glm::vec3 left(goals[i].x - m.position.x, 0.0f, goals[i].z - m.position.z);
+      if (!m.blocked || m.edge || m.no_ground || m.ground_normal.y < kTreadNormalY ||
+          std::abs(m.position.y - starts[i].y) < kClimbedHeight ||
+          glm::length(left) < kClimbedHeight) {
+        continue;
+      }
+      from[count] = m.position;
+      to[count] = goals[i];
+      which[count++] = i;
+    }
+    if (count == 0) return;
+    mover_.collide(*world_, origin_, character_shape(), std::span(from).first(count),
+                   std::span(to).first(count), std::span(again).first(count));
+    for (size_t k = 0; k < count; ++k) {
+      const MoveResult& m = again[k];
+      if (m.no_ground) continue;
+      starts[which[k]] = from[k];
+      moved[which[k]] = m;
+    }
+  }
 }
 
 // The root's step since the last update, the animation's own displacement, through the world,
@@ -171,8 +220,8 @@ void Controller::lift_to_ground(float dt) {
     // lag up a ramp is made up ahead of time.
     if (debug_.trajectory_count > 0) ground = 0.5f * (ground + debug_.predicted_positions[0].y);
   }
-  critical_spring_update(ground_height_, ground_velocity_, ground, settings_.ground_height_halflife,
-                         dt);
+  critical_spring_update(ground_height_, ground_velocity_, ground,
+                         settings_.ground_height_halflife / climb_pace_.rate(), dt);
   locals_[0].translation.y += ground_height_;
   debug_.ground_height = ground_height_;
 }
@@ -602,6 +651,7 @@ void Controller::place_feet(float dt) {
   placement.max_foot_tilt = settings_.max_foot_tilt;
   placement.step_height = settings_.step_height;
   placement.max_step_down = settings_.max_step_down;
+  placement.pace = climb_pace_.rate();
   foot_placement_.update(*world_, origin_, mover_, placement, legs, ground_height_, sim_velocity_,
                          dt);
   debug_.world_rejected = mover_.rejected();

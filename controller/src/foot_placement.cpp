@@ -63,22 +63,24 @@ constexpr int now_of(int which) {
   return which % 2;
 }
 
-void follow_ground(float& height, float& velocity, float goal, float acceleration, float dt) {
+// `pace` (FootPlacementSettings::pace) stretches the follower's time.
+void follow_ground(float& height, float& velocity, float goal, float acceleration, float pace,
+                   float dt) {
   if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
   // A rise under way lands on its own (approach): followed at once within an update's reach of
   // its goal, a climb was cut short, the rest in one update.
   const bool rising = goal > height && velocity > 0.0f;
   if (!rising && std::abs(goal - height) <= step_change &&
-      std::abs(velocity) <= kStepAcceleration * dt) {
+      std::abs(velocity) <= kStepAcceleration * pace * pace * dt) {
     height = goal;
     velocity = 0.0f;
     return;
   }
   if (goal < height) {
-    critical_spring_update(height, velocity, goal, kFallHalflife, dt);
+    critical_spring_update(height, velocity, goal, kFallHalflife / pace, dt);
   } else {
-    approach(height, velocity, goal, acceleration, dt);
+    approach(height, velocity, goal, acceleration * pace * pace, dt);
   }
 }
 
@@ -110,8 +112,9 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
                            CharacterMover& mover, const FootPlacementSettings& settings,
                            std::span<const PlacementLeg, 2> legs, float body_ground,
                            const glm::vec3& body_velocity, float dt) {
+  const float pace = std::isfinite(settings.pace) ? std::clamp(settings.pace, 0.1f, 1.0f) : 1.0f;
   follow_toes(legs, dt);
-  probe(world, origin, mover, settings, legs, body_ground, body_velocity);
+  probe(world, origin, mover, settings, legs, body_ground, body_velocity / pace);
   for (int side = 0; side < 2; ++side) {
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
     const FootGround g = goal(side, settings, foot_length);
@@ -120,8 +123,8 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     // as the foot turns on its held toe) rises more gently: the foot pivots about the held toe,
     // and the leg carried the whole rise into the knee (docs/world.md, session 23).
     const float heel_rise = legs[side].planted ? kPlantedHeelAcceleration : kStepAcceleration;
-    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, heel_rise, dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, kStepAcceleration, dt);
+    follow_ground(foot.ground.heel, foot.velocity.heel, g.heel, heel_rise, pace, dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, g.toe, kStepAcceleration, pace, dt);
     // The ground under the toe now is a floor the toe never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
@@ -137,7 +140,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.
-  const float halflife = 0.5f * settings.pelvis_drop_halflife;
+  const float halflife = 0.5f * settings.pelvis_drop_halflife / pace;
   const float drop_before = pelvis_drop_;
   critical_spring_update(drop_goal_, drop_goal_velocity_, drop_goal(settings, legs, body_ground),
                          halflife, dt);

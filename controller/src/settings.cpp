@@ -75,6 +75,8 @@ constexpr FloatField kFloatFields[] = {
     {"max_slope", &ControllerSettings::max_slope, 0.0f, 1.5f},
     {"ground_height_halflife", &ControllerSettings::ground_height_halflife, 0.0f, 10.0f},
     {"max_pelvis_drop", &ControllerSettings::max_pelvis_drop, 0.0f, 2.0f},
+    {"max_climb_speed", &ControllerSettings::max_climb_speed, 0.0f, 100.0f},
+    {"min_playback_rate", &ControllerSettings::min_playback_rate, 0.1f, 1.0f},
     {"pelvis_drop_halflife", &ControllerSettings::pelvis_drop_halflife, 0.0f, 10.0f},
     {"max_foot_tilt", &ControllerSettings::max_foot_tilt, 0.0f, 1.5f},
     {"max_dt", &ControllerSettings::max_dt, 1e-4f, 10.0f},

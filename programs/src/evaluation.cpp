@@ -544,7 +544,7 @@ std::string csv_header(const Database& db) {
   }
   h.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
   h.append(",toe_support_l,toe_support_r");
-  h.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop");
+  h.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop,playback_rate");
   return h;
 }
 
@@ -568,10 +568,10 @@ std::string csv_row(const EvaluationFrame& r) {
                 r.toe_ground[1], r.hips_ground, r.wall_depth, r.stuck ? 1 : 0, r.locked[0] ? 1 : 0,
                 r.locked[1] ? 1 : 0);
   row += buffer;
-  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
+  std::snprintf(buffer, sizeof buffer, ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f",
                 std::max(r.toe_ground[0], r.toe_support[0]),
                 std::max(r.toe_ground[1], r.toe_support[1]), r.body_ground, r.placed_toe_ground[0],
-                r.placed_toe_ground[1], r.pelvis_drop);
+                r.placed_toe_ground[1], r.pelvis_drop, r.playback_rate);
   row += buffer;
   return row;
 }
@@ -607,6 +607,7 @@ EvaluationFrame frame_record(const Controller& controller, float t, double updat
   r.searched = d.searched;
   r.search_seconds = d.search_seconds;
   r.body_ground = d.ground_height;
+  r.playback_rate = d.playback_rate;
   r.placed_toe_ground[0] = d.foot_ground[0].toe;
   r.placed_toe_ground[1] = d.foot_ground[1].toe;
   r.pelvis_drop = d.pelvis_drop;

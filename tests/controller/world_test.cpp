@@ -182,7 +182,8 @@ TEST(ControllerWorld, UpARampTheBodyStandsOnTheSurface) {
   c.set_world(&world);
   Controller flat = make_controller();
   float worst = 0.0f;
-  for (int f = 0; f < 8 * 60; ++f) {
+  // 11 s: up a 15 degree ramp the walk slows to climb at max_climb_speed (climb_pace.hpp).
+  for (int f = 0; f < 11 * 60; ++f) {
     c.update(kDt, push_toward(0.0f));
     flat.update(kDt, push_toward(0.0f));
     const glm::vec3 root = c.root_transform().translation;
@@ -208,7 +209,8 @@ TEST(ControllerWorld, UpStairsTheHipsRiseWithoutPopping) {
   Controller c = make_controller();
   c.set_world(&world);
   std::vector<float> heights;
-  for (int f = 0; f < 8 * 60; ++f) {
+  // 16 s: 6 m to the stair, and up it at the climbing pace (climb_pace.hpp).
+  for (int f = 0; f < 16 * 60; ++f) {
     c.update(kDt, push_toward(0.0f));
     heights.push_back(hips_height(c));
   }

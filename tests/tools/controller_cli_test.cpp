@@ -170,7 +170,7 @@ TEST(ControllerCli, EvalIsDeterministicAndTheDumpHasTheDocumentedColumns) {
   }
   header.append(",toe_ground_l,toe_ground_r,hips_ground,wall_depth,stuck,locked_l,locked_r");
   header.append(",toe_support_l,toe_support_r");
-  header.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop");
+  header.append(",body_ground,placed_toe_ground_l,placed_toe_ground_r,pelvis_drop,playback_rate");
   std::istringstream lines(dumps[0]);
   std::string first;
   std::getline(lines, first);

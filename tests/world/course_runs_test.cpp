@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <utility>
@@ -20,6 +21,7 @@ struct CourseRun {
   const char* script;
   glm::dvec2 start;
   float dt;
+  ControllerSettings settings = {};
 };
 
 // The run's metrics (the test fails, and they are empty, when it cannot run).
@@ -37,6 +39,7 @@ EvaluationMetrics run(const CourseRun& r,
   options.world = r.course ? &world : nullptr;
   options.start = r.start;
   options.on_frame = std::move(on_frame);
+  options.settings = r.settings;
   const Result<EvaluationResult> result =
       evaluate_script(test::normal_controller_database(), *script, options);
   EXPECT_TRUE(result.ok()) << result.message();
@@ -126,11 +129,16 @@ TEST(CourseRuns, AlongATurnedWallTheCharacterKeepsSliding) {
 // stood, slow and low, which the geometric skating counts. A held toe now steps only where the
 // animated one is nearer the hip: on the ramps, about as many locks let go during their
 // contacts as on flat ground (7 and 18 more on the tests' database before).
+// The climbing pace is off (max_climb_speed 0): it slows the strafes up and down the ramps and
+// changes where their steps fall, two more releases on the second course (its geometric
+// skating lower all the same; docs/world.md, session 24), and the count is this rule's.
 TEST(CourseRuns, ADownhillFootOutOfReachStaysHeld) {
   constexpr float kDt = 1.0f / 144.0f;
-  const CourseRun flat{nullptr, "strafe.txt", {0.0, 0.0}, kDt};
-  const CourseRun ramps[] = {{"data/levels/course2.glb", "strafe.txt", {3.4, 2.0}, kDt},
-                             {"data/levels/course.glb", "strafe.txt", {7.0, 3.0}, kDt}};
+  ControllerSettings unpaced;
+  unpaced.max_climb_speed = 0.0f;
+  const CourseRun flat{nullptr, "strafe.txt", {0.0, 0.0}, kDt, unpaced};
+  const CourseRun ramps[] = {{"data/levels/course2.glb", "strafe.txt", {3.4, 2.0}, kDt, unpaced},
+                             {"data/levels/course.glb", "strafe.txt", {7.0, 3.0}, kDt, unpaced}};
   const int on_flat = labelled_releases(flat);
   EXPECT_GT(on_flat, 10);  // the count sees releases at all
   for (const CourseRun& r : ramps) EXPECT_LE(labelled_releases(r), on_flat + 5) << r.course;
@@ -250,6 +258,69 @@ TEST(CourseRuns, AToeOutOverALedgesEdgeComesBackWithoutAJump) {
   const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
   const CourseRun r{"data/levels/course.glb", "stop-and-go.txt", {10.0, 3.0}, 1.0f / 60.0f};
   EXPECT_LT(largest_acceleration(r, roles.left_toe, 14.8f, 15.3f), 150.0f);
+}
+
+// Walking up the second course's stairs_20_25 (20 cm risers, 25 cm treads, a landing 0.8 m up)
+// from standing at its foot, for `seconds`: the steepest the predicted trajectory ever rose
+// ahead of the simulation object (m), the lowest playback rate, the time the simulation object
+// took to climb from 5 cm to 75 cm, and the rate after standing still on the landing a while.
+struct StairClimb {
+  float trajectory_rise = 0.0f;
+  float lowest_rate = 1.0f;
+  float climb_s = 0.0f;
+  float rate_standing = 0.0f;
+};
+
+StairClimb climb_stairs(const ControllerSettings& settings) {
+  constexpr float kDt = 1.0f / 60.0f;
+  const BulletWorld world =
+      test::course_world(std::filesystem::path(MM_SOURCE_DIR) / "data/levels/course2.glb");
+  Controller c = test::make_controller(settings);
+  c.set_world(&world);
+  c.teleport_world(glm::dvec3(11.5, 0.0, 2.0), 0.0f);
+  StairClimb out;
+  float started = -1.0f, t = 0.0f;
+  for (int f = 0; f < static_cast<int>(4.0f / kDt); ++f, t += kDt) {
+    c.update(kDt, test::push_toward(0.0f));
+    const ControllerDebug& d = c.debug();
+    const float y = d.simulation_position.y;
+    if (d.trajectory_count > 0) {
+      out.trajectory_rise =
+          std::max(out.trajectory_rise,
+                   d.predicted_positions[static_cast<size_t>(d.trajectory_count - 1)].y - y);
+    }
+    out.lowest_rate = std::min(out.lowest_rate, d.playback_rate);
+    if (started < 0.0f && y > 0.05f) started = t;
+    if (started >= 0.0f && out.climb_s == 0.0f && y > 0.75f) out.climb_s = t - started;
+  }
+  for (int f = 0; f < static_cast<int>(2.0f / kDt); ++f) c.update(kDt, ControllerInput{});
+  out.rate_standing = c.debug().playback_rate;
+  return out;
+}
+
+// A sample's move through the world climbs one step at most (the capsule is swept lifted by
+// step_height), so up a stair the predicted trajectory stopped at the second riser, a tread or
+// two ahead: the search matched a stop on every stair. Each move now goes on from the step that
+// stopped it (Controller::climb_trajectory). And a stair climbed in the data's flat strides took
+// three risers a step, the swinging foot lifted half a metre in a third of a second: up steep
+// ground the clip plays slower and the character walks slower by the same rate
+// (climb_pace.hpp), no slower than min_playback_rate.
+TEST(CourseRuns, UpAStairTheTrajectoryClimbsAndThePaceSlows) {
+  const ControllerSettings defaults;
+  const StairClimb paced = climb_stairs(defaults);
+  // Past the second riser: more than a step above the simulation object.
+  EXPECT_GT(paced.trajectory_rise, defaults.step_height);
+  EXPECT_NEAR(paced.lowest_rate, defaults.min_playback_rate, 0.05f);
+  EXPECT_GT(paced.climb_s, 0.0f);  // the flight climbed
+  EXPECT_GT(paced.rate_standing, 0.99f);
+
+  ControllerSettings unpaced = defaults;
+  unpaced.max_climb_speed = 0.0f;  // no limit
+  const StairClimb fast = climb_stairs(unpaced);
+  EXPECT_EQ(fast.lowest_rate, 1.0f);
+  EXPECT_GT(fast.trajectory_rise, defaults.step_height);
+  ASSERT_GT(fast.climb_s, 0.0f);
+  EXPECT_GT(paced.climb_s, 1.5f * fast.climb_s);
 }
 
 }  // namespace

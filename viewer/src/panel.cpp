@@ -29,7 +29,7 @@ void playback(const Scene& scene) {
   if (d.clip < 0 || d.clip >= static_cast<int>(db.clips().size())) return;
   const ClipRange& clip = db.clips()[d.clip];
   ImGui::Text("clip %s", clip.name.c_str());
-  ImGui::Text("frame %d (%.2f s into the clip)", d.frame, d.clip_time);
+  ImGui::Text("frame %d (%.2f s into the clip, rate %.2f)", d.frame, d.clip_time, d.playback_rate);
   std::string tags;
   for (size_t t = 0; t < db.tag_names().size(); ++t) {
     if (clip.tags & (uint64_t{1} << t)) tags += (tags.empty() ? "" : ", ") + db.tag_names()[t];

@@ -42,6 +42,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "mm/controller/character_mover.hpp"
+#include "mm/controller/climb_pace.hpp"
 #include "mm/controller/foot_placement.hpp"
 #include "mm/controller/input.hpp"
 #include "mm/controller/local_origin.hpp"
@@ -324,6 +325,11 @@ struct ControllerSettings {
   float max_pelvis_drop = 0.35f;
   float pelvis_drop_halflife = 0.24f;
   float max_foot_tilt = 0.6f;
+  // Up and down steep ground the clip plays slower and the character moves slower by the same
+  // rate (climb_pace.hpp), so that it climbs no faster than max_climb_speed (m/s, vertical;
+  // 0: no limit), at a rate no lower than min_playback_rate.
+  float max_climb_speed = 0.25f;
+  float min_playback_rate = 0.4f;
 
   // ---- Robustness. A dt larger than this is clamped to it (s).
   float max_dt = 0.1f;
@@ -395,6 +401,7 @@ struct ControllerDebug {
 
   // The world (none: all zero).
   float ground_height = 0.0f;          // the ground under the root the body stands on (m)
+  float playback_rate = 1.0f;          // the clip's rate on steep ground (climb_pace.hpp)
   bool simulation_blocked = false;     // the simulation object's move met an obstacle
   glm::vec3 simulation_contact{0.0f};  // that obstacle's horizontal normal
   int64_t world_rejected = 0;          // the world's answers ignored (world.hpp), since create()
@@ -557,11 +564,15 @@ class Controller {
   glm::vec3 toe_push(int side) const;
   glm::vec3 without_slide_back(const glm::vec3& step, float dt) const;
   void place_feet(float dt);
+  void climb_trajectory(std::span<const glm::vec3> goals,
+                        std::span<glm::vec3, CharacterMover::kMaxMoves> starts,
+                        std::span<MoveResult, CharacterMover::kMaxMoves> moved);
   void face_along_obstacle();
   bool held_by_obstacle() const;
   void track_held_by_obstacle(float dt);
   bool standing_at_obstacle() const;
   void desired_motion(const ControllerInput& input);
+  void pace_to_ground(float dt);
   void simulate(float dt);
   void stand_turn(float dt);
   void limit_turn_rate(const glm::quat& before, float dt);
@@ -855,6 +866,8 @@ class Controller {
   CharacterMover mover_;
   float ground_height_ = 0.0f;
   float ground_velocity_ = 0.0f;
+  // The rate the clip plays at, and the desired velocity is scaled by, on steep ground.
+  ClimbPace climb_pace_;
   glm::vec3 last_root_{0.0f};
   // The walls and ledges' edges the root's own moves met lately (collide_root_motion).
   HeldContacts root_contacts_;

@@ -67,6 +67,10 @@ struct FootPlacementSettings {
   float max_foot_tilt = 0.6f;          // radians, pitch of the heel-to-toe line
   float step_height = 0.35f;           // m: ground higher than this above the body's is a wall
   float max_step_down = 0.5f;          // m: ground lower than this below the body's is a ledge
+  // The climbing pace (climb_pace.hpp), in (0, 1]: the clip plays at this rate, and the feet's
+  // grounds follow as much slower (accelerations times its square, halflives and look-aheads
+  // over it), so that the legs lift and lower over the time they swing in.
+  float pace = 1.0f;
 };
 
 // One foot's ground (heights in the controller's frame, m).

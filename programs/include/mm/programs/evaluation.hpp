@@ -247,6 +247,7 @@ struct EvaluationFrame {
   float body_ground = 0.0f;
   float placed_toe_ground[2] = {0.0f, 0.0f};
   float pelvis_drop = 0.0f;
+  float playback_rate = 1.0f;  // climb_pace.hpp
 };
 
 // One joint's acceleration among those transition_accel_p99 is taken over: which joint, when
