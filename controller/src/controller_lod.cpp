@@ -16,6 +16,9 @@ void Controller::update_move_only(float dt, const ControllerInput& input) {
   debug_.searched = debug_.transitioned = false;
   debug_.search_seconds = 0.0f;
   desired_motion(input);
+  // Moved only, the character keeps the pace of its last full update's ground: the same speed
+  // up a stair at every level of detail.
+  if (world_) pace_to_ground(dt);
   const glm::vec3 before = sim_position_;
   const float yaw_before = quat_yaw(sim_rotation_);
   simulate(dt);

@@ -145,11 +145,11 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
 
 // A sample's move climbs one step at most: the capsule is swept lifted by step_height, and up a
 // stair the second riser stands higher than that above where the move started, a wall. The
-// trajectory stopped a tread or two ahead (and, down a stair, at the first drop deeper than a
-// step), the search matched a stop, and the character climbed stairs in a string of starts and
-// stops. A sample stopped on other ground than it started from moves on from there toward its
-// goal, as the simulation object itself would over the next updates: a wall stops it at once,
-// a stair only after the flight.
+// trajectory stopped a tread or two ahead, the search matched a stop on every tread, and the
+// climbing pace (climb_pace.hpp) read no stair ahead. A sample stopped on a tread higher or
+// lower than it started from moves on from there toward its goal, as the simulation object
+// itself would over the next updates: a wall (no height gained), a ledge's edge and a ramp's own
+// slope still stop it at once, a stair only after the flight.
 void Controller::climb_trajectory(std::span<const glm::vec3> goals,
                                   std::span<glm::vec3, CharacterMover::kMaxMoves> starts,
                                   std::span<MoveResult, CharacterMover::kMaxMoves> moved) {
@@ -220,8 +220,8 @@ void Controller::lift_to_ground(float dt) {
     // lag up a ramp is made up ahead of time.
     if (debug_.trajectory_count > 0) ground = 0.5f * (ground + debug_.predicted_positions[0].y);
   }
-  critical_spring_update(ground_height_, ground_velocity_, ground,
-                         settings_.ground_height_halflife / climb_pace_.rate(), dt);
+  critical_spring_update(ground_height_, ground_velocity_, ground, settings_.ground_height_halflife,
+                         dt);
   locals_[0].translation.y += ground_height_;
   debug_.ground_height = ground_height_;
 }

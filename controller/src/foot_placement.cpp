@@ -140,7 +140,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.
-  const float halflife = 0.5f * settings.pelvis_drop_halflife / pace;
+  const float halflife = 0.5f * settings.pelvis_drop_halflife;
   const float drop_before = pelvis_drop_;
   critical_spring_update(drop_goal_, drop_goal_velocity_, drop_goal(settings, legs, body_ground),
                          halflife, dt);

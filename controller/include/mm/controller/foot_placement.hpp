@@ -68,8 +68,10 @@ struct FootPlacementSettings {
   float step_height = 0.35f;           // m: ground higher than this above the body's is a wall
   float max_step_down = 0.5f;          // m: ground lower than this below the body's is a ledge
   // The climbing pace (climb_pace.hpp), in (0, 1]: the clip plays at this rate, and the feet's
-  // grounds follow as much slower (accelerations times its square, halflives and look-aheads
-  // over it), so that the legs lift and lower over the time they swing in.
+  // grounds follow as much slower (a rise's acceleration times its square, a fall's halflife
+  // over it), so that the legs lift and lower over the time they swing in; the probes look as
+  // far ahead as the unslowed body would go. The pelvis drop's springs keep their time: slowed,
+  // the planted toes up a stair floated 2 cm higher (docs/world.md, session 24).
   float pace = 1.0f;
 };
 
