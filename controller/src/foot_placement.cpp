@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mm/controller/climb_pace.hpp"
 #include "mm/runtime/approach.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
@@ -112,7 +113,8 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
                            CharacterMover& mover, const FootPlacementSettings& settings,
                            std::span<const PlacementLeg, 2> legs, float body_ground,
                            const glm::vec3& body_velocity, float dt) {
-  const float pace = std::isfinite(settings.pace) ? std::clamp(settings.pace, 0.1f, 1.0f) : 1.0f;
+  const float pace =
+      std::isfinite(settings.pace) ? std::clamp(settings.pace, ClimbPace::kMinRate, 1.0f) : 1.0f;
   follow_toes(legs, dt);
   probe(world, origin, mover, settings, legs, body_ground, body_velocity / pace);
   for (int side = 0; side < 2; ++side) {
