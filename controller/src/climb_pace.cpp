@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mm/runtime/spring.hpp"
+
 namespace mm {
 
 float grade_ahead(const glm::vec3& from, std::span<const glm::vec3> trajectory) {
@@ -28,7 +30,7 @@ void ClimbPace::update(float grade, float speed, float max_climb_speed, float mi
   if (!(dt > 0.0f) || !std::isfinite(dt)) return;
   if (!std::isfinite(grade) || !std::isfinite(speed) || grade < 0.0f || speed < 0.0f) return;
   const float target = goal(grade, speed, max_climb_speed, min_rate);
-  rate_ += (target - rate_) * (1.0f - std::exp2(-dt / kHalflife));
+  rate_ += (target - rate_) * pull_fraction(kHalflife, dt);
 }
 
 }  // namespace mm

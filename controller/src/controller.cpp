@@ -225,11 +225,6 @@ PoseMotion body_part(const std::vector<Transform>& pose, const std::vector<glm::
           std::span(angular_velocities).subspan(1)};
 }
 
-// Fraction of the remaining distance an exponential pull with this halflife closes in dt.
-float pull_fraction(float halflife, float dt) {
-  return 1.0f - std::exp2(-dt / std::max(halflife, kMinSpringHalflife));
-}
-
 }  // namespace
 
 float Controller::PullFractionCache::of(float halflife, float dt) {

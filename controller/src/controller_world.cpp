@@ -52,10 +52,10 @@ constexpr float kToeWallPushHalflife = 0.08f;
 constexpr float kLedgePushAcceleration = 60.0f;
 // A trajectory sample's move goes on from where a step stopped it at most this many times (a
 // second's walk up a stair of 25 cm treads crosses five risers; two or three per move), and
-// only where it ended this much higher or lower than it started (m): a wall leaves it where
-// it was.
+// only where it ended at least this much higher or lower than it started and has at least this
+// far still to go (m): a wall leaves it where it was.
 constexpr int kTrajectoryClimbs = 4;
-constexpr float kClimbedHeight = 0.01f;
+constexpr float kClimbMinimum = 0.01f;
 // Only a move stopped on level ground (a tread; the up vector's share of its normal at least
 // this) goes on: one stopped on a ramp met its own slope, not a step.
 constexpr float kTreadNormalY = 0.99f;
@@ -162,8 +162,8 @@ void Controller::climb_trajectory(std::span<const glm::vec3> goals,
       const MoveResult& m = moved[i];
       const glm::vec3 left(goals[i].x - m.position.x, 0.0f, goals[i].z - m.position.z);
       if (!m.blocked || m.edge || m.no_ground || m.ground_normal.y < kTreadNormalY ||
-          std::abs(m.position.y - starts[i].y) < kClimbedHeight ||
-          glm::length(left) < kClimbedHeight) {
+          std::abs(m.position.y - starts[i].y) < kClimbMinimum ||
+          glm::length(left) < kClimbMinimum) {
         continue;
       }
       from[count] = m.position;

@@ -32,7 +32,9 @@
 //   with a non-finite goal or halflife give the current state at every time.
 // Nothing here allocates.
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -68,6 +70,12 @@ float damping_to_halflife(float damping);
 
 // The stiffness k = w*w of x'' = -c*x' - k*(x - goal) for this halflife (critical damping).
 float halflife_to_stiffness(float halflife);
+
+// The share of the remaining distance an exponential pull (no velocity of its own: a damper)
+// with this halflife closes in dt seconds: half in one halflife.
+inline float pull_fraction(float halflife, float dt) {
+  return 1.0f - std::exp2(-dt / std::max(halflife, kMinSpringHalflife));
+}
 
 // Advances a scalar spring (position x, velocity v) toward goal by dt seconds, exactly.
 void critical_spring_update(float& x, float& v, float goal, float halflife, float dt);
