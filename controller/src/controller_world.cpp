@@ -77,7 +77,7 @@ void Controller::set_world(const WorldQueries* world) {
   obstacle_edge_ = false;
   held_time_ = 0.0f;
   root_contacts_.clear();
-  wall_push_ = wall_push_velocity_ = 0.0f;
+  wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
   // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
   body_shift_ = glm::vec3(0.0f);
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
@@ -356,48 +356,60 @@ void Controller::settle_on_ground() {
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
   std::fill(std::begin(riser_walls_), std::end(riser_walls_), WallHit{});
   std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
-  wall_push_ = wall_push_velocity_ = 0.0f;
+  wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
 }
 
 // The body kept out of walls: the capsule keeps the root a radius away, but an arm swinging
-// forward or an idle hand reaches past it. Everything above the root is moved back by as far as
-// the deepest joint higher than a step is past the wall the simulation object stands against,
-// or a hand, elbow or the head past the wall found toward it (find_walls), at once (a hand must
-// not go in), at most kMaxWallPush, and eases back on a spring once nothing is. The feet stay
-// where the animation has them: the foot lock takes the shift (body_shift_) off their targets,
-// so the body leans over them rather than sliding them.
+// forward or an idle hand reaches past it. Everything above the root is moved back from each wall
+// by as far as its deepest joint is past it: the wall the simulation object stands against (the
+// joints higher than a step), and the wall found toward a hand, elbow or the head (find_walls).
+// The push is one horizontal offset that covers every wall's depth at once (a hand must not go
+// in), at most kMaxWallPush long, and eases back on a spring once nothing is in. One offset, not a
+// depth along the deepest wall's normal: in a corner the deepest wall changes from one update to
+// the next, and a push that turned with it threw the whole body sideways. The feet stay where
+// the animation has them: the foot lock takes the shift (body_shift_) off their targets, so the
+// body leans over them rather than sliding them.
 void Controller::keep_body_off_walls(float dt) {
-  float depth = 0.0f;
-  glm::vec3 wall, n;
-  if (wall_beside(wall, n)) {
-    wall_push_normal_ = n;
+  struct Depth {
+    glm::vec3 normal;
+    float depth;
+  };
+  std::array<Depth, 1 + kReachingJoints> walls;
+  size_t count = 0;
+  glm::vec3 point, n;
+  if (wall_beside(point, n)) {
     const float above = ground_height_ + settings_.step_height;
+    float depth = 0.0f;
     for (size_t j = 1; j < globals_.size(); ++j) {
       const glm::vec3& p = globals_[j].translation;
-      if (p.y > above) depth = std::max(depth, glm::dot(wall - p, n));
+      if (p.y > above) depth = std::max(depth, glm::dot(point - p, n));
     }
+    walls[count++] = {n, depth};
   }
-  // Walls the arms or the head reach (find_walls), met at any angle, moving or not.
   for (const WallHit& hit : body_walls_) {
     if (!hit.found) continue;
-    const float past =
-        glm::dot(hit.point - globals_[static_cast<size_t>(hit.joint)].translation, hit.normal);
-    if (past > depth) {
-      depth = past;
-      wall_push_normal_ = hit.normal;
+    const glm::vec3& p = globals_[static_cast<size_t>(hit.joint)].translation;
+    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal)};
+  }
+  critical_spring_update(wall_push_, wall_push_velocity_, glm::vec3(0.0f), kWallPushHalflife, dt);
+  // Twice over: where two walls meet at less than a right angle, the push out of one takes some of
+  // the push out of the other back.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t k = 0; k < count; ++k) {
+      const glm::vec3& normal = walls[k].normal;
+      const float short_by = std::min(walls[k].depth, kMaxWallPush) - glm::dot(wall_push_, normal);
+      if (short_by <= 0.0f) continue;
+      wall_push_ += normal * short_by;
+      wall_push_velocity_ -= normal * glm::dot(wall_push_velocity_, normal);
     }
   }
-  critical_spring_update(wall_push_, wall_push_velocity_, 0.0f, kWallPushHalflife, dt);
-  depth = std::min(depth, kMaxWallPush);
-  if (depth > wall_push_) {
-    wall_push_ = depth;
-    wall_push_velocity_ = 0.0f;
-  }
-  if (wall_push_ < 1e-5f) {
-    wall_push_ = wall_push_velocity_ = 0.0f;
+  const float length = glm::length(wall_push_);
+  if (length > kMaxWallPush) wall_push_ *= kMaxWallPush / length;
+  if (length < 1e-5f) {
+    wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
     body_shift_ = glm::vec3(0.0f);
   } else {
-    body_shift_ = wall_push_normal_ * wall_push_;
+    body_shift_ = wall_push_;
     for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
   }
   keep_arms_off_walls();

@@ -886,10 +886,9 @@ class Controller {
   float held_time_ = 0.0f;      // how long the simulation has been held at it (s)
   // The velocity the stick asks for (desired_velocity_ before standing at an obstacle).
   glm::vec3 stick_velocity_{0.0f};
-  // How far (m) the body above the root is moved back from that wall, its rate, and along what.
-  float wall_push_ = 0.0f;
-  float wall_push_velocity_ = 0.0f;
-  glm::vec3 wall_push_normal_{0.0f};
+  // How far (m) the body above the root is moved back from walls (horizontal), and its rate.
+  glm::vec3 wall_push_{0.0f};
+  glm::vec3 wall_push_velocity_{0.0f};
   // A wall found between the body and each toe, and each hand, elbow and the head, this update
   // (find_walls): a point on its face and its horizontal normal.
   struct WallHit {
