@@ -15,17 +15,18 @@ namespace mm {
 
 namespace {
 
-// A foot's ground follows its goal at once where the goal moves little in an update (along a
-// slope, over bumps: anything slower would lag behind a slope and land the foot above or in
-// it); across a step (a tread's edge: the foot would pop) down on a spring, up with an
-// acceleration of kStepAcceleration, arriving at rest. A spring answers a step with its largest
-// acceleration at once (a 20 cm riser at a 0.03 s halflife: over 600 m/s^2, where the data's
-// locomotion p99 is about 60), and the foot's joints carry it. A toe that meets the step sooner
-// than that rise takes waits at its riser (the controller keeps it out, as a wall), and one
-// already over the step is kept above it (stay_above). The goal's change is measured as a speed, so
-// that the same ground is followed the same way at every update rate (6 cm an update at 1/30 s; the
-// same 6 cm at 1/144 s is a step).
+// A foot's ground follows its goal at once where the goal moves little in an update and the
+// ground is at rest (along a slope, over bumps: anything slower would lag behind a slope and land
+// the foot above or in it; a follow at once leaves it at rest); across a step (a tread's edge: the
+// foot would pop) down on a spring, up with an acceleration of kStepAcceleration, arriving at rest.
+// A spring answers a step with its largest acceleration at once (a 20 cm riser at a 0.03 s
+// halflife: over 600 m/s^2, where the data's locomotion p99 is about 60), and the foot's joints
+// carry it. A toe that meets the step sooner than that rise takes waits at its riser (the
+// controller keeps it out, as a wall), and one already over the step is kept above it (stay_above).
+// The goal's change is measured as a speed, so that the same ground is followed the same way at
+// every update rate (6 cm an update at 1/30 s; the same 6 cm at 1/144 s is a step).
 constexpr float kStepChangeSpeed = 1.8f;           // m/s: a step, not a slope
+constexpr float kAtRestSpeed = 0.05f;              // m/s: slower, a ground is at rest
 constexpr float kStepAcceleration = 40.0f;         // m/s^2
 constexpr float kPlantedHeelAcceleration = 20.0f;  // m/s^2: a planted foot's heel
 constexpr float kFallHalflife = 0.06f;             // s
@@ -70,10 +71,12 @@ void follow_ground(float& height, float& velocity, float goal, float acceleratio
   if (!(dt > 0.0f) || !std::isfinite(goal)) return;
   const float step_change = kStepChangeSpeed * dt;
   // A rise under way lands on its own (approach): followed at once within an update's reach of
-  // its goal, a climb was cut short, the rest in one update.
+  // its goal, a climb was cut short, the rest in one update. So does any move under way: a fall
+  // on its spring, or a rise whose goal went back down (a bump a probe ahead found, passed), cut
+  // short, jumped the rest and stopped dead in an update (a toe over the rough patch, 2.7 cm in
+  // 1/60 s).
   const bool rising = goal > height && velocity > 0.0f;
-  if (!rising && std::abs(goal - height) <= step_change &&
-      std::abs(velocity) <= kStepAcceleration * pace * pace * dt) {
+  if (!rising && std::abs(goal - height) <= step_change && std::abs(velocity) <= kAtRestSpeed) {
     height = goal;
     velocity = 0.0f;
     return;
@@ -178,6 +181,7 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
     probe_grounds_[i] =
         glm::vec3(probe_points_[i].x, found(i, body_ground, settings), probe_points_[i].z);
   }
+  rest_heels_on_edges(legs);
   stand_on_edges(body_ground, settings);
   keep_steps_ahead();
   sweep_toes(world, origin, mover, legs, body_ground);
@@ -271,8 +275,11 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
 glm::vec3 FootPlacement::own_lookahead(int side, const PlacementLeg& leg) const {
   const glm::vec3 ahead = feet_[side].toe_velocity * kToeLookahead;
   const glm::vec3 back(-leg.shift.x, 0.0f, -leg.shift.z);
-  // Held at a riser, over the step: sliding along its face, the toe's own way looked beside it.
-  if (leg.held_at_step) return back;
+  // Held at a riser, over the step and on by the toe's way: sliding along its face, the toe's own
+  // way alone looked beside it; the update it is first held, the animated toe only just reached
+  // the face, and its way back alone was millimetres short of the step (the ground found over a
+  // kerb and lost again every other update, the swinging leg lifting and dropping).
+  if (leg.held_at_step) return back + ahead;
   return glm::dot(back, back) > glm::dot(ahead, ahead) ? back : ahead;
 }
 
@@ -318,6 +325,32 @@ void FootPlacement::stand_on_edges(float body_ground, const FootPlacementSetting
   }
 }
 
+// The height at `at` (horizontally) of the plane through the ground probe `which` of a side found,
+// tilted as the surface it hit (level where it hit nothing).
+float FootPlacement::plane_height(int side, int which, const glm::vec3& at) const {
+  const glm::vec3& here = probe_grounds_[slot(side, which)];
+  const GroundHit& hit = hits_[slot(side, which)];
+  const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+  return here.y - (n.x * (at.x - here.x) + n.z * (at.z - here.z)) / std::max(n.y, 0.1f);
+}
+
+// A planted foot whose toe stands on a tread and whose heel is out over the edge behind it rests
+// on the edge, level with the toe's surface, as a foot does with its heel off a stair: the heel's
+// ground is the plane under the toe, where the ground found under the heel drops below it (an
+// edge, not a slope). The toe joint itself over the tread (before stand_on_edges): a toe only
+// its footprint holds on an edge has the whole foot out over the drop, and held level the foot
+// stood on air. Pitched down into the drop instead, the foot rocked as the ankle crossed
+// the edge by millimetres (turning on the spot at the top of stairs_12_35, the heel's ground fell
+// 4 cm and came back the next update).
+void FootPlacement::rest_heels_on_edges(std::span<const PlacementLeg, 2> legs) {
+  for (int side = 0; side < 2; ++side) {
+    if (!legs[side].planted) continue;
+    glm::vec3& heel = probe_grounds_[slot(side, kHeel)];
+    const float plane = plane_height(side, kToe, heel);
+    if (heel.y < plane - kStepRise) heel.y = plane;
+  }
+}
+
 // Ahead counts only where the ground steps up: up a slope it is only the slope, which the foot
 // will meet as it gets there (counted now, a landing foot would lock in the air).
 void FootPlacement::keep_steps_ahead() {
@@ -325,12 +358,9 @@ void FootPlacement::keep_steps_ahead() {
     for (const int later : {kHeelAhead, kToeAhead, kHeelOwn, kToeOwn}) {
       const int now = now_of(later);
       glm::vec3& ahead_ground = probe_grounds_[slot(side, later)];
-      const glm::vec3& here = probe_grounds_[slot(side, now)];
-      const GroundHit& hit = hits_[slot(side, now)];
-      const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
-      const glm::vec3 d = ahead_ground - here;
-      const float along_plane = here.y - (n.x * d.x + n.z * d.z) / std::max(n.y, 0.1f);
-      if (ahead_ground.y < along_plane + kStepRise) ahead_ground.y = here.y;
+      if (ahead_ground.y < plane_height(side, now, ahead_ground) + kStepRise) {
+        ahead_ground.y = probe_grounds_[slot(side, now)].y;
+      }
     }
   }
 }

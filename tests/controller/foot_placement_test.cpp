@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include "analytic_world.hpp"
 #include "controller_support.hpp"
@@ -165,21 +166,50 @@ TEST(FootPlacement, AFootPitchedSteeplyToeDownIsNotTilted) {
   }
 }
 
+// A foot with its toe on a step and its heel out over the step's edge. Planted, it rests on the
+// edge level, as a foot stands with its heel off a stair: pitched down into the drop, turning on
+// the spot at the top of a stair rocked it as the ankle crossed the edge by millimetres (the
+// heel's ground 4 cm down and back in an update). In the air (a step onto the tread, the heel not
+// yet over it), the heel hangs toward the lower tread, the foot tilted no more than its limit.
 TEST(FootPlacement, AFootOverAStairsEdgeRestsOnTheStepNeverInsideIt) {
   AnalyticWorld world;
   // A 17 cm step whose edge is at z = 0.1: the heel is below it, the toe over it.
   world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 2.1f), glm::vec2(5.0f, 2.0f), 0.0f, 0.17f});
   CharacterMover mover;
   FootPlacement p;
-  const std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f),
-                                         standing_leg(0.1f, 0.0f, 0.0f)};
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.0f), standing_leg(0.1f, 0.0f, 0.0f)};
+  settle(p, world, mover, legs, 0.0f);
+  EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f);
+  EXPECT_NEAR(p.ground(0).heel, 0.17f, 1e-3f);
+
+  legs[0].planted = false;
   settle(p, world, mover, legs, 0.0f);
   const FootPlacementSettings settings;
   const float rise = glm::length(legs[0].toe - legs[0].ankle) * std::tan(settings.max_foot_tilt);
   EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f);
-  // The heel hangs over the lower tread, the foot tilted no more than its limit.
   EXPECT_NEAR(p.ground(0).heel, 0.17f - rise, 2e-3f);
   EXPECT_GT(p.ground(0).heel, 0.0f);
+}
+
+// A planted foot whose toe joint is past a step's edge, held on it only by its footprint
+// (stand_on_edges): the whole foot is out over the drop, and rested level it would stand on air.
+// Its heel hangs toward the lower ground as a foot in the air does.
+TEST(FootPlacement, AFootOutOverAStepsEdgeIsNotRestedOnIt) {
+  AnalyticWorld world;
+  // A 17 cm step ending at z = 0.16; the body stands on it.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, -0.84f), glm::vec2(5.0f, 1.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(-0.1f, 0.0f, 0.17f),
+                                   standing_leg(0.1f, 0.0f, 0.17f)};
+  for (PlacementLeg& leg : legs) {
+    // Facing back toward the step: the toe 1 cm past its edge, the ankle 15 cm farther out.
+    leg.toe.z = 0.17f;
+    leg.ankle.z = 0.32f;
+  }
+  settle(p, world, mover, legs, 0.17f);
+  EXPECT_NEAR(p.ground(0).toe, 0.17f, 1e-3f);  // on the edge by its footprint
+  EXPECT_LT(p.ground(0).heel, 0.12f);          // hanging toward the floor, not level
 }
 
 TEST(FootPlacement, AToeAtATreadsEdgeStandsOnTheTreadNotBelowItsEdge) {
@@ -228,6 +258,61 @@ TEST(FootPlacement, ARiseUnderTheHeelIsFollowedOnItsSpringAtEveryRate) {
       }
     }
   }
+}
+
+// A ground already moving is not followed at once, even where its goal comes within an update's
+// reach: a fall on its spring was cut short there, the rest jumped and the fall stopped dead in
+// one update (a toe's ground over the second course's rough patch, 2.7 cm: the foot 154 m/s^2 at
+// 1/60 s). The heel of a foot in the air, its block taken away from under it: the fall's largest
+// acceleration is the spring's first update's (about 21 m/s^2; cut short at 3 cm, about 80).
+TEST(FootPlacement, AFallUnderWayIsNotCutShortWithinAnUpdatesReach) {
+  constexpr float kStep = 1.0f / 60.0f;
+  AnalyticWorld world;
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f), glm::vec2(1.0f), 0.0f, 0.1f});
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs = left_swinging(0.0f);
+  settle(p, world, mover, legs, 0.0f);
+  ASSERT_NEAR(p.ground(0).heel, 0.1f, 1e-4f);
+  world.boxes.clear();
+  std::vector<float> heights = {p.ground(0).heel, p.ground(0).heel};
+  for (int f = 0; f < 60; ++f) {
+    p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+             kStep);
+    heights.push_back(p.ground(0).heel);
+  }
+  EXPECT_NEAR(heights.back(), 0.0f, 1e-3f);
+  float largest = 0.0f;
+  for (size_t i = 2; i < heights.size(); ++i) {
+    const float a = (heights[i] - 2.0f * heights[i - 1] + heights[i - 2]) / (kStep * kStep);
+    largest = std::max(largest, std::abs(a));
+  }
+  EXPECT_LT(largest, 50.0f);
+}
+
+// A swinging toe the controller first holds at a riser (held_at_step) is only millimetres from
+// where the animation has it: looking only back to the animated toe, its probe stayed in front
+// of the riser and found the floor, the step its own way had found the update before lost again
+// (the ground over a kerb found and lost every other update, the leg lifting and dropping). Its
+// own way is looked along too.
+TEST(FootPlacement, AToeFirstHeldAtARiserKeepsSeeingTheStep) {
+  AnalyticWorld world;
+  add_riser(world, 0.2f, 0.15f);
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs = left_swinging(0.0f);
+  p.reset(0.0f);
+  legs[0].toe.z = 0.15f;
+  p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+           kDt);
+  // 2 cm on, toward the riser (1.2 m/s), held 3 cm before it, 3 mm behind the animated toe.
+  legs[0].toe.z = 0.17f;
+  legs[0].held_at_step = true;
+  legs[0].shift = glm::vec3(0.0f, 0.0f, -0.003f);
+  p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f, glm::vec3(0.0f),
+           kDt);
+  EXPECT_GT(p.ground(0).toe, 0.0f);  // on its way up
+  EXPECT_EQ(p.ground(1).toe, 0.0f);  // the standing foot stays on the floor
 }
 
 // A foot just released with an offset from the animated toe has a toe still at rest, and its

@@ -154,7 +154,9 @@ class FootPlacement {
   float below_foot(int side, float body_ground) const;
   float found(int i, float body_ground, const FootPlacementSettings& settings) const;
   void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
+  void rest_heels_on_edges(std::span<const PlacementLeg, 2> legs);
   void keep_steps_ahead();
+  float plane_height(int side, int which, const glm::vec3& at) const;
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
   void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
