@@ -196,12 +196,12 @@ float largest_acceleration(const CourseRun& r, int joint, float t0, float t1) {
   return largest;
 }
 
-// Running diagonally into the second course's outer corner: the body was kept off the walls by
-// a push along the deepest wall's normal, and in the corner the deepest wall changed from one
-// update to the next (the wall the simulation object stands against, the other one a hand
-// reaches): the whole body was thrown 4 to 6 cm sideways and back (every joint over 240 m/s^2;
-// random-long from x = 0.8 at 1/60 s on the tests' database, 86.15 s). The push is one offset
-// now, out of every wall at once.
+// Running diagonally into the corner of the second course's floor (two ledge edges): the body was
+// kept off the obstacle the simulation object stands against by a push along its normal, and in
+// the corner that obstacle was one edge, then the other, from one update to the next: the whole
+// body was thrown 4 to 6 cm sideways and back (every joint over 240 m/s^2; random-long from
+// x = 0.8 at 1/60 s on the tests' database, 86.15 s). The push is one offset now, out of every
+// wall and edge at once.
 TEST(CourseRuns, IntoACornerTheBodyIsKeptOffBothWallsWithoutAJump) {
   const int hips = test::normal_controller_database()->database().roles().hips;
   constexpr const char* kIntoTheCorner =
