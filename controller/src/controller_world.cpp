@@ -368,9 +368,9 @@ void Controller::settle_on_ground() {
 // depth along the deepest wall's normal: in a corner the wall the simulation object stands
 // against is one side, then the other, from one update to the next, and a push that turned with
 // it threw the whole body sideways and back (the ledge's edges at the second course's floor
-// corner: the hips 482 m/s^2). The feet stay where
-// the animation has them: the foot lock takes the shift (body_shift_) off their targets, so the
-// body leans over them rather than sliding them.
+// corner: the hips 482 m/s^2). The feet stay where the animation has them: the foot lock takes
+// the shift (body_shift_) off their targets, so the body leans over them rather than sliding
+// them.
 void Controller::keep_body_off_walls(float dt) {
   struct Depth {
     glm::vec3 normal;

@@ -337,11 +337,11 @@ float FootPlacement::plane_height(int side, int which, const glm::vec3& at) cons
 // A planted foot whose toe stands on a tread and whose heel is out over the edge behind it rests
 // on the edge, level with the toe's surface, as a foot does with its heel off a stair: the heel's
 // ground is the plane under the toe, where the ground found under the heel drops below it (an
-// edge, not a slope). The toe joint itself over the tread (before stand_on_edges): a toe only
-// its footprint holds on an edge has the whole foot out over the drop, and held level the foot
-// stood on air. Pitched down into the drop instead, the foot rocked as the ankle crossed
-// the edge by millimetres (turning on the spot at the top of stairs_12_35, the heel's ground fell
-// 4 cm and came back the next update).
+// edge, not a slope). Pitched down into the drop instead, the foot rocked as the ankle crossed the
+// edge by millimetres (turning on the spot at the top of stairs_12_35, the heel's ground fell 4 cm
+// and came back the next update). Only where the toe joint itself is over the tread (called
+// before stand_on_edges): a toe only its footprint holds on an edge has the whole foot out over
+// the drop, and rested level it stood on air.
 void FootPlacement::rest_heels_on_edges(std::span<const PlacementLeg, 2> legs) {
   for (int side = 0; side < 2; ++side) {
     if (!legs[side].planted) continue;
