@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "mm/database/sampling.hpp"
+#include "mm/runtime/approach.hpp"
 #include "mm/runtime/atan2_polynomial.hpp"
 #include "mm/runtime/constraints.hpp"
 #include "mm/runtime/finite.hpp"
@@ -82,6 +83,12 @@ constexpr float kReleaseHold = 0.5f;
 // (kHalflifeFrequencyFactor / 2 ln 2)^2 = 1.47 times this: about 29 m/s^2 (the formula was
 // written with the other convention of halflife; kept, as the motion was measured with it).
 constexpr float kReleaseMaxAcceleration = 20.0f;
+// The bound on the angular acceleration (rad/s^2) with which a heel takes up the lift a lock
+// needed as it began: taken at once, the ankle swung about the toe in one update.
+constexpr float kHeelLagAcceleration = 200.0f;
+// How much of that lift (radians) is taken at once all the same: eased, the toe slid for the
+// few updates the heel took to rise, and a lock begins a little out of reach at most steps.
+constexpr float kHeelRiseAtOnce = 0.1f;
 // A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
 // follows the animation's own lift rather than stepping with a lift of its own.
 constexpr float kLiftOffSpeed = 0.2f;
@@ -1337,6 +1344,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   if (contact && !f.locked && !f.stepping &&
       (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
     f.locked = true;
+    f.lock_began = true;
     f.position = f.target;
     f.lock_ground = toe_ground(side);
     f.offset = f.offset_velocity = glm::vec3(0.0f);
@@ -1558,8 +1566,12 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   if (leg[3] >= 0 && (f.locked || f.heel_rise > 0.0f)) {
     const float length = glm::length(reached);
     const float needed = heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis);
-    if (f.locked && needed > f.heel_rise) {
-      f.heel_rise = needed;
+    if (f.lock_began) {
+      f.heel_lag = std::max(0.0f, needed - f.heel_rise - kHeelRiseAtOnce);
+      f.heel_lag_velocity = 0.0f;
+    }
+    if (f.locked && needed - f.heel_lag > f.heel_rise) {
+      f.heel_rise = needed - f.heel_lag;
       f.heel_rise_velocity = 0.0f;
     }
     if (f.heel_rise > 0.0f) {
@@ -1568,6 +1580,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
       reached *= std::min(1.0f, length / glm::length(reached));
     }
   }
+  f.lock_began = false;
   ankle_target = hip_position + reached;
   // The knee turns about its hinge in the data (ControllerDatabase::knee_hinge), the chain
   // keeping the animation's twist. Without one it bends toward the pole, where it points now; a
@@ -1648,6 +1661,7 @@ void Controller::restore_leg_lengths(int side) {
 // The heel's lift decays toward none on a spring; reach raises it again as a held toe needs.
 void Controller::ease_heel_down(int side, float dt) {
   FootLock& f = feet_[side];
+  approach(f.heel_lag, f.heel_lag_velocity, 0.0f, kHeelLagAcceleration, dt);
   if (f.heel_rise <= 0.0f) return;
   foot_springs_[side].heel.update(f.heel_rise, f.heel_rise_velocity, 0.0f,
                                   settings_.foot_lock_release_halflife, dt);

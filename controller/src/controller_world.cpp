@@ -9,6 +9,7 @@
 
 #include "mm/controller/arm_off_wall.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/wall_slide.hpp"
 #include "mm/runtime/approach.hpp"
 #include "mm/runtime/finite.hpp"
 #include "mm/runtime/spring.hpp"
@@ -27,12 +28,6 @@ constexpr float kSlideFacingShare = 0.3f;
 // character stands.
 constexpr float kHeldSpeed = 0.1f;
 constexpr float kHeldDelay = 0.3f;
-// The simulation object is still beside the wall it last met while no farther from it than
-// this (m).
-constexpr float kBesideObstacle = 0.05f;
-// The most of the simulation object's slide along a wall (share) its yield toward the character
-// may take back in an update.
-constexpr float kMaxSlideBack = 0.5f;
 // Halflife (s) of the body's return from a wall it was kept out of.
 constexpr float kWallPushHalflife = 0.15f;
 // The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
@@ -443,31 +438,22 @@ void Controller::keep_arms_off_walls() {
 // The wall the simulation object stands against, as a point on its face and its horizontal
 // normal; false when there is none. Only where the wall was met: its plane goes on past its end.
 bool Controller::wall_beside(glm::vec3& point, glm::vec3& normal) const {
-  const glm::vec3 n(obstacle_normal_.x, 0.0f, obstacle_normal_.z);
-  if (!world_ || glm::length(n) < 0.5f ||
-      glm::dot(sim_position_ - obstacle_point_, obstacle_normal_) > kBesideObstacle ||
-      glm::distance(sim_position_, obstacle_point_) > settings_.character_radius) {
+  if (!world_ || !beside_wall(sim_position_, {obstacle_point_, obstacle_normal_},
+                              settings_.character_radius)) {
     return false;
   }
-  normal = glm::normalize(n);
+  normal = glm::normalize(glm::vec3(obstacle_normal_.x, 0.0f, obstacle_normal_.z));
   point = obstacle_point_ - normal * settings_.character_radius;
   return true;
 }
 
-// The simulation object's yield toward the character (synchronize), its part back along the wall
-// the object slides along at most half the slide: the clip played does not slide, and given back
-// to the character whole each update, the object stood still beside the wall where it could
-// have slid.
+// The simulation object's yield toward the character (synchronize) beside the wall it slides
+// along (wall_slide.hpp).
 glm::vec3 Controller::without_slide_back(const glm::vec3& step, float dt) const {
-  glm::vec3 point, normal;
-  if (!wall_beside(point, normal)) return step;
-  const glm::vec3 slide = (sim_velocity_ - normal * glm::dot(sim_velocity_, normal)) * dt;
-  const float slide_length = glm::length(slide);
-  if (slide_length <= 0.0f) return step;
-  const glm::vec3 direction = slide / slide_length;
-  const float back = -glm::dot(step, direction);
-  const float allowed = kMaxSlideBack * slide_length;
-  return back > allowed ? step + direction * (back - allowed) : step;
+  if (!world_) return step;
+  const WallMet wall{obstacle_point_, obstacle_normal_};
+  return mm::without_slide_back(step, sim_velocity_, obstacle_normal_,
+                                beside_weight(sim_position_, wall, settings_.character_radius), dt);
 }
 
 // Walls near the feet and the arms: a small sphere swept from the root's vertical line out to

@@ -216,6 +216,17 @@ TEST(CourseRuns, IntoACornerTheBodyIsKeptOffBothWallsWithoutAJump) {
   }
 }
 
+// Strafing across the first course's 20-degree ramp at 1/144 s: a foot locked (planted by its
+// height and speed) where the softened leg fell short of its toe, and the heel rose at once to
+// the whole lift the held toe needed, 0.43 rad in an update: the ankle swung 4.7 cm about the toe
+// (Foot_L 944 m/s^2 at 18.91 s on the tests' database). Beyond kHeelRiseAtOnce the lift a lock
+// needs as it begins is taken up with a bounded acceleration.
+TEST(CourseRuns, ALockBegunOutOfReachLiftsItsHeelWithoutAJump) {
+  const int foot = test::normal_controller_database()->database().roles().left_foot;
+  const CourseRun r{"data/levels/course.glb", "strafe.txt", {4.0, 3.0}, 1.0f / 144.0f};
+  EXPECT_LT(largest_acceleration(r, foot, 18.8f, 19.0f), 300.0f);
+}
+
 // Running off the second course's ramp_15 onto the floor: each update's foot IK was skipped where
 // the toe's target came within 10 micrometres of the animated toe (its ground offset decaying to
 // the floor's), and with it the softening of the leg the run stretches near straight: the knee

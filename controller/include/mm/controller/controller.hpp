@@ -815,6 +815,11 @@ class Controller {
     float heel_rise = 0.0f;
     float heel_rise_velocity = 0.0f;
     glm::vec3 heel_axis{1.0f, 0.0f, 0.0f};
+    // What of the lift a lock needed as it began is still to come (radians), and its rate: made
+    // up with a bounded acceleration (reach); and whether the lock began this update.
+    float heel_lag = 0.0f;
+    float heel_lag_velocity = 0.0f;
+    bool lock_began = false;
     // The animated toe on its ground last update, its velocity and horizontal speed (m/s)
     // then, and whether it was low and slow.
     glm::vec3 animated{0.0f};
