@@ -930,7 +930,10 @@ void Controller::sample_body_velocities(const PlaybackPoint& at, std::span<glm::
 
 void Controller::simulate(float dt) {
   const glm::vec3 before = sim_position_;
-  spring_character_update(sim_position_, sim_velocity_, sim_acceleration_, desired_velocity_,
+  const glm::vec3 goal = world_ ? braked_velocity(desired_velocity_, sim_position_, obstacle_ahead_,
+                                                  settings_.obstacle_deceleration)
+                                : desired_velocity_;
+  spring_character_update(sim_position_, sim_velocity_, sim_acceleration_, goal,
                           settings_.simulation_velocity_halflife, dt);
   if (stopping_) {
     stand_turn(dt);

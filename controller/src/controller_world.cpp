@@ -69,6 +69,7 @@ void Controller::set_world(const WorldQueries* world) {
   foot_placement_.reset(0.0f);
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   obstacle_normal_ = edge_normal_ = glm::vec3(0.0f);
+  obstacle_ahead_ = ObstacleAhead{};
   obstacle_edge_ = false;
   held_time_ = 0.0f;
   root_contacts_.clear();
@@ -120,6 +121,8 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
   std::array<MoveResult, CharacterMover::kMaxMoves> moved;
   const size_t n = positions.size();
   std::fill_n(starts.begin(), n, sim_position_);
+  std::array<glm::vec3, CharacterMover::kMaxMoves> goals;
+  std::copy_n(positions.begin(), n, goals.begin());
   // Beside a ledge's edge (or stopped at one ahead) the samples lose their part toward it, as the
   // simulation object's steps do and as a wall's sweep slides them: the search then matches the
   // slide along the edge the simulation makes (beyond it, a sample found the ground below the
@@ -134,7 +137,28 @@ void Controller::collide_trajectory(std::span<glm::vec3> positions) {
   mover_.collide(*world_, origin_, character_shape(), std::span(starts).first(n), positions,
                  std::span(moved).first(n));
   climb_trajectory(positions, starts, moved);
-  for (size_t i = 0; i < n; ++i) positions[i] = moved[i].position;
+  // Where the stick's own way is blocked (before a ledge's edge beside the simulation object took
+  // its part toward the edge), and by what: the simulation object slows down toward it
+  // (obstacle_brake.hpp).
+  std::array<glm::vec3, CharacterMover::kMaxMoves> normals;
+  for (size_t i = 0; i < n; ++i) {
+    positions[i] = moved[i].position;
+    // Not a riser a sample is still climbing (ended a step above or below the simulation
+    // object): braked there, the walk up a stair slowed on every tread, on top of the pace.
+    const bool climbing = std::abs(moved[i].position.y - sim_position_.y) >= kClimbMinimum;
+    normals[i] = moved[i].blocked && !climbing ? moved[i].normal : glm::vec3(0.0f);
+    // A move over a ledge's drop is cancelled (the sample stays where it started): the drop is
+    // somewhere along it, the way it blocks the move's own unless the edge was found.
+    if (moved[i].no_ground) {
+      const glm::vec3 back(starts[i].x - goals[i].x, 0.0f, starts[i].z - goals[i].z);
+      const float length = glm::length(back);
+      normals[i] = glm::length(moved[i].edge_normal) > 0.5f ? moved[i].edge_normal
+                   : length > 0.0f                          ? back / length
+                                                            : glm::vec3(0.0f);
+    }
+  }
+  obstacle_ahead_ =
+      obstacle_ahead(std::span(goals).first(n), positions, std::span(normals).first(n));
   debug_.world_rejected = mover_.rejected();
 }
 
@@ -346,6 +370,7 @@ void Controller::settle_on_ground() {
   debug_.ground_height = ground_height_;
   foot_placement_.reset(ground_height_);
   obstacle_normal_ = glm::vec3(0.0f);
+  obstacle_ahead_ = ObstacleAhead{};
   obstacle_edge_ = false;
   held_time_ = 0.0f;
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});

@@ -77,6 +77,7 @@ constexpr FloatField kFloatFields[] = {
     {"max_pelvis_drop", &ControllerSettings::max_pelvis_drop, 0.0f, 2.0f},
     {"max_climb_speed", &ControllerSettings::max_climb_speed, 0.0f, 100.0f},
     {"min_playback_rate", &ControllerSettings::min_playback_rate, 0.1f, 1.0f},
+    {"obstacle_deceleration", &ControllerSettings::obstacle_deceleration, 0.0f, 100.0f},
     {"pelvis_drop_halflife", &ControllerSettings::pelvis_drop_halflife, 0.0f, 10.0f},
     {"max_foot_tilt", &ControllerSettings::max_foot_tilt, 0.0f, 1.5f},
     {"max_dt", &ControllerSettings::max_dt, 1e-4f, 10.0f},

@@ -216,6 +216,40 @@ TEST(CourseRuns, IntoACornerTheBodyIsKeptOffBothWallsWithoutAJump) {
   }
 }
 
+// The largest horizontal acceleration (m/s^2) of the simulation object over a run.
+float largest_simulation_acceleration(const CourseRun& r) {
+  float largest = 0.0f;
+  int frames = 0;
+  glm::dvec2 before[2];
+  run(r, [&](const EvaluationFrame& frame) {
+    const glm::dvec2 at(frame.origin.x + frame.sim_position.x,
+                        frame.origin.z + frame.sim_position.z);
+    if (frames >= 2) {
+      const glm::dvec2 a = (at - 2.0 * before[1] + before[0]) / double(r.dt * r.dt);
+      largest = std::max(largest, static_cast<float>(glm::length(a)));
+    }
+    before[0] = before[1];
+    before[1] = at;
+    ++frames;
+  });
+  return largest;
+}
+
+// Walking up the first course's stairs and on to its landing's far edge (a ledge), the
+// simulation object went on at the stick's speed until the world stopped it, within an update
+// (62 m/s^2 at 1/30 s; the root and the swinging toe with it, 110 m/s^2). Where the predicted
+// trajectory is blocked it slows down (obstacle_brake.hpp): no harder than it stops on the flat
+// plane when the stick is let go.
+TEST(CourseRuns, BeforeALedgesEdgeTheCharacterSlowsDownAsOnTheFlat) {
+  constexpr float kDt = 1.0f / 30.0f;
+  const float on_flat = largest_simulation_acceleration({nullptr, "stop-and-go.txt", {}, kDt});
+  const CourseRun r{"data/levels/course.glb", "stop-and-go.txt", {10.0, 3.0}, kDt};
+  EXPECT_LT(largest_simulation_acceleration(r), 1.2f * on_flat);
+  CourseRun unbraked = r;
+  unbraked.settings.obstacle_deceleration = 0.0f;
+  EXPECT_GT(largest_simulation_acceleration(unbraked), 3.0f * on_flat);
+}
+
 // Strafing across the first course's 20-degree ramp at 1/144 s: a foot locked (planted by its
 // height and speed) where the softened leg fell short of its toe, and the heel rose at once to
 // the whole lift the held toe needed, 0.43 rad in an update: the ankle swung 4.7 cm about the toe

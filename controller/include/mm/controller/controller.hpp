@@ -46,6 +46,7 @@
 #include "mm/controller/foot_placement.hpp"
 #include "mm/controller/input.hpp"
 #include "mm/controller/local_origin.hpp"
+#include "mm/controller/obstacle_brake.hpp"
 #include "mm/controller/world.hpp"
 #include "mm/database/database.hpp"
 #include "mm/runtime/dead_blending.hpp"
@@ -330,6 +331,10 @@ struct ControllerSettings {
   // 0: no limit), at a rate no lower than min_playback_rate.
   float max_climb_speed = 0.25f;
   float min_playback_rate = 0.4f;
+  // Toward a wall or a ledge's edge the predicted trajectory stops at, the simulation object
+  // slows down at no more than this deceleration (m/s^2) to arrive at rest (obstacle_brake.hpp;
+  // 0: it walks on until the world stops it).
+  float obstacle_deceleration = 3.0f;
 
   // ---- Robustness. A dt larger than this is clamped to it (s).
   float max_dt = 0.1f;
@@ -887,8 +892,9 @@ class Controller {
   glm::vec3 obstacle_normal_{0.0f};
   glm::vec3 edge_normal_{0.0f};  // the ledge edge the simulation stands at, or zero
   glm::vec3 obstacle_point_{0.0f};
-  bool obstacle_edge_ = false;  // that obstacle is a ledge's edge (a drop), not a wall's face
-  float held_time_ = 0.0f;      // how long the simulation has been held at it (s)
+  bool obstacle_edge_ = false;    // that obstacle is a ledge's edge (a drop), not a wall's face
+  ObstacleAhead obstacle_ahead_;  // where the last prediction's way was blocked
+  float held_time_ = 0.0f;        // how long the simulation has been held at it (s)
   // The velocity the stick asks for (desired_velocity_ before standing at an obstacle).
   glm::vec3 stick_velocity_{0.0f};
   // How far (m) the body above the root is moved back from walls (horizontal), and its rate.
