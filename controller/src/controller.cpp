@@ -1563,7 +1563,8 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // the toe: the leg keeps the softened length, so the knee bends as it would, and the toe
   // stays put (up to the heel's limit).
   // The heel lifts as far as the held toe needs and comes down on a spring (ease_heel_down), not
-  // at once, when the need ends or the lock does.
+  // at once, when the need ends or the lock does. A lock that begins needing more than
+  // kHeelRiseAtOnce takes up the rest with a bounded acceleration (heel_lag).
   FootLock& f = feet_[side];
   glm::quat heel_rise(1.0f, 0.0f, 0.0f, 0.0f);
   if (leg[3] >= 0 && (f.locked || f.heel_rise > 0.0f)) {

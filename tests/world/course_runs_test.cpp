@@ -148,18 +148,32 @@ TEST(CourseRuns, ADownhillFootOutOfReachStaysHeld) {
   for (const CourseRun& r : ramps) EXPECT_LE(labelled_releases(r), on_flat + 5) << r.course;
 }
 
+// Calls `each(frame, d)` from a run's third update on with `d`, the second difference (m) of the
+// point `at(frame)` gives over that update and the two before it.
+void each_second_difference(const CourseRun& r,
+                            const std::function<glm::dvec3(const EvaluationFrame&)>& at,
+                            const std::function<void(const EvaluationFrame&, double)>& each) {
+  int frames = 0;
+  glm::dvec3 before[2];
+  run(r, [&](const EvaluationFrame& frame) {
+    const glm::dvec3 now = at(frame);
+    if (frames >= 2) each(frame, glm::length(now - 2.0 * before[1] + before[0]));
+    before[0] = before[1];
+    before[1] = now;
+    ++frames;
+  });
+}
+
 // How many updates the root's horizontal step changed by more than `jump` (m) from the update
 // before.
 int root_jerks(const CourseRun& r, float jump) {
-  int jerks = 0, frames = 0;
-  glm::vec3 before[2];
-  run(r, [&](const EvaluationFrame& frame) {
-    const glm::vec3 at(frame.root_position.x, 0.0f, frame.root_position.z);
-    if (frames >= 2 && glm::length((at - before[1]) - (before[1] - before[0])) > jump) ++jerks;
-    before[0] = before[1];
-    before[1] = at;
-    ++frames;
-  });
+  int jerks = 0;
+  each_second_difference(
+      r,
+      [](const EvaluationFrame& frame) {
+        return glm::dvec3(frame.root_position.x, 0.0, frame.root_position.z);
+      },
+      [&](const EvaluationFrame&, double d) { jerks += d > jump ? 1 : 0; });
   return jerks;
 }
 
@@ -180,20 +194,16 @@ TEST(CourseRuns, BesideALedgesEdgeAndAlongAWallTheRootDoesNotJitter) {
 // The largest acceleration (m/s^2, second differences of its position) of `joint` between t0 and
 // t1 (s) of a run.
 float largest_acceleration(const CourseRun& r, int joint, float t0, float t1) {
-  float largest = 0.0f;
-  int frames = 0;
-  glm::vec3 before[2];
-  run(r, [&](const EvaluationFrame& frame) {
-    const glm::vec3 at =
-        glm::vec3(frame.origin + glm::dvec3(frame.joints[static_cast<size_t>(joint)]));
-    if (frames >= 2 && frame.t >= t0 && frame.t <= t1) {
-      largest = std::max(largest, glm::length(at - 2.0f * before[1] + before[0]) / (r.dt * r.dt));
-    }
-    before[0] = before[1];
-    before[1] = at;
-    ++frames;
-  });
-  return largest;
+  double largest = 0.0;
+  each_second_difference(
+      r,
+      [joint](const EvaluationFrame& frame) {
+        return frame.origin + glm::dvec3(frame.joints[static_cast<size_t>(joint)]);
+      },
+      [&](const EvaluationFrame& frame, double d) {
+        if (frame.t >= t0 && frame.t <= t1) largest = std::max(largest, d);
+      });
+  return static_cast<float>(largest / (double(r.dt) * r.dt));
 }
 
 // Running diagonally into the corner of the second course's floor (two ledge edges): the body was
@@ -218,21 +228,15 @@ TEST(CourseRuns, IntoACornerTheBodyIsKeptOffBothWallsWithoutAJump) {
 
 // The largest horizontal acceleration (m/s^2) of the simulation object over a run.
 float largest_simulation_acceleration(const CourseRun& r) {
-  float largest = 0.0f;
-  int frames = 0;
-  glm::dvec2 before[2];
-  run(r, [&](const EvaluationFrame& frame) {
-    const glm::dvec2 at(frame.origin.x + frame.sim_position.x,
-                        frame.origin.z + frame.sim_position.z);
-    if (frames >= 2) {
-      const glm::dvec2 a = (at - 2.0 * before[1] + before[0]) / double(r.dt * r.dt);
-      largest = std::max(largest, static_cast<float>(glm::length(a)));
-    }
-    before[0] = before[1];
-    before[1] = at;
-    ++frames;
-  });
-  return largest;
+  double largest = 0.0;
+  each_second_difference(
+      r,
+      [](const EvaluationFrame& frame) {
+        return glm::dvec3(frame.origin.x + frame.sim_position.x, 0.0,
+                          frame.origin.z + frame.sim_position.z);
+      },
+      [&](const EvaluationFrame&, double d) { largest = std::max(largest, d); });
+  return static_cast<float>(largest / (double(r.dt) * r.dt));
 }
 
 // Walking up the first course's stairs and on to its landing's far edge (a ledge), the
