@@ -82,6 +82,8 @@ std::array<glm::vec3, kFootSupportProbes> foot_support_points(const glm::vec3& t
   const glm::vec3 side = kFootHalfWidth * glm::vec3(across.x, 0.0f, across.y);
   points[kFootSupportSamples] = toe + side;
   points[kFootSupportSamples + 1] = toe - side;
+  const glm::vec2 ahead = length > 1e-4f ? forward / length * kToeReach : glm::vec2(0.0f);
+  points[kFootSupportSamples + 2] = toe + glm::vec3(ahead.x, 0.0f, ahead.y);
   return points;
 }
 

@@ -163,7 +163,7 @@ TEST(GroundMetrics, FootSupportPointsRunToTheHeelAndBesideTheToe) {
     EXPECT_NEAR(glm::length(points[static_cast<size_t>(k)] - expected), 0.0f, 1e-6f) << k;
   }
   const glm::vec3 forward = glm::normalize(glm::vec3(toe.x - heel.x, 0.0f, toe.z - heel.z));
-  for (size_t k = kFootSupportSamples; k < points.size(); ++k) {
+  for (size_t k = kFootSupportSamples; k < kFootSupportSamples + 2; ++k) {
     const glm::vec3 out = points[k] - toe;
     EXPECT_NEAR(glm::length(out), kFootHalfWidth, 1e-6f) << k;
     EXPECT_NEAR(glm::dot(out, forward), 0.0f, 1e-6f) << k;
@@ -171,9 +171,35 @@ TEST(GroundMetrics, FootSupportPointsRunToTheHeelAndBesideTheToe) {
   }
   EXPECT_NEAR(glm::length(points[kFootSupportSamples] - points[kFootSupportSamples + 1]),
               2.0f * kFootHalfWidth, 1e-6f);
+  // The last, ahead of the toe on the level.
+  EXPECT_NEAR(glm::length(points.back() - (toe + kToeReach * forward)), 0.0f, 1e-6f);
   const auto down = foot_support_points(toe, toe + glm::vec3(0.0f, 0.2f, 0.0f));
   EXPECT_NEAR(std::abs(down[kFootSupportSamples].x - toe.x), kFootHalfWidth, 1e-6f);
   EXPECT_FLOAT_EQ(down[kFootSupportSamples].z, toe.z);
+  EXPECT_EQ(down.back(), toe);
+}
+
+// Ahead of the toe too: a foot facing a riser, its toe joint just before it and above the tread
+// beyond, has its toes on that tread's edge (stop-and-go from x = 14.6 on the second course at
+// 1/30 s: standing on stairs_down with the toe joint 9 mm before the edge above, the float read
+// 22 cm over the tread below); a toe joint a whole toe's length before it does not, nor one below
+// the tread's top (its toes against the riser).
+TEST(GroundMetrics, AFootRestsOnTheTreadItsToesReachBeforeARiser) {
+  // The tread above: z > 0, 16 cm higher than the one below. The foot points along +z.
+  const auto ground = [](const glm::vec3& p) {
+    return ground_at(p.x, p.z > 0.0f ? 0.32f : 0.16f, p.z);
+  };
+  const auto support = [&](float toe_z, float toe_y) {
+    const glm::vec3 toe(0.0f, toe_y, toe_z), heel(0.0f, toe_y + 0.05f, toe_z - 0.15f);
+    std::array<GroundHit, kFootSupportProbes> hits;
+    const auto points = foot_support_points(toe, heel);
+    for (size_t k = 0; k < points.size(); ++k) hits[k] = ground(points[k]);
+    const GroundHit under = ground(toe);
+    return foot_support_height(under.point.y, under, hits, toe.y);
+  };
+  EXPECT_FLOAT_EQ(support(-0.009f, 0.38f), 0.32f);
+  EXPECT_FLOAT_EQ(support(-(kToeReach + 0.01f), 0.38f), 0.16f);
+  EXPECT_FLOAT_EQ(support(-0.009f, 0.2f), 0.16f);
 }
 
 TEST(GroundMetrics, HipsHeightAboveTheirGroundAndVerticalAcceleration) {

@@ -65,7 +65,11 @@ inline constexpr int kFootSupportSamples = 4;  // from the toe to the heel
 // Beside the toe, on either side, this far out (m): the ball of a foot is about three times as
 // wide, so a toe joint this far past a tread's side still has the inside of its foot on it.
 inline constexpr float kFootHalfWidth = 0.03f;
-inline constexpr int kFootSupportProbes = kFootSupportSamples + 2;
+// Ahead of the toe joint, along the heel-to-toe line on the level, this far (m): the toes reach
+// past their joint (the ball of the foot), so a toe joint this close before a riser has its toes
+// on the tread above it.
+inline constexpr float kToeReach = 0.03f;
+inline constexpr int kFootSupportProbes = kFootSupportSamples + 3;
 inline constexpr float kNoSupport = std::numeric_limits<float>::infinity();
 
 struct GroundMetrics {
@@ -112,7 +116,8 @@ float foot_support_height(float toe_ground, const GroundHit& under,
 // Where foot_support_height's `along` is probed for a foot: kFootSupportSamples points from the
 // toe to the heel (the ankle), evenly, the heel last, then one kFootHalfWidth to each side of the
 // toe, across the heel-to-toe line on the level (across x where the foot points straight up or
-// down).
+// down), then one kToeReach ahead of the toe along that line (none where the foot points straight
+// up or down: the last point is the toe itself).
 std::array<glm::vec3, kFootSupportProbes> foot_support_points(const glm::vec3& toe,
                                                               const glm::vec3& heel);
 
