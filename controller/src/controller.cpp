@@ -1426,8 +1426,13 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
   // turning round its toe still has its heel's arc to go); the lift itself follows that height
   // on a spring, so the foot leaves the ground smoothly.
-  const float to_go =
-      std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
+  float to_go = std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
+  // A settling step goes to where the idle clip itself puts the toe, and the blend into the idle
+  // carries the released toe there: lifted only by the offset left, it slid along the ground.
+  if (settling && f.stepping) {
+    const glm::vec3 way = playing_leg_end(side) - target;
+    to_go = std::max(to_go, std::hypot(way.x, way.z));
+  }
   const float lift_goal = f.stepping ? std::min(kStepHeight, kStepLift * to_go) : 0.0f;
   foot_springs_[side].lift.update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
   target.y += f.lift;
