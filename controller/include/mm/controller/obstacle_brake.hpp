@@ -1,13 +1,14 @@
 #pragma once
 // Slowing down before an obstacle (issue 29). The simulation object follows the stick's velocity
 // on a spring, and the world stops it where it meets a wall or a ledge's edge: walked into, it
-// stopped within an update, and the character kept with it stopped dead (the whole body about 40
-// m/s^2 in one update, a toe swung out over the edge pulled back 8 cm). People slow down before
-// they get there, and the collided trajectory already shows where: the first predicted sample the
-// world stopped short of its goal. Toward it, the velocity the simulation object follows is kept
-// to the speed from which a constant deceleration stops in the room left, so the character
-// arrives nearly at rest; headed along the obstacle (a slide along a wall) nothing changes. The
-// search still sees the stick's own trajectory, stopped at the obstacle, and picks the stop.
+// stopped within an update, and the character kept with it stopped dead (the whole body in one
+// update, a toe swung out over the edge pulled back; docs/world.md, sessions 25 and 26). People
+// slow down before they get there, and the collided trajectory already shows where: the first
+// predicted sample the world stopped short of its goal. Toward it, the velocity the simulation
+// object follows is kept to the speed from which a constant deceleration stops in the room left, so
+// the character arrives nearly at rest; headed along the obstacle (a slide along a wall) nothing
+// changes. The search still sees the stick's own trajectory, stopped at the obstacle, and picks the
+// stop.
 //
 // Units: metres, m/s, m/s^2. Robustness: non-finite positions give no obstacle, a non-finite or
 // non-positive deceleration brakes nothing. Called per update: no allocation.
@@ -39,7 +40,7 @@ ObstacleAhead obstacle_ahead(std::span<const glm::vec3> goals, std::span<const g
 // A velocity with less than this share of its (horizontal) length along the obstacle heads into
 // it; one that goes more along it slides along it as the world lets it, unbraked. Braked, a
 // circle run curving beside a stair's side slowed while the clip played on, the character
-// running 0.4 m ahead of the simulation object.
+// running far ahead of the simulation object.
 inline constexpr float kAlongShare = 0.5f;
 
 // `velocity` with its part toward `ahead` (horizontal) no faster than the speed from which

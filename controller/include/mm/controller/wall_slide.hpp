@@ -5,8 +5,7 @@
 // still beside the wall where it could have slid. The limit holds while the object is beside the
 // wall, and fades out over the last kBesideFade of the distances that say so: cut off there, the
 // yield was whole on one update and limited on the next, back and forth as the object crossed
-// the line, and the character, clamped to it, shook with it (4 mm steps back and forth, every
-// joint over 80 m/s^2 at 1/144 s).
+// the line, and the character, clamped to it, shook with it (docs/world.md, session 26).
 //
 // Units: metres, m/s, seconds. Robustness: a weight is in [0, 1] for any finite input (0 where
 // a distance is not finite); a zero slide, a zero weight or dt <= 0 leaves the step as it is.
