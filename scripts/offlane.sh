@@ -5,7 +5,11 @@
 # time stuck, the planted toes' float against the same script's on flat ground and the geometric
 # skating against the data's own; BAD marks a run that breaks a target (a toe below 1 cm, a toe in
 # the ground, a joint 2 cm in a wall, skating over the data's, planted toes floating more than
-# 1.5 cm higher than on flat ground).
+# 1.5 cm higher than on flat ground). The flat run's float is read for what the level played:
+# each run's float stands beside the played clips' own (foot_float_data_cm_mean), and where a
+# course stops the character (standing at a wall while the flat run walks on) the two runs plant
+# different steps; the reference is the flat float moved by the difference of the two runs'
+# played float.
 #   scripts/offlane.sh DB OUT_DIR [DT...]        (mm from build/release, or $MM)
 # Its lines, saved to a file, sum into docs/world.md's table rows: scripts/offlane_summary.py FILE.
 # Another course: COURSE (the .glb), LANES (the lanes' x, from the course's table in
@@ -27,17 +31,18 @@ mkdir -p "$out"
 [[ $# -gt 0 ]] || set -- 0.0333333 0.0166667 0.00694444
 for dt in "$@"; do
   for script in $scripts; do
-    # The planted toes' float on flat ground, the level's is read against (issue 29: at most
-    # 1.5 cm higher on a level).
+    # How much higher the planted toes float on flat ground than the played clips' own, the
+    # level's is read against (issue 29: at most 1.5 cm higher on a level).
     flat="$out/$script-flat-$dt.json"
     "$mm" eval --db "$db" --script "scripts/input/$script.txt" --dt "$dt" --json "$flat" >/dev/null
-    flat_float=$(jq .foot_float_cm_mean "$flat")
+    flat_float=$(jq '.foot_float_cm_mean - .foot_float_data_cm_mean' "$flat")
     for x in $lanes; do
       json="$out/$script-$x-$dt.json"
       "$mm" eval --db "$db" --script "scripts/input/$script.txt" --dt "$dt" \
         --world "$course" --start "$x,$start_z" --json "$json" >/dev/null
-      jq -r --arg s "$script" --arg x "$x" --arg dt "$dt" --argjson flat "$flat_float" '
+      jq -r --arg s "$script" --arg x "$x" --arg dt "$dt" --argjson above "$flat_float" '
         def f: . * 100 | round / 100;
+        (.foot_float_data_cm_mean + $above) as $flat |
         (.toe_clearance_cm_min < 1 or .foot_penetration_cm_max > 0 or .wall_depth_cm_max > 2
          or .foot_skate_geom_cm_s_mean > .foot_skate_geom_data_cm_s_mean
          or .foot_float_cm_mean > $flat + 1.5) as $bad |

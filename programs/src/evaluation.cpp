@@ -223,6 +223,7 @@ void EvaluationAccumulator::add(const EvaluationFrame& frame) {
   std::copy(std::begin(frame.toe_support), std::end(frame.toe_support), ground.toe_support);
   ground.hips_ground = frame.hips_ground;
   std::copy(std::begin(frame.contact), std::end(frame.contact), ground.contact);
+  std::copy(std::begin(frame.played_toe), std::end(frame.played_toe), ground.played_toe);
   ground.wall_depth = frame.wall_depth;
   ground.stuck = frame.stuck;
   s.ground->add(ground);
@@ -711,39 +712,17 @@ class WorldReadings {
   glm::vec3 previous_sim_velocity_{0.0f};
 };
 
-// The acceleration the playing clips have on their own at the moments transition_accel_p99
-// samples (the 10 frames from each transition, counted once per transition among them): the
-// clip played straight through those moments, with the controller's sampling. What a blend
-// adds to a jump shows against this; against the whole database it would also show how much
-// more the script runs than the data does.
-class PlayedAcceleration {
+// The playing clips' own poses: a clip's global joint positions at a time, held within the
+// clip, sampled as the controller samples them. Buffers sized once.
+class ClipPoses {
  public:
-  PlayedAcceleration(const Database& db, float dt, bool cubic)
+  ClipPoses(const Database& db, bool cubic)
       : db_(db),
-        dt_(dt),
         cubic_(cubic),
         local_(static_cast<size_t>(db.joint_count())),
-        global_(local_.size()) {
-    for (std::vector<glm::vec3>& step : steps_) step.assign(local_.size(), glm::vec3(0.0f));
-  }
+        global_(local_.size()) {}
 
-  void add(const ControllerDebug& d) {
-    transition_bits_ = (transition_bits_ << 1) | (d.transitioned ? 1u : 0u);
-    const int count = std::popcount(transition_bits_ & 0x3ffu);
-    if (count == 0 || d.clip < 0) return;
-    for (int k = 0; k < 3; ++k) {
-      pose_at(d.clip, d.clip_time + static_cast<float>(k - 1) * dt_,
-              steps_[static_cast<size_t>(k)]);
-    }
-    for (int i = 0; i < count; ++i) {
-      joint_accelerations(steps_[0], steps_[1], steps_[2], dt_, accelerations_);
-    }
-  }
-  double p99() const { return accelerations_.percentile(99.0); }
-
- private:
-  // The clip's global joint positions at `time`, held within the clip.
-  void pose_at(int clip_index, float time, std::vector<glm::vec3>& out) {
+  void pose_at(int clip_index, float time, std::span<glm::vec3> out) {
     const ClipRange& clip = db_.clips()[static_cast<size_t>(clip_index)];
     const float last = static_cast<float>(clip.frame_count() - 1);
     const float x = std::clamp(time / db_.frame_time(), 0.0f, last);
@@ -757,14 +736,69 @@ class PlayedAcceleration {
     forward_kinematics(db_.skeleton().parents(), local_, global_);
     for (size_t j = 0; j < local_.size(); ++j) out[j] = global_[j].translation;
   }
+  size_t joints() const { return local_.size(); }
 
+ private:
   const Database& db_;
-  float dt_;
   bool cubic_;
   std::vector<Transform> local_, global_;
+};
+
+// The acceleration the playing clips have on their own at the moments transition_accel_p99
+// samples (the 10 frames from each transition, counted once per transition among them): the
+// clip played straight through those moments, with the controller's sampling. What a blend
+// adds to a jump shows against this; against the whole database it would also show how much
+// more the script runs than the data does.
+class PlayedAcceleration {
+ public:
+  PlayedAcceleration(const Database& db, float dt, bool cubic) : dt_(dt), poses_(db, cubic) {
+    for (std::vector<glm::vec3>& step : steps_) step.assign(poses_.joints(), glm::vec3(0.0f));
+  }
+
+  void add(const ControllerDebug& d) {
+    transition_bits_ = (transition_bits_ << 1) | (d.transitioned ? 1u : 0u);
+    const int count = std::popcount(transition_bits_ & 0x3ffu);
+    if (count == 0 || d.clip < 0) return;
+    for (int k = 0; k < 3; ++k) {
+      poses_.pose_at(d.clip, d.clip_time + static_cast<float>(k - 1) * dt_,
+                     steps_[static_cast<size_t>(k)]);
+    }
+    for (int i = 0; i < count; ++i) {
+      joint_accelerations(steps_[0], steps_[1], steps_[2], dt_, accelerations_);
+    }
+  }
+  double p99() const { return accelerations_.percentile(99.0); }
+
+ private:
+  float dt_;
+  ClipPoses poses_;
   std::vector<glm::vec3> steps_[3];
   uint32_t transition_bits_ = 0;
   PercentileHistogram accelerations_;
+};
+
+// The playing clip's own toe heights above its flat ground at the playing time
+// (EvaluationFrame::played_toe, for foot_float_data_cm_mean).
+class PlayedToes {
+ public:
+  PlayedToes(const Database& db, bool cubic) : poses_(db, cubic), pose_(poses_.joints()) {
+    const JointRoleIndices& roles = db.roles();
+    toes_[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
+    toes_[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+  }
+
+  void read(const ControllerDebug& d, EvaluationFrame& r) {
+    if (d.clip < 0) return;
+    poses_.pose_at(d.clip, d.clip_time, pose_);
+    for (int side = 0; side < 2; ++side) {
+      if (toes_[side] >= 0) r.played_toe[side] = pose_[static_cast<size_t>(toes_[side])].y;
+    }
+  }
+
+ private:
+  ClipPoses poses_;
+  std::vector<glm::vec3> pose_;
+  int toes_[2] = {-1, -1};
 };
 
 // The transition figures against the database's own acceleration at the same dt.
@@ -863,6 +897,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   std::vector<glm::vec3> positions(joints);
   WorldReadings world(options.world, db.roles(), joints);
   PlayedAcceleration played(db, dt, options.settings.cubic_playback);
+  PlayedToes played_toes(db, options.settings.cubic_playback);
   using Clock = std::chrono::steady_clock;
   for (int f = 0; f < *frame_count; ++f) {
     const float t = static_cast<float>(f + 1) * dt;
@@ -872,6 +907,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     EvaluationFrame frame = frame_record(controller, t, elapsed, positions);
     world.read(controller, dt, frame);
+    played_toes.read(controller.debug(), frame);
     accumulator.add(frame);
     played.add(controller.debug());
     if (options.dump) *options.dump << csv_row(frame) << "\n";

@@ -59,6 +59,7 @@ nlohmann::json evaluation_metrics_json(const EvaluationMetrics& m) {
           {"foot_penetration_cm_mean", m.ground.foot_penetration_cm_mean},
           {"foot_penetration_cm_max", m.ground.foot_penetration_cm_max},
           {"foot_float_cm_mean", m.ground.foot_float_cm_mean},
+          {"foot_float_data_cm_mean", m.ground.foot_float_data_cm_mean},
           {"hips_height_cm_mean", m.ground.hips_height_cm_mean},
           {"hips_height_cm_std", m.ground.hips_height_cm_std},
           {"hips_vertical_accel_p99_m_s2", m.ground.hips_vertical_accel_p99_m_s2},

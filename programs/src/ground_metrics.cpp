@@ -98,7 +98,7 @@ struct GroundAccumulator::State {
   GeomPlant plant;
   float clearance_min = INFINITY;
   LinearHistogram clearance{-100.0, 100.0, 4000};  // cm: 0.5 mm bins over +-1 m
-  RunningMean penetration, floating, hips_height;
+  RunningMean penetration, floating, floating_data, hips_height;
   double penetration_max = 0.0;
   double hips_height_squares = 0.0;
   PercentileHistogram hips_accelerations;
@@ -139,6 +139,9 @@ void GroundAccumulator::add(const GroundFrame& r) {
     if (r.contact[side]) {
       const float support = std::max(r.toe_ground[side], r.toe_support[side]);
       s.floating.add(100.0 * std::max(0.0f, toe.y - support));
+      if (std::isfinite(r.played_toe[side])) {
+        s.floating_data.add(100.0 * std::max(0.0f, r.played_toe[side]));
+      }
     }
     if (s.frames > 0) s.plant.add(side, height, horizontal_speed(toe, s.previous_toes[side], s.dt));
     s.previous_toes[side] = toe;
@@ -186,6 +189,7 @@ GroundMetrics GroundAccumulator::metrics() const {
   m.foot_penetration_cm_mean = s.penetration.value();
   m.foot_penetration_cm_max = s.penetration_max;
   m.foot_float_cm_mean = s.floating.value();
+  m.foot_float_data_cm_mean = s.floating_data.value();
   m.hips_height_cm_mean = s.hips_height.value();
   if (s.hips_height.count > 0) {
     const double mean = s.hips_height.value();

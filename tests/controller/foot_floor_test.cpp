@@ -80,6 +80,27 @@ TEST(FootFloorTest, ToesStayAtOrAboveTheDataLowestWithIk) {
                });
 }
 
+// The played clips' own float (foot_float_data_cm_mean) is what the animation alone plants:
+// without IK the planted toes are the played clip's but for the blends, so the two floats
+// agree within a few millimetres; a read of any other frame than the playing time's would
+// not.
+TEST(FootFloorTest, WithoutIkThePlantedToesFloatAsThePlayedClipsOwn) {
+  const std::shared_ptr<const ControllerDatabase> shared = normal_controller_database();
+  for (const char* name : {"stop-and-go.txt", "circle.txt"}) {
+    Result<InputScript> script =
+        load_input_script(std::filesystem::path(MM_SOURCE_DIR) / "scripts/input" / name);
+    ASSERT_TRUE(script.ok()) << script.message();
+    EvaluationOptions options;
+    options.dt = 1.0f / 60.0f;
+    options.settings.ik_enabled = false;
+    Result<EvaluationResult> run = evaluate_script(shared, *script, options);
+    ASSERT_TRUE(run.ok()) << run.message();
+    const GroundMetrics& g = run->metrics.ground;
+    EXPECT_GT(g.foot_float_data_cm_mean, 2.0) << name;
+    EXPECT_NEAR(g.foot_float_cm_mean, g.foot_float_data_cm_mean, 0.3) << name;
+  }
+}
+
 // Planted through blends (issue 29): counted by geometry alone (low and slow), the toes slide
 // well under the data's own under the same rule, on the shipped scripts where a held toe
 // was dragged beyond the leg's softened reach or let go mid-blend, at the coarsest and the

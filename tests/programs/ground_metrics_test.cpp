@@ -96,6 +96,25 @@ TEST(GroundMetrics, FloatIsAgainstTheGroundTheFootRestsOn) {
   EXPECT_NEAR(m.toe_clearance_cm_min, 24.0, 1e-3);
 }
 
+// The played clips' own float is taken over the frames the float is (contact on), from the
+// playing clip's toe heights; frames that read none are left out.
+TEST(GroundMetrics, TheDataFloatIsThePlayedToesOverTheFloatsFrames) {
+  GroundAccumulator a(roles(), kDt);
+  const std::vector<glm::vec3> joints = pose(0.0f, 0.06f);
+  const float played[3] = {0.04f, 0.5f, NAN};  // planted, lifted (label off), none read
+  for (int f = 0; f < 3; ++f) {
+    GroundFrame frame;
+    frame.joints = joints;
+    frame.contact[0] = f != 1;
+    frame.played_toe[0] = played[f];
+    frame.played_toe[1] = 0.03f;  // never planted
+    a.add(frame);
+  }
+  const GroundMetrics m = a.metrics();
+  EXPECT_NEAR(m.foot_float_cm_mean, 6.0, 1e-3);
+  EXPECT_NEAR(m.foot_float_data_cm_mean, 4.0, 1e-3);
+}
+
 GroundHit ground_at(float x, float y, float z, const glm::vec3& normal = {0.0f, 1.0f, 0.0f}) {
   return GroundHit{true, glm::vec3(x, y, z), normal, true};
 }

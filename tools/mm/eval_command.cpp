@@ -207,7 +207,8 @@ void print_ground_metrics(const EvaluationMetrics& m) {
               g.toe_clearance_cm_p1);
   std::printf("foot_penetration_cm_mean    %10.3f   (max %.3f)\n", g.foot_penetration_cm_mean,
               g.foot_penetration_cm_max);
-  std::printf("foot_float_cm_mean          %10.3f\n", g.foot_float_cm_mean);
+  std::printf("foot_float_cm_mean          %10.3f   (the played clips' own %.3f)\n",
+              g.foot_float_cm_mean, g.foot_float_data_cm_mean);
   std::printf("hips_height_cm_mean         %10.3f   (std %.3f)\n", g.hips_height_cm_mean,
               g.hips_height_cm_std);
   std::printf("hips_vertical_accel_p99_m_s2 %9.3f\n", g.hips_vertical_accel_p99_m_s2);

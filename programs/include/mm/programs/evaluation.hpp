@@ -241,6 +241,10 @@ struct EvaluationFrame {
   float hips_ground = 0.0f;
   float wall_depth = 0.0f;
   bool stuck = false;
+  // The playing clip's own toe heights (left, right) above its flat ground at the playing time
+  // (m; NaN where none was read): GroundFrame::played_toe.
+  float played_toe[2] = {std::numeric_limits<float>::quiet_NaN(),
+                         std::numeric_limits<float>::quiet_NaN()};
   // The controller's own view (ControllerDebug): the ground the body stands on, the ground each
   // toe is placed on (foot_placement.hpp) and how far the pelvis came down (m). Heights, like
   // toe_ground's: the controller's origin moves only horizontally.

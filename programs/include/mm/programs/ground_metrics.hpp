@@ -20,6 +20,11 @@
 //   under the foot that the toe is above (foot_support_height: a foot held level on a tread,
 //   its toe a centimetre past the tread's edge or its side, rests on the tread, not on the
 //   floor below);
+// - foot_float_data_cm_mean: over the same frames, the height the playing clip's own toe has
+//   above its flat ground at the playing time (GroundFrame::played_toe): how high the planted
+//   toes of what played sit in the data. The float is read against it rather than against
+//   another run on flat ground, which may be doing something else by then (a course that stops
+//   the character at a wall has it stand on an idle while the flat run walks on);
 // - hips_height_cm_mean / _std: the hips' height above the ground under them;
 //   hips_vertical_accel_p99_m_s2: the p99 of the hips' vertical acceleration (second
 //   differences of their height above the world's y = 0);
@@ -80,6 +85,7 @@ struct GroundMetrics {
   double foot_penetration_cm_mean = 0.0;
   double foot_penetration_cm_max = 0.0;
   double foot_float_cm_mean = 0.0;
+  double foot_float_data_cm_mean = 0.0;
   double hips_height_cm_mean = 0.0;
   double hips_height_cm_std = 0.0;
   double hips_vertical_accel_p99_m_s2 = 0.0;
@@ -99,6 +105,10 @@ struct GroundFrame {
   float toe_support[2] = {-kNoSupport, -kNoSupport};
   float hips_ground = 0.0f;
   bool contact[2] = {false, false};
+  // The playing clip's own toe heights above its flat ground at the playing time (m; NaN where
+  // nothing plays): the data's float on these frames.
+  float played_toe[2] = {std::numeric_limits<float>::quiet_NaN(),
+                         std::numeric_limits<float>::quiet_NaN()};
   float wall_depth = 0.0f;  // m
   bool stuck = false;
 };
