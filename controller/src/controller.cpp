@@ -21,6 +21,7 @@
 #include "mm/runtime/spring.hpp"
 #include "mm/runtime/transform_sse.hpp"
 
+#include "mm/controller/leg_reach.hpp"
 #include "mm/controller/style_search.hpp"
 
 namespace mm {
@@ -123,15 +124,9 @@ glm::vec3 stick_to_world(const glm::vec2& stick, const glm::quat& camera) {
   return camera * glm::vec3(-stick.x, 0.0f, stick.y);
 }
 
-// Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
-// target at the edge of reach makes the knee snap. Reach is softened instead: distances up to
-// kSoftReach of the leg's length, or up to the animation's own hip-to-ankle distance when its leg
-// is straighter than that, are kept; longer ones approach the full length exponentially, over
-// at least kMinSoftSpan of it. The animation's own extension is kept only standing, where poses
-// lock their knees and softening them would bend both knees forward by centimetres; in motion
-// the shorter span it leaves makes knees snap straight at the transitions.
-constexpr float kSoftReach = 0.96f;
-constexpr float kMinSoftSpan = 0.01f;
+// How far (m) a foot's ground lies below the body's before its leg falls short by its height
+// alone (reach, reach_down).
+constexpr float kShortBelowDepth = 0.05f;
 // The most (radians) the root turns to bring a standing pose's hips onto the facing, and the
 // halflife (s) over which it follows their offset: short beside the adjustment's own halflife,
 // because the two lags add, and a weight shift after a transition inside the idle turns the
@@ -174,20 +169,6 @@ inline glm::vec3 rotated(const glm::quat& q, const glm::vec3& v) {
   return q * v;
 }
 #endif
-
-// `keep_animated` in [0, 1] is how much of the animation's own extension beyond kSoftReach is
-// kept (1 standing, 0 in motion, eased between, so the reach never jumps).
-glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, float keep_animated,
-                     float length) {
-  const float d = glm::length(hip_to_ankle);
-  const float soft = kSoftReach * length;
-  const float kept =
-      soft + keep_animated * std::max(0.0f, std::min(animated_distance, length) - soft);
-  if (d <= kept || d < 1e-6f) return hip_to_ankle;
-  const float span = std::max(length - kept, kMinSoftSpan * length);
-  const float reached = kept + span * (1.0f - std::exp(-(d - kept) / span));
-  return hip_to_ankle * (reached / d);
-}
 
 // The turn (radians, at most FootPlacement::kMaxHeelRise) about the held toe that brings the ankle
 // to `distance` from the hip, turning the toe-to-ankle line toward the toe-to-hip line about `axis`
@@ -1564,6 +1545,15 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
       glm::length(globals_[static_cast<size_t>(foot)].translation - hip_position);
   glm::vec3 reached =
       soft_reach(ankle_target - hip_position, animated_reach, standing_reach_, leg_length(side));
+  // A foot reaching down to ground lower than the body's (a step down, a ledge's foot) stays over
+  // where it reaches for until the pelvis has come down (leg_reach.hpp): shortened along the
+  // hip-to-target line instead, a foot behind the body over a box's edge swung back toward the
+  // hip, into the box's face (docs/world.md, session 27). Faded in over kShortBelowDepth of the
+  // foot's ground below the body's.
+  if (world_) {
+    const float below = ground_height_ - foot_placement_.ground(side).toe;
+    reached = reach_down(ankle_target - hip_position, reached, below / kShortBelowDepth);
+  }
   // A held toe the softened leg falls short of is reached by lifting the heel, not by dragging
   // the toe: the leg keeps the softened length, so the knee bends as it would, and the toe
   // stays put (up to the heel's limit).

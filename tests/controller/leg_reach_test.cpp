@@ -1,0 +1,87 @@
+// How far a leg reaches (leg_reach.hpp): the softened reach, and a foot reaching down to ground
+// below the body's that falls short below the point it reaches for, not back toward the hip.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <glm/glm.hpp>
+
+#include "mm/controller/leg_reach.hpp"
+
+namespace mm {
+namespace {
+
+constexpr float kLength = 0.9f;  // a leg's upper plus lower length (m)
+
+void expect_near(const glm::vec3& a, const glm::vec3& b, float tolerance) {
+  EXPECT_NEAR(a.x, b.x, tolerance);
+  EXPECT_NEAR(a.y, b.y, tolerance);
+  EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+TEST(LegReach, WithinTheSoftReachTheTargetIsKept) {
+  const glm::vec3 target(0.1f, -0.8f, 0.2f);  // 0.83 m of a 0.9 m leg: under kSoftReach
+  expect_near(soft_reach(target, 0.8f, 0.0f, kLength), target, 1e-6f);
+}
+
+// Beyond it the reach approaches the leg's length along the hip-to-target line, never past it,
+// and the farther the target the farther the reach.
+TEST(LegReach, BeyondTheSoftReachTheLegFallsShortAlongTheLine) {
+  const glm::vec3 near(0.0f, -0.88f, 0.1f), far(0.0f, -1.2f, 0.1f);
+  const glm::vec3 a = soft_reach(near, 0.8f, 0.0f, kLength);
+  const glm::vec3 b = soft_reach(far, 0.8f, 0.0f, kLength);
+  EXPECT_LT(glm::length(a), glm::length(near));
+  EXPECT_GT(glm::length(a), kSoftReach * kLength);
+  EXPECT_LT(glm::length(b), kLength);
+  EXPECT_GT(glm::length(b), glm::length(a));
+  EXPECT_NEAR(glm::dot(glm::normalize(b), glm::normalize(far)), 1.0f, 1e-6f);
+  // Standing, the animation's own straighter leg is kept.
+  EXPECT_NEAR(glm::length(soft_reach(near, 0.89f, 1.0f, kLength)), glm::length(near), 1e-5f);
+}
+
+TEST(LegReach, ShortBelowKeepsTheHorizontalOffset) {
+  const glm::vec3 target(0.1f, -1.2f, -0.2f);
+  const glm::vec3 r = short_below(target, 0.85f);
+  EXPECT_NEAR(glm::length(r), 0.85f, 1e-5f);
+  EXPECT_NEAR(r.x, 0.1f, 1e-6f);
+  EXPECT_NEAR(r.z, -0.2f, 1e-6f);
+  EXPECT_LT(r.y, 0.0f);
+  // Farther out than the length itself: out at the hip's height, toward the target.
+  const glm::vec3 wide = short_below(glm::vec3(1.0f, -0.5f, 0.0f), 0.85f);
+  expect_near(wide, glm::vec3(0.85f, 0.0f, 0.0f), 1e-6f);
+}
+
+// A foot over a drop behind the body (the target 0.35 m below a step's top, 0.1 m behind the
+// hip): along the line the ankle swings forward toward the hip's vertical, under the step's
+// edge; reaching down it stays 0.1 m behind, at the same length, and a partial weight is between.
+TEST(LegReach, ReachingDownTheFootStaysOverItsTarget) {
+  const glm::vec3 target(0.0f, -1.25f, -0.1f);
+  const glm::vec3 along = soft_reach(target, 0.8f, 0.0f, kLength);
+  ASSERT_LT(glm::length(along), glm::length(target));
+  const glm::vec3 down = reach_down(target, along, 1.0f);
+  EXPECT_NEAR(glm::length(down), glm::length(along), 1e-5f);
+  EXPECT_NEAR(down.z, -0.1f, 1e-5f);
+  EXPECT_GT(along.z, -0.1f + 0.02f);  // the line's fall-short swung it 2 cm and more forward
+  const glm::vec3 half = reach_down(target, along, 0.5f);
+  EXPECT_NEAR(glm::length(half), glm::length(along), 1e-5f);
+  EXPECT_LT(half.z, along.z);
+  EXPECT_GT(half.z, down.z);
+}
+
+TEST(LegReach, ReachingDownChangesNothingWhereTheLegReachesOrTheWeightIsNone) {
+  const glm::vec3 target(0.0f, -0.8f, -0.1f);
+  expect_near(reach_down(target, target, 1.0f), target, 0.0f);  // reached: nothing short
+  const glm::vec3 far(0.0f, -1.25f, -0.1f);
+  const glm::vec3 along = soft_reach(far, 0.8f, 0.0f, kLength);
+  expect_near(reach_down(far, along, 0.0f), along, 0.0f);
+  expect_near(reach_down(far, along, -3.0f), along, 0.0f);
+  expect_near(reach_down(far, along, NAN), along, 0.0f);
+  // A target above the hip is not reached down to.
+  const glm::vec3 up(0.0f, 1.25f, -0.1f);
+  const glm::vec3 up_along = soft_reach(up, 0.8f, 0.0f, kLength);
+  expect_near(reach_down(up, up_along, 1.0f), up_along, 0.0f);
+}
+
+}  // namespace
+}  // namespace mm
