@@ -33,6 +33,9 @@ constexpr float kWallPushHalflife = 0.15f;
 // The farthest (m) the body is moved back from a wall: farther, the legs could not reach the
 // feet, which stay.
 constexpr float kMaxWallPush = 0.1f;
+// The most the body accelerates (m/s^2, along each horizontal axis) following a push an arm's
+// depth asks for (keep_body_off_walls).
+constexpr float kArmPushAcceleration = 20.0f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
@@ -74,6 +77,7 @@ void Controller::set_world(const WorldQueries* world) {
   held_time_ = 0.0f;
   root_contacts_.clear();
   wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
+  arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
   // Without a world nothing moves the body back, and the foot lock must not keep taking it off.
   body_shift_ = glm::vec3(0.0f);
   if (clip_ >= 0) place(sim_position_, quat_yaw(sim_rotation_));
@@ -377,41 +381,54 @@ void Controller::settle_on_ground() {
   std::fill(std::begin(riser_walls_), std::end(riser_walls_), WallHit{});
   std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
   wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
+  arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
 }
 
 // The body kept out of walls: the capsule keeps the root a radius away, but an arm swinging
 // forward or an idle hand reaches past it. Everything above the root is moved back from each wall
 // by as far as its deepest joint is past it: the wall the simulation object stands against (the
 // joints higher than a step), and the wall found toward a hand, elbow or the head (find_walls).
-// The push is one horizontal offset that covers every wall's depth at once (a hand must not go
-// in), at most kMaxWallPush long, and eases back on a spring once nothing is in. One offset, not a
-// depth along the deepest wall's normal: in a corner the wall the simulation object stands
-// against is one side, then the other, from one update to the next, and a push that turned with
-// it threw the whole body sideways and back (the ledge's edges at the second course's floor
-// corner: the hips 482 m/s^2). The feet stay where the animation has them: the foot lock takes
-// the shift (body_shift_) off their targets, so the body leans over them rather than sliding
-// them.
+// The push is one horizontal offset that covers every wall's depth at once, at most kMaxWallPush
+// long, and eases back on a spring once nothing is in. One offset, not a depth along the deepest
+// wall's normal: in a corner the wall the simulation object stands against is one side, then the
+// other, from one update to the next, and a push that turned with it threw the whole body
+// sideways and back (the ledge's edges at the second course's floor corner: the hips 482 m/s^2).
+// The feet stay where the animation has them: the foot lock takes the shift (body_shift_) off
+// their targets, so the body leans over them rather than sliding them.
+// What an arm's depth raises the push by the body follows with a bounded acceleration
+// (arm_push_lag_), and the arm's swing out of the wall (keep_arms_off_walls) takes the rest
+// meanwhile: a hand swinging past the end of a wall is found a hand's depth in at once, and taken
+// at once, the whole body jumped sideways in an update (walking past the end of the second
+// course's corner wall; docs/world.md, session 27). The head and the trunk are pushed out at
+// once.
 void Controller::keep_body_off_walls(float dt) {
   struct Depth {
     glm::vec3 normal;
     float depth;
+    bool arm;
   };
-  std::array<Depth, 1 + kReachingJoints> walls;
+  std::array<Depth, 2 + kReachingJoints> walls;
   size_t count = 0;
   glm::vec3 point, n;
   if (wall_beside(point, n)) {
     const float above = ground_height_ + settings_.step_height;
-    float depth = 0.0f;
+    float depth[2] = {0.0f, 0.0f};  // the trunk and head's, the arms'
     for (size_t j = 1; j < globals_.size(); ++j) {
       const glm::vec3& p = globals_[j].translation;
-      if (p.y > above) depth = std::max(depth, glm::dot(point - p, n));
+      if (p.y > above) {
+        float& deepest = depth[in_arm(static_cast<int>(j)) ? 1 : 0];
+        deepest = std::max(deepest, glm::dot(point - p, n));
+      }
     }
-    walls[count++] = {n, depth};
+    walls[count++] = {n, depth[0], false};
+    walls[count++] = {n, depth[1], true};
   }
-  for (const WallHit& hit : body_walls_) {
+  for (int k = 0; k < kReachingJoints; ++k) {
+    const WallHit& hit = body_walls_[k];
     if (!hit.found) continue;
     const glm::vec3& p = globals_[static_cast<size_t>(hit.joint)].translation;
-    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal)};
+    // find_walls' list: the hands and the lower arms, then the head.
+    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal), k < 4};
   }
   critical_spring_update(wall_push_, wall_push_velocity_, glm::vec3(0.0f), kWallPushHalflife, dt);
   // Twice over: where two walls meet at less than a right angle, the push out of one takes some of
@@ -423,18 +440,47 @@ void Controller::keep_body_off_walls(float dt) {
       if (short_by <= 0.0f) continue;
       wall_push_ += normal * short_by;
       wall_push_velocity_ -= normal * glm::dot(wall_push_velocity_, normal);
+      if (walls[k].arm) arm_push_lag_ += normal * short_by;
     }
   }
   const float length = glm::length(wall_push_);
   if (length > kMaxWallPush) wall_push_ *= kMaxWallPush / length;
+  // The arms' part of the push, followed with a bounded acceleration: never more than the push,
+  // and never leaving the trunk or the head in a wall.
+  for (const int axis : {0, 2}) {
+    approach(arm_push_lag_[axis], arm_push_lag_velocity_[axis], 0.0f, kArmPushAcceleration, dt);
+  }
+  const float lag = glm::length(arm_push_lag_);
+  if (lag > glm::length(wall_push_)) arm_push_lag_ *= glm::length(wall_push_) / lag;
+  for (size_t k = 0; k < count; ++k) {
+    if (walls[k].arm) continue;
+    const glm::vec3& normal = walls[k].normal;
+    const float short_by =
+        std::min(walls[k].depth, kMaxWallPush) - glm::dot(wall_push_ - arm_push_lag_, normal);
+    if (short_by > 0.0f) arm_push_lag_ -= normal * short_by;
+  }
   if (length < 1e-5f) {
     wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
+    arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
     body_shift_ = glm::vec3(0.0f);
   } else {
-    body_shift_ = wall_push_;
+    body_shift_ = wall_push_ - arm_push_lag_;
     for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
   }
   keep_arms_off_walls();
+}
+
+// Whether `joint` is an upper arm or below one (the skeleton keeps each joint's subtree after
+// it).
+bool Controller::in_arm(int joint) const {
+  const JointRoleIndices& roles = db_->roles();
+  for (const int upper_arm : {roles.left_upper_arm, roles.right_upper_arm}) {
+    if (upper_arm >= 0 && joint >= upper_arm &&
+        joint < upper_arm + db_->skeleton().subtree_size(upper_arm)) {
+      return true;
+    }
+  }
+  return false;
 }
 
 // What the body's push leaves of an arm in a wall (the push stops at kMaxWallPush, and eases in

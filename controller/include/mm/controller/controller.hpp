@@ -561,6 +561,7 @@ class Controller {
   void settle_on_ground();
   void keep_body_off_walls(float dt);
   void keep_arms_off_walls();
+  bool in_arm(int joint) const;
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
@@ -900,6 +901,10 @@ class Controller {
   // How far (m) the body above the root is moved back from walls (horizontal), and its rate.
   glm::vec3 wall_push_{0.0f};
   glm::vec3 wall_push_velocity_{0.0f};
+  // What of the push an arm's depth raised at once the body has still to follow, and its rate
+  // (keep_body_off_walls): made up with a bounded acceleration.
+  glm::vec3 arm_push_lag_{0.0f};
+  glm::vec3 arm_push_lag_velocity_{0.0f};
   // A wall found between the body and each toe, and each hand, elbow and the head, this update
   // (find_walls): a point on its face and its horizontal normal.
   struct WallHit {
