@@ -407,7 +407,7 @@ void Controller::keep_body_off_walls(float dt) {
     float depth;
     bool arm;
   };
-  std::array<Depth, 2 + kReachingJoints> walls;
+  std::array<Depth, 2 + 2 * kReachingJoints> walls;
   size_t count = 0;
   glm::vec3 point, n;
   if (wall_beside(point, n)) {
@@ -423,12 +423,21 @@ void Controller::keep_body_off_walls(float dt) {
     walls[count++] = {n, depth[0], false};
     walls[count++] = {n, depth[1], true};
   }
+  const JointRoleIndices& roles = db_->roles();
+  const int upper_arms[2] = {roles.left_upper_arm, roles.right_upper_arm};
   for (int k = 0; k < kReachingJoints; ++k) {
     const WallHit& hit = body_walls_[k];
     if (!hit.found) continue;
     const glm::vec3& p = globals_[static_cast<size_t>(hit.joint)].translation;
-    // find_walls' list: the hands and the lower arms, then the head.
-    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal), k < 4};
+    // find_walls' list: the hands and the lower arms (left, right), then the head.
+    const bool arm = k < 4;
+    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal), arm};
+    // The arm's swing turns it about its upper arm, which only the push takes out of that wall.
+    const int upper_arm = arm ? upper_arms[k % 2] : -1;
+    if (upper_arm >= 0) {
+      const glm::vec3& shoulder = globals_[static_cast<size_t>(upper_arm)].translation;
+      walls[count++] = {hit.normal, glm::dot(hit.point - shoulder, hit.normal), false};
+    }
   }
   critical_spring_update(wall_push_, wall_push_velocity_, glm::vec3(0.0f), kWallPushHalflife, dt);
   // Twice over: where two walls meet at less than a right angle, the push out of one takes some of
@@ -470,12 +479,13 @@ void Controller::keep_body_off_walls(float dt) {
   keep_arms_off_walls();
 }
 
-// Whether `joint` is an upper arm or below one (the skeleton keeps each joint's subtree after
-// it).
+// Whether `joint` is below an upper arm (the skeleton keeps each joint's subtree after it): what
+// the arm's swing about the upper arm moves. Not the upper arm itself, which only the body's
+// push takes out of a wall.
 bool Controller::in_arm(int joint) const {
   const JointRoleIndices& roles = db_->roles();
   for (const int upper_arm : {roles.left_upper_arm, roles.right_upper_arm}) {
-    if (upper_arm >= 0 && joint >= upper_arm &&
+    if (upper_arm >= 0 && joint > upper_arm &&
         joint < upper_arm + db_->skeleton().subtree_size(upper_arm)) {
       return true;
     }
