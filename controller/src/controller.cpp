@@ -67,6 +67,9 @@ constexpr float kStepReachGain = 0.02f;
 // is planted, whatever its label says: the skating metric's rule (ground_metrics.hpp).
 constexpr float kPlantedHeight = 0.06f;
 constexpr float kPlantedSpeed = 0.35f;
+// A lock begins only on a toe at most this high (m) above the ground under it now: the data's
+// labelled toes stand lower.
+constexpr float kLockAboveGround = 0.12f;
 // A labelled contact whose animated toe moves horizontally faster than this (m/s) is not held:
 // planted toes in the data move under 0.3 m/s, and some clips label a toe sweeping in at a
 // run's landing or out at its push-off. Held there, the toe stops dead and the leg snaps after
@@ -1294,7 +1297,8 @@ void Controller::foot_lock(float dt) {
     const bool planted = low_and_slow(side, on_ground, dt);
     const bool labelled = contact_label_holds(side);
     const bool contact = labelled || planted;
-    const glm::vec3 target = foot_target(side, unshifted, on_ground, contact, settling, dt);
+    const glm::vec3 target = foot_target(side, unshifted, on_ground, contact,
+                                         on_its_ground(side, on_ground), settling, dt);
     hold_heading(side, dt);
     debug_.locked[side] = feet_[side].locked;
     debug_.lock_position[side] = feet_[side].position;
@@ -1318,14 +1322,14 @@ void Controller::foot_lock(float dt) {
 // a contact begins or once a foot released during one has eased back onto the animation; it
 // holds that point in 3-D.
 glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
-                                  bool contact, bool settling, float dt) {
+                                  bool contact, bool grounded, bool settling, float dt) {
   FootLock& f = feet_[side];
   bool released = false;
   if (!f.has_target) {
     f.target = on_ground;
     f.has_target = true;
   }
-  if (contact && !f.locked && !f.stepping &&
+  if (contact && grounded && !f.locked && !f.stepping &&
       (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
     f.locked = true;
     f.lock_began = true;
@@ -1422,6 +1426,19 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     f.stepping = false;
   }
   return target;
+}
+
+// Whether a toe (placed `on_ground`) is near enough the ground under it now for a lock to begin:
+// a foot whose ground the look-ahead raised toward a step it then lands short of (or a box its
+// heel swung over) has its contact label on in the air, and locked there it stood on nothing
+// until its ground came back down (docs/world.md, session 27). Under the heel counts too: a foot
+// on a tread's edge, its toe out over the tread below, stands on the edge. Without a world the
+// toe is on its ground.
+bool Controller::on_its_ground(int side, const glm::vec3& on_ground) const {
+  if (!world_) return true;
+  const float under =
+      std::max(foot_placement_.ground_under_toe(side), foot_placement_.ground_under_heel(side));
+  return on_ground.y - under < kLockAboveGround;
 }
 
 // Whether the playing frame's contact label holds the toe: not where the animated toe moves

@@ -122,7 +122,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   probe(world, origin, mover, settings, legs, body_ground, body_velocity / pace);
   for (int side = 0; side < 2; ++side) {
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
-    const FootGround g = goal(side, settings, foot_length);
+    const FootGround g = goal(side, settings, foot_length, legs[side].planted);
     Foot& foot = feet_[side];
     // A planted foot's heel crossing a tread's edge (its ankle passing the edge by millimetres
     // as the foot turns on its held toe) rises more gently: the foot pivots about the held toe,
@@ -368,12 +368,20 @@ void FootPlacement::keep_steps_ahead() {
 // The heights a foot's heel and toe go to: the highest of now and ahead, then each raised to
 // within the steepest tilt of the other (a foot over a step's edge rests on the higher side),
 // a toe beyond that tilt's reach below the heel level with it.
-FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings,
-                               float foot_length) const {
+FootGround FootPlacement::goal(int side, const FootPlacementSettings& settings, float foot_length,
+                               bool planted) const {
   const auto height = [&](int which) { return probe_grounds_[slot(side, which)].y; };
   const float heel = std::max({height(kHeel), height(kHeelAhead), height(kHeelOwn)});
   const float toe = std::max({height(kToe), height(kToeAhead), height(kToeOwn)});
   const float rise = foot_length * std::tan(settings.max_foot_tilt);
+  // A planted foot whose heel comes over a step higher than the tilt reaches, while its toe
+  // stands on the ground below (as it did when it was planted), stays on the toe's ground, level:
+  // lifted level with the heel, a foot planted on the floor before a box, its heel swung over
+  // the box's edge, stood a box's height up in the air (docs/world.md, session 27). A foot that
+  // already stood up there (its heel on a tread's edge, its toe over the tread below) stays.
+  if (planted && toe < heel - rise && feet_[side].ground.toe < heel - rise) {
+    return FootGround{toe, toe};
+  }
   // A toe whose ground is out of the tilt's reach below the heel's hangs level with the heel, as
   // a foot standing on a tread's edge does: pitched down toward the ground below, it hung in
   // the air all the same. Not the heel: held level with a toe on the tread above too, a walk
@@ -470,6 +478,10 @@ void FootPlacement::keep_planted_toes_reached(const FootPlacementSettings& setti
 
 float FootPlacement::ground_under_toe(int side) const {
   return probe_grounds_[slot(side != 0 ? 1 : 0, kToe)].y;
+}
+
+float FootPlacement::ground_under_heel(int side) const {
+  return probe_grounds_[slot(side != 0 ? 1 : 0, kHeel)].y;
 }
 
 glm::quat FootPlacement::tilt(int side, const glm::vec3& along, float max_tilt) const {

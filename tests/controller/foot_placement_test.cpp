@@ -618,6 +618,37 @@ TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
   }
 }
 
+// A foot planted on the floor before a box (0.35 m, higher than the foot's tilt reaches), its
+// heel swung back over the box's edge: lifted level with the heel it stood a box's height in the
+// air; it stays on the floor. A foot that already stood up there (its heel on the edge, its toe
+// out over the floor, as on a tread's edge going down stairs) stays up there.
+TEST(FootPlacement, APlantedFootsHeelOverAHighStepDoesNotLiftItOffTheFloor) {
+  AnalyticWorld world;
+  // A box 0.35 m high for z < 0: its face at z = 0.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, -1.0f), glm::vec2(2.0f, 1.0f), 0.0f, 0.35f});
+  CharacterMover mover;
+  const FootPlacementSettings settings;
+  // Toe 10 cm before the face (+Z), heel 5 cm over the box: the foot points away from it.
+  std::array<PlacementLeg, 2> legs{standing_leg(0.0f, -0.05f, 0.0f),
+                                   standing_leg(0.3f, 0.5f, 0.0f)};
+  legs[0].toe = glm::vec3(0.0f, 0.03f, 0.1f);
+  FootPlacement on_floor;
+  on_floor.reset(0.0f);
+  for (int f = 0; f < 30; ++f) {
+    on_floor.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f), kDt);
+  }
+  EXPECT_NEAR(on_floor.ground(0).toe, 0.0f, 1e-3f);
+  EXPECT_NEAR(on_floor.ground(0).heel, 0.0f, 1e-3f);
+  // The same foot already standing on the box's edge (its ground there), the body on the floor.
+  FootPlacement on_edge;
+  on_edge.reset(0.35f);
+  for (int f = 0; f < 30; ++f) {
+    on_edge.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f), kDt);
+  }
+  EXPECT_NEAR(on_edge.ground(0).toe, 0.35f, 1e-3f);
+  EXPECT_NEAR(on_edge.ground(0).heel, 0.35f, 1e-3f);
+}
+
 TEST(FootPlacement, AProbeThatMissesFallsBackToTheBodysGround) {
   AnalyticWorld world;
   world.height = [](double, double) { return -5.0; };  // far below any probe's reach

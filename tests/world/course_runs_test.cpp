@@ -243,6 +243,26 @@ TEST(CourseRuns, AHandPastAWallsEndDoesNotThrowTheBody) {
   EXPECT_LE(m.ground.wall_depth_cm_max, 2.0);
 }
 
+// Up the second course's stairs_20_25 (stop-and-go from x = 11.5 at 1/30 s on the tests'
+// database): a foot landing on the first tread 6 cm before the next riser had its ground raised
+// toward the next tread by the probes' look-ahead, and its contact label came on with the toe
+// 25 cm above its tread: locked there, it stood in the air until its ground came back down (13
+// updates over 15 cm up). A lock begins only on a toe near the ground under it now.
+TEST(CourseRuns, AFootLandingShortOfAStepIsNotLockedInTheAir) {
+  const CourseRun r{"data/levels/course2.glb", "stop-and-go.txt", {11.5, 2.0}, 1.0f / 30.0f};
+  const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
+  const int toes[2] = {roles.left_toe, roles.right_toe};
+  int in_the_air = 0;
+  run(r, [&](const EvaluationFrame& frame) {
+    for (int side = 0; side < 2; ++side) {
+      const float under = std::max(frame.toe_ground[side], frame.toe_support[side]);
+      const float height = frame.joints[static_cast<size_t>(toes[side])].y - under;
+      in_the_air += frame.locked[side] && height > 0.15f ? 1 : 0;
+    }
+  });
+  EXPECT_LE(in_the_air, 3);
+}
+
 // The largest horizontal acceleration (m/s^2) of the simulation object over a run.
 float largest_simulation_acceleration(const CourseRun& r) {
   double largest = 0.0;

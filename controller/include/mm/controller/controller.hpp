@@ -629,7 +629,8 @@ class Controller {
   void move_root(const glm::vec3& position, const glm::quat& rotation);
   void foot_lock(float dt);
   glm::vec3 foot_target(int side, const glm::vec3& animated, const glm::vec3& on_ground,
-                        bool contact, bool settling, float dt);
+                        bool contact, bool grounded, bool settling, float dt);
+  bool on_its_ground(int side, const glm::vec3& on_ground) const;
   float toe_ground(int side) const;
   bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
   bool contact_label_holds(int side) const;

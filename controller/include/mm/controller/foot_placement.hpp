@@ -117,6 +117,9 @@ class FootPlacement {
   // The ground probed under the toe now (its footprint's edge included), without the look-ahead
   // that raises a foot's ground before a step.
   float ground_under_toe(int side) const;
+  // The ground probed under the heel now (resting on a tread's edge where the toe is on it), also
+  // without the look-ahead.
+  float ground_under_heel(int side) const;
 
   // The rotation that pitches a foot whose heel-to-toe line is `along` (the animated one, after
   // any heading swivel) so that heel and toe each keep their animated height above their own
@@ -158,7 +161,8 @@ class FootPlacement {
   void keep_steps_ahead();
   float plane_height(int side, int which, const glm::vec3& at) const;
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
-  FootGround goal(int side, const FootPlacementSettings& settings, float foot_length) const;
+  FootGround goal(int side, const FootPlacementSettings& settings, float foot_length,
+                  bool planted) const;
   void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
                   std::span<const PlacementLeg, 2> legs, float body_ground);
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
