@@ -632,21 +632,17 @@ TEST(FootPlacement, APlantedFootsHeelOverAHighStepDoesNotLiftItOffTheFloor) {
   std::array<PlacementLeg, 2> legs{standing_leg(0.0f, -0.05f, 0.0f),
                                    standing_leg(0.3f, 0.5f, 0.0f)};
   legs[0].toe = glm::vec3(0.0f, 0.03f, 0.1f);
-  FootPlacement on_floor;
-  on_floor.reset(0.0f);
-  for (int f = 0; f < 30; ++f) {
-    on_floor.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f), kDt);
+  // Planted on the floor, then the same foot already standing on the box's edge (its ground
+  // there), the body on the floor both times: each foot stays on the ground it stood on.
+  for (const float stood : {0.0f, 0.35f}) {
+    FootPlacement p;
+    p.reset(stood);
+    for (int f = 0; f < 30; ++f) {
+      p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f), kDt);
+    }
+    EXPECT_NEAR(p.ground(0).toe, stood, 1e-3f);
+    EXPECT_NEAR(p.ground(0).heel, stood, 1e-3f);
   }
-  EXPECT_NEAR(on_floor.ground(0).toe, 0.0f, 1e-3f);
-  EXPECT_NEAR(on_floor.ground(0).heel, 0.0f, 1e-3f);
-  // The same foot already standing on the box's edge (its ground there), the body on the floor.
-  FootPlacement on_edge;
-  on_edge.reset(0.35f);
-  for (int f = 0; f < 30; ++f) {
-    on_edge.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f), kDt);
-  }
-  EXPECT_NEAR(on_edge.ground(0).toe, 0.35f, 1e-3f);
-  EXPECT_NEAR(on_edge.ground(0).heel, 0.35f, 1e-3f);
 }
 
 TEST(FootPlacement, AProbeThatMissesFallsBackToTheBodysGround) {
