@@ -402,12 +402,39 @@ void Controller::settle_on_ground() {
 // course's corner wall; docs/world.md, session 27). The head and the trunk are pushed out at
 // once.
 void Controller::keep_body_off_walls(float dt) {
-  struct Depth {
-    glm::vec3 normal;
-    float depth;
-    bool arm;
-  };
-  std::array<Depth, 2 + 2 * kReachingJoints> walls;
+  std::array<WallDepth, kMaxWallDepths> walls;
+  const std::span<const WallDepth> found = std::span(walls).first(wall_depths(walls));
+  critical_spring_update(wall_push_, wall_push_velocity_, glm::vec3(0.0f), kWallPushHalflife, dt);
+  // Twice over: where two walls meet at less than a right angle, the push out of one takes some of
+  // the push out of the other back.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const WallDepth& wall : found) {
+      const float short_by = std::min(wall.depth, kMaxWallPush) - glm::dot(wall_push_, wall.normal);
+      if (short_by <= 0.0f) continue;
+      wall_push_ += wall.normal * short_by;
+      wall_push_velocity_ -= wall.normal * glm::dot(wall_push_velocity_, wall.normal);
+      if (wall.arm) arm_push_lag_ += wall.normal * short_by;
+    }
+  }
+  const float length = glm::length(wall_push_);
+  if (length > kMaxWallPush) wall_push_ *= kMaxWallPush / length;
+  follow_arm_push(found, dt);
+  if (length < 1e-5f) {
+    wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
+    arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
+    body_shift_ = glm::vec3(0.0f);
+  } else {
+    body_shift_ = wall_push_ - arm_push_lag_;
+    for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
+  }
+  keep_arms_off_walls();
+}
+
+// The walls the body is in, into `out`, and how many: the wall the simulation object stands
+// against (the joints higher than a step: the trunk and head's deepest, and the arms'), and the
+// walls found toward each hand, lower arm and the head (find_walls), with the upper arm's depth
+// in a hand's or lower arm's wall (the arm's swing turns about it, so only the push takes it out).
+size_t Controller::wall_depths(std::span<WallDepth, kMaxWallDepths> out) const {
   size_t count = 0;
   glm::vec3 point, n;
   if (wall_beside(point, n)) {
@@ -420,8 +447,8 @@ void Controller::keep_body_off_walls(float dt) {
         deepest = std::max(deepest, glm::dot(point - p, n));
       }
     }
-    walls[count++] = {n, depth[0], false};
-    walls[count++] = {n, depth[1], true};
+    out[count++] = {n, depth[0], false};
+    out[count++] = {n, depth[1], true};
   }
   const JointRoleIndices& roles = db_->roles();
   const int upper_arms[2] = {roles.left_upper_arm, roles.right_upper_arm};
@@ -431,52 +458,30 @@ void Controller::keep_body_off_walls(float dt) {
     const glm::vec3& p = globals_[static_cast<size_t>(hit.joint)].translation;
     // find_walls' list: the hands and the lower arms (left, right), then the head.
     const bool arm = k < 4;
-    walls[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal), arm};
-    // The arm's swing turns it about its upper arm, which only the push takes out of that wall.
+    out[count++] = {hit.normal, glm::dot(hit.point - p, hit.normal), arm};
     const int upper_arm = arm ? upper_arms[k % 2] : -1;
     if (upper_arm >= 0) {
       const glm::vec3& shoulder = globals_[static_cast<size_t>(upper_arm)].translation;
-      walls[count++] = {hit.normal, glm::dot(hit.point - shoulder, hit.normal), false};
+      out[count++] = {hit.normal, glm::dot(hit.point - shoulder, hit.normal), false};
     }
   }
-  critical_spring_update(wall_push_, wall_push_velocity_, glm::vec3(0.0f), kWallPushHalflife, dt);
-  // Twice over: where two walls meet at less than a right angle, the push out of one takes some of
-  // the push out of the other back.
-  for (int pass = 0; pass < 2; ++pass) {
-    for (size_t k = 0; k < count; ++k) {
-      const glm::vec3& normal = walls[k].normal;
-      const float short_by = std::min(walls[k].depth, kMaxWallPush) - glm::dot(wall_push_, normal);
-      if (short_by <= 0.0f) continue;
-      wall_push_ += normal * short_by;
-      wall_push_velocity_ -= normal * glm::dot(wall_push_velocity_, normal);
-      if (walls[k].arm) arm_push_lag_ += normal * short_by;
-    }
-  }
-  const float length = glm::length(wall_push_);
-  if (length > kMaxWallPush) wall_push_ *= kMaxWallPush / length;
-  // The arms' part of the push, followed with a bounded acceleration: never more than the push,
-  // and never leaving the trunk or the head in a wall.
+  return count;
+}
+
+// The arms' part of the push (arm_push_lag_), followed with a bounded acceleration: never more
+// than the push, and never leaving the trunk, the head or an upper arm in a wall.
+void Controller::follow_arm_push(std::span<const WallDepth> walls, float dt) {
   for (const int axis : {0, 2}) {
     approach(arm_push_lag_[axis], arm_push_lag_velocity_[axis], 0.0f, kArmPushAcceleration, dt);
   }
   const float lag = glm::length(arm_push_lag_);
   if (lag > glm::length(wall_push_)) arm_push_lag_ *= glm::length(wall_push_) / lag;
-  for (size_t k = 0; k < count; ++k) {
-    if (walls[k].arm) continue;
-    const glm::vec3& normal = walls[k].normal;
+  for (const WallDepth& wall : walls) {
+    if (wall.arm) continue;
     const float short_by =
-        std::min(walls[k].depth, kMaxWallPush) - glm::dot(wall_push_ - arm_push_lag_, normal);
-    if (short_by > 0.0f) arm_push_lag_ -= normal * short_by;
+        std::min(wall.depth, kMaxWallPush) - glm::dot(wall_push_ - arm_push_lag_, wall.normal);
+    if (short_by > 0.0f) arm_push_lag_ -= wall.normal * short_by;
   }
-  if (length < 1e-5f) {
-    wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
-    arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
-    body_shift_ = glm::vec3(0.0f);
-  } else {
-    body_shift_ = wall_push_ - arm_push_lag_;
-    for (size_t j = 1; j < globals_.size(); ++j) globals_[j].translation += body_shift_;
-  }
-  keep_arms_off_walls();
 }
 
 // Whether `joint` is below an upper arm (the skeleton keeps each joint's subtree after it): what

@@ -915,6 +915,16 @@ class Controller {
     glm::vec3 normal{0.0f};
   };
   static constexpr int kReachingJoints = 5;
+  // How deep the body is in a wall along its normal (keep_body_off_walls), and whether an arm's
+  // joints are (the push follows those with a bounded acceleration).
+  struct WallDepth {
+    glm::vec3 normal{0.0f};
+    float depth = 0.0f;
+    bool arm = false;
+  };
+  static constexpr int kMaxWallDepths = 2 + 2 * kReachingJoints;
+  size_t wall_depths(std::span<WallDepth, kMaxWallDepths> out) const;
+  void follow_arm_push(std::span<const WallDepth> walls, float dt);
   WallHit toe_walls_[2];
   WallHit riser_walls_[2];
   WallHit body_walls_[kReachingJoints];
