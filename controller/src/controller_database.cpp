@@ -13,6 +13,7 @@
 #include "mm/database/database.hpp"
 #include "mm/database/search_input.hpp"
 #include "mm/runtime/float_to_integer.hpp"
+#include "mm/runtime/transform.hpp"
 
 namespace mm {
 
@@ -81,23 +82,55 @@ ControllerDatabase::Speeds measure_speeds(const Database& db, uint64_t excluded_
   return speeds;
 }
 
-// The lowest height above the ground of `joint` in any frame (m): its global transform composed
-// along its chain of ancestors, joint 0 being relative to the ground.
-float lowest_height(const Database& db, int joint) {
+// `joint` and its ancestors, root first.
+std::vector<int> chain_to(const Database& db, int joint) {
   std::vector<int> chain;
   for (int j = joint; j >= 0; j = db.skeleton().parent(j)) chain.push_back(j);
   std::reverse(chain.begin(), chain.end());
+  return chain;
+}
+
+// The global transform of the chain's last joint at frame f, joint 0 being relative to the
+// ground (its clip's origin).
+Transform chain_global(const Database& db, std::span<const int> chain, int frame) {
   const size_t joints = static_cast<size_t>(db.joint_count());
+  Transform global;
+  for (const int j : chain) {
+    const size_t k = static_cast<size_t>(frame) * joints + static_cast<size_t>(j);
+    global = compose(global, Transform{db.local_rotations()[k], db.local_positions()[k]});
+  }
+  return global;
+}
+
+// The lowest height above the ground of `joint` in any frame (m).
+float lowest_height(const Database& db, int joint) {
+  const std::vector<int> chain = chain_to(db, joint);
   float lowest = std::numeric_limits<float>::infinity();
-  for (size_t f = 0; f < static_cast<size_t>(db.frame_count()); ++f) {
-    Transform global;
-    for (const int j : chain) {
-      const size_t k = f * joints + static_cast<size_t>(j);
-      global = compose(global, Transform{db.local_rotations()[k], db.local_positions()[k]});
-    }
-    lowest = std::min(lowest, global.translation.y);
+  for (int f = 0; f < db.frame_count(); ++f) {
+    lowest = std::min(lowest, chain_global(db, chain, f).translation.y);
   }
   return std::isfinite(lowest) ? lowest : 0.0f;
+}
+
+// ControllerDatabase::next_landing of one side for every frame: each clip walked backward,
+// remembering its latest frame whose label is on (the frame itself where it is).
+void find_landings(const Database& db, int side, int end_joint,
+                   std::span<ControllerDatabase::FootLanding> landings) {
+  const std::vector<int> chain = chain_to(db, end_joint);
+  const int horizon = clamped_integer<int>(
+      std::floor(ControllerDatabase::kLandingHorizon / db.frame_time()));
+  for (const ClipRange& clip : db.clips()) {
+    int next = -1;  // the clip's next frame with the label on
+    for (int f = clip.end - 1; f >= clip.start; --f) {
+      ControllerDatabase::FootLanding& out = landings[2 * static_cast<size_t>(f) +
+                                                      static_cast<size_t>(side)];
+      if (db.contacts()[2 * static_cast<size_t>(f) + static_cast<size_t>(side)] != 0) next = f;
+      if (next < 0 || next - f > horizon) continue;
+      const Transform root = chain_global(db, std::span(chain).first(1), f);
+      out.toe = transform_point(inverse(root), chain_global(db, chain, next).translation);
+      out.found = true;
+    }
+  }
 }
 
 // A knee's bend axis in its own frame (ControllerDatabase::knee_hinge): the mean of its local
@@ -190,6 +223,8 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   for (int side = 0; side < 2; ++side) {
     const bool toe = toes[side] >= 0 && db.skeleton().parent(toes[side]) == feet[side];
     out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
+    if (side == 0) out->landings_.resize(2 * static_cast<size_t>(db.frame_count()));
+    find_landings(db, side, toe ? toes[side] : feet[side], out->landings_);
     const int knee = db.skeleton().parent(feet[side]);
     if (knee > 0) out->knee_hinge_[side] = measure_knee_hinge(db, knee);
   }

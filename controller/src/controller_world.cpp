@@ -714,6 +714,11 @@ void Controller::place_feet(float dt) {
     // along under its label: they look ahead like any other.
     p.planted = f.locked || (contact_label_holds(side) && !f.stepping);
     p.near_ground = p.planted || p.toe.y - ground_height_ - p.lowest < kNearGroundHeight;
+    const PlaybackPoint& played = sampled_at_;
+    const ControllerDatabase::FootLanding landing =
+        shared_->next_landing(played.weight < 0.5f ? played.frame0 : played.frame1, side);
+    p.lands = landing.found;
+    p.landing = transform_point(globals_[0], landing.toe);
   }
   // A toe a wall keeps out (keep_toe_off_wall) is probed where it is kept, not where the
   // animation would put it past the wall: held on a ledge's top while the animation swings it

@@ -250,10 +250,10 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
     const glm::vec3 own = leg.planted ? glm::vec3(0.0f) : own_lookahead(side, leg);
     probe_points_[slot(side, kHeel)] = leg.ankle;
     probe_points_[slot(side, kToe)] = leg.toe;
-    probe_points_[slot(side, kHeelAhead)] = leg.ankle + body;
-    probe_points_[slot(side, kToeAhead)] = leg.toe + body;
-    probe_points_[slot(side, kHeelOwn)] = leg.ankle + own;
-    probe_points_[slot(side, kToeOwn)] = leg.toe + own;
+    probe_points_[slot(side, kHeelAhead)] = short_of_landing(leg.ankle, body, leg);
+    probe_points_[slot(side, kToeAhead)] = short_of_landing(leg.toe, body, leg);
+    probe_points_[slot(side, kHeelOwn)] = short_of_landing(leg.ankle, own, leg);
+    probe_points_[slot(side, kToeOwn)] = short_of_landing(leg.toe, own, leg);
     for (int which = 0; which < kPerSide; ++which) {
       const glm::vec3& p = probe_points_[slot(side, which)];
       probes_[slot(side, which)] = GroundProbe{glm::vec3(p.x, top[side], p.z), reach[side], 0.0f};
@@ -281,6 +281,20 @@ glm::vec3 FootPlacement::own_lookahead(int side, const PlacementLeg& leg) const 
   // kerb and lost again every other update, the swinging leg lifting and dropping).
   if (leg.held_at_step) return back + ahead;
   return glm::dot(back, back) > glm::dot(ahead, ahead) ? back : ahead;
+}
+
+// `from` (the heel or the toe) moved by a look-ahead `way` (horizontal), the way shortened to end
+// at most kPastLanding beyond where the toe lands (measured along the way): the heel too looks
+// as far as that, a foot's length past its own landing. Given the toe's shortened way instead, a
+// heel coming onto a stair's landing behind a toe already over it dipped 7 cm toward the tread
+// below, its look-ahead no longer on the landing (the first course's stairs).
+glm::vec3 FootPlacement::short_of_landing(const glm::vec3& from, const glm::vec3& way,
+                                          const PlacementLeg& leg) {
+  const float length = glm::length(way);
+  if (!leg.lands || !(length > 1e-4f)) return from + way;
+  const glm::vec3 to_landing(leg.landing.x - from.x, 0.0f, leg.landing.z - from.z);
+  const float reach = glm::dot(to_landing, way) / length + kPastLanding;
+  return from + way * std::clamp(reach / length, 0.0f, 1.0f);
 }
 
 // What a foot's steps down and ledges are measured from: the body's ground, or the foot's own

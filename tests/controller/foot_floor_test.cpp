@@ -69,6 +69,61 @@ TEST(FootFloorTest, TheDataLowestToeIsTheLowestOfEveryFrame) {
   }
 }
 
+// Where each clip next puts each toe down (ControllerDatabase::next_landing), found again here
+// with the runtime's forward kinematics over every frame: the toe at the clip's first frame from
+// this one on whose label is on, in this frame's root frame; nothing beyond the horizon or the
+// clip's end. The frames at the horizon itself are left out (rounding decides them).
+TEST(FootFloorTest, TheNextLandingIsWhereTheClipNextPutsTheToeDown) {
+  const ControllerDatabase& shared = *normal_controller_database();
+  const Database& db = shared.database();
+  const size_t joints = static_cast<size_t>(db.joint_count());
+  const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
+  const double horizon = ControllerDatabase::kLandingHorizon / db.frame_time();
+  std::vector<Transform> local(joints), global(joints);
+  std::vector<std::vector<Transform>> clip_globals;
+  int found = 0, past_horizon = 0, in_the_air = 0;
+  for (const ClipRange& clip : db.clips()) {
+    clip_globals.clear();
+    for (int f = clip.start; f < clip.end; ++f) {
+      for (size_t j = 0; j < joints; ++j) {
+        const size_t k = static_cast<size_t>(f) * joints + j;
+        local[j] = Transform{db.local_rotations()[k], db.local_positions()[k]};
+      }
+      forward_kinematics(db.skeleton().parents(), local, global);
+      clip_globals.push_back(global);
+    }
+    for (int side = 0; side < 2; ++side) {
+      for (int f = clip.start; f < clip.end; ++f) {
+        int next = f;
+        while (next < clip.end && db.contacts()[2 * static_cast<size_t>(next) + side] == 0) ++next;
+        const ControllerDatabase::FootLanding landing = shared.next_landing(f, side);
+        const double ahead = next - f;
+        if (next == clip.end || ahead > horizon + 1.0) {
+          EXPECT_FALSE(landing.found) << clip.name << " frame " << f << " side " << side;
+          ++past_horizon;
+          continue;
+        }
+        if (ahead > horizon - 1.0) continue;
+        in_the_air += next > f ? 1 : 0;
+        ASSERT_TRUE(landing.found) << clip.name << " frame " << f << " side " << side;
+        const Transform& root = clip_globals[static_cast<size_t>(f - clip.start)][0];
+        const glm::vec3 toe =
+            clip_globals[static_cast<size_t>(next - clip.start)][static_cast<size_t>(toes[side])]
+                .translation;
+        const glm::vec3 expected = glm::conjugate(root.rotation) * (toe - root.translation);
+        EXPECT_LT(glm::length(landing.toe - expected), 1e-4f)
+            << clip.name << " frame " << f << " side " << side;
+        ++found;
+      }
+    }
+  }
+  EXPECT_GT(in_the_air, 1000);
+  EXPECT_GT(found, in_the_air);
+  EXPECT_GT(past_horizon, 0);
+  EXPECT_FALSE(shared.next_landing(-1, 0).found);
+  EXPECT_FALSE(shared.next_landing(db.frame_count(), 1).found);
+}
+
 // The shipped scripts where toes sank below the data's lowest before foot IK held them
 // (reversals at a walk and a run, walks and runs with stops), at every rate.
 TEST(FootFloorTest, ToesStayAtOrAboveTheDataLowestWithIk) {

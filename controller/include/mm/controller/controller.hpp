@@ -127,6 +127,20 @@ class ControllerDatabase {
   // rotations where it is bent, the data's knees bending far further forward than back. Zero
   // where a knee does not turn about one axis (foot IK then bends it toward a pole).
   glm::vec3 knee_hinge(int side) const { return knee_hinge_[side != 0 ? 1 : 0]; }
+  // Where the clip playing `frame` next puts a leg's end down (index 0 left, 1 right): the end
+  // joint (as lowest_foot_end) at the clip's first frame from `frame` on whose contact label is
+  // on, within kLandingHorizon, in `frame`'s root frame (m); where the label is on, where it
+  // stands (a foot the controller lets slide or step under its label lands there). Not found
+  // where the clip ends or the horizon passes first, nor for frames out of range.
+  struct FootLanding {
+    glm::vec3 toe{0.0f};
+    bool found = false;
+  };
+  static constexpr float kLandingHorizon = 0.6f;  // s
+  FootLanding next_landing(int frame, int side) const {
+    const size_t k = 2 * static_cast<size_t>(frame) + (side != 0 ? 1 : 0);
+    return frame >= 0 && k < landings_.size() ? landings_[k] : FootLanding{};
+  }
 
   // Tag bits: clips that are not locomotion (carry "action"), and the synthesized idle clip.
   uint64_t action_tags() const { return action_tags_; }
@@ -173,6 +187,7 @@ class ControllerDatabase {
   Speeds speeds_;
   float lowest_foot_end_[2] = {0.0f, 0.0f};
   glm::vec3 knee_hinge_[2] = {glm::vec3(0.0f), glm::vec3(0.0f)};
+  std::vector<FootLanding> landings_;  // [frame * 2 + side]
   uint64_t action_tags_ = 0;
   uint64_t idle_tags_ = 0;
   std::vector<uint64_t> style_tags_;  // per style id

@@ -5,8 +5,9 @@
 // step up, a tread down, a slope under the toe. Once per update, after forward kinematics and
 // before foot locking, FootPlacement
 // 1. probes the world under each foot's heel (ankle) and toe, and under where they are heading
-//    (the body's velocity ahead, and the toe's own), in one batched call of kQueries probes,
-//    and sweeps each planted toe's way toward its hip, in one more call (two sweeps);
+//    (the body's velocity ahead, and the toe's own, neither much past where the playing clip
+//    puts the toe down), in one batched call of kQueries probes, and sweeps each planted toe's
+//    way toward its hip, in one more call (two sweeps);
 // 2. keeps per foot the height of the ground under its heel and its toe: the higher of "now"
 //    and "ahead" (a toe lifts before the stair's riser, never into it), the two heights within
 //    the steepest tilt of each other (a foot half over a step edge rests on the higher support,
@@ -59,6 +60,10 @@ struct PlacementLeg {
   // Held back by the side of a step it is not yet above (a riser): it waits there while it
   // rises, looking for its ground over the step.
   bool held_at_step = false;
+  // Where the playing clip next puts this toe down, when it does soon
+  // (ControllerDatabase::next_landing): a toe in the air looks no farther ahead than past it.
+  glm::vec3 landing{0.0f};
+  bool lands = false;
 };
 
 struct FootPlacementSettings {
@@ -96,6 +101,10 @@ class FootPlacement {
   // (a step to the side or a turn's step goes where the body does not) times kToeLookahead.
   static constexpr float kLookahead = 0.2f;
   static constexpr float kToeLookahead = 0.1f;
+  // A toe about to land looks at most this far (m) past where it lands, along either
+  // look-ahead: what lies farther is where the body goes, not the foot (a box the next step
+  // reaches, seen from the step landing short of it, raised that foot toward its top).
+  static constexpr float kPastLanding = 0.1f;
   // A leg may straighten to this share of its length to reach a lower foot's ground before
   // the pelvis has to drop.
   static constexpr float kMaxLegExtension = 0.97f;
@@ -154,6 +163,8 @@ class FootPlacement {
   void place_probes(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
                     float body_ground, const glm::vec3& body_velocity);
   glm::vec3 own_lookahead(int side, const PlacementLeg& leg) const;
+  static glm::vec3 short_of_landing(const glm::vec3& from, const glm::vec3& way,
+                                    const PlacementLeg& leg);
   float below_foot(int side, float body_ground) const;
   float found(int i, float body_ground, const FootPlacementSettings& settings) const;
   void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
