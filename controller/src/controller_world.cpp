@@ -751,6 +751,9 @@ void Controller::place_feet(float dt) {
   for (int side = 0; side < 2; ++side) {
     ground_offset_[side] = foot_placement_.ground(side).toe - ground_height_ + drop;
     debug_.foot_ground[side] = foot_placement_.ground(side);
+    debug_.foot_landing[side] = legs[static_cast<size_t>(side)].landing;
+    debug_.foot_lands[side] =
+        legs[static_cast<size_t>(side)].lands && !legs[static_cast<size_t>(side)].planted;
   }
   std::copy(foot_placement_.probe_points().begin(), foot_placement_.probe_points().end(),
             debug_.foot_probes);

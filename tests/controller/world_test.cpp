@@ -66,6 +66,38 @@ TEST(ControllerWorld, AFlatWorldMovesTheCharacterExactlyAsNoWorld) {
   EXPECT_LE(flat.probe_calls.load() + flat.sweep_calls.load(), 600 * kMaxWorldCallsPerUpdate);
 }
 
+// The debug drawing's landing (ControllerDebug::foot_landing): walking on, each foot in the air
+// shows where the playing clip puts it down, and the lock that holds it there begins within 10 cm
+// of the last one shown; a held foot shows none.
+TEST(ControllerWorld, AFootInTheAirShowsWhereItLands) {
+  AnalyticWorld flat;
+  Controller c = make_controller();
+  c.set_world(&flat);
+  glm::vec3 shown[2] = {};
+  bool any_shown[2] = {false, false}, was_locked[2] = {false, false};
+  int locks = 0, near = 0;
+  for (int f = 0; f < 6 * 60; ++f) {
+    c.update(kDt, push_toward(0.0f));
+    const ControllerDebug& d = c.debug();
+    for (int side = 0; side < 2; ++side) {
+      // Held since the update before (the placement runs before this update's lock).
+      if (d.locked[side] && was_locked[side]) {
+        EXPECT_FALSE(d.foot_lands[side]) << f;
+      }
+      if (d.locked[side] && !was_locked[side] && any_shown[side] && f > 60) {
+        ++locks;
+        const glm::vec3 held = d.lock_position[side];
+        near += std::hypot(held.x - shown[side].x, held.z - shown[side].z) < 0.1f ? 1 : 0;
+      }
+      was_locked[side] = d.locked[side];
+      if (d.foot_lands[side]) shown[side] = d.foot_landing[side];
+      any_shown[side] |= d.foot_lands[side];
+    }
+  }
+  EXPECT_GE(locks, 6);
+  EXPECT_GE(near, locks - 1) << near << " of " << locks;
+}
+
 TEST(ControllerWorld, HeadOnIntoAWallTheCharacterStopsBeforeItAndStands) {
   AnalyticWorld world;
   world.boxes.push_back(wall_across_z(4.0f));

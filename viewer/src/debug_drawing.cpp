@@ -137,7 +137,8 @@ void draw_contacts(const Controller& controller, DebugLines& lines) {
 }
 
 // Feet on a level's ground: each probe from the foot down to the ground it found (a cross
-// there), and the pelvis drop as a bar from where the hips would be down to where they are.
+// there), where each foot in the air lands by the playing clip (a circle on its ground), and the
+// pelvis drop as a bar from where the hips would be down to where they are.
 void draw_foot_placement(const Controller& controller, DebugLines& lines) {
   if (!controller.world()) return;
   const ControllerDebug& d = controller.debug();
@@ -145,6 +146,12 @@ void draw_foot_placement(const Controller& controller, DebugLines& lines) {
     const glm::vec3 found = d.world(d.foot_probe_grounds[i]);
     lines.line(d.world(d.foot_probes[i]), found, kProbe);
     lines.cross(found, 0.02f, kProbe);
+  }
+  for (int side = 0; side < 2; ++side) {
+    if (!d.foot_lands[side]) continue;
+    glm::vec3 landing = d.world(d.foot_landing[side]);
+    landing.y = static_cast<float>(d.origin.y + d.foot_ground[side].toe) + kLift;
+    lines.circle(landing, 0.04f, kProbe, 12);
   }
   const int hips = controller.controller_database().database().roles().hips;
   if (hips < 0 || d.pelvis_drop <= 0.0f) return;

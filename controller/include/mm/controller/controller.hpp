@@ -432,6 +432,10 @@ struct ControllerDebug {
   glm::vec3 foot_probe_grounds[FootPlacement::kProbes] = {};
   FootGround foot_ground[2] = {};
   float pelvis_drop = 0.0f;
+  // Where each foot in the air lands by the playing clip (ControllerDatabase::next_landing), its
+  // look-aheads shortened to a little past it; foot_lands false for a planted foot or none found.
+  glm::vec3 foot_landing[2] = {};
+  bool foot_lands[2] = {false, false};
 
   // Feet: 0 left, 1 right.
   bool contact[2] = {false, false};  // the playing frame's contact, false while stepping
