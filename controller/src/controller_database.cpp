@@ -117,17 +117,21 @@ float lowest_height(const Database& db, int joint) {
 void find_landings(const Database& db, int side, int end_joint,
                    std::span<ControllerDatabase::FootLanding> landings) {
   const std::vector<int> chain = chain_to(db, end_joint);
-  const int horizon = clamped_integer<int>(
-      std::floor(ControllerDatabase::kLandingHorizon / db.frame_time()));
+  const int horizon =
+      clamped_integer<int>(std::floor(ControllerDatabase::kLandingHorizon / db.frame_time()));
   for (const ClipRange& clip : db.clips()) {
-    int next = -1;  // the clip's next frame with the label on
+    int next = -1;  // the clip's next frame with the label on, and its toe
+    glm::vec3 next_toe(0.0f);
     for (int f = clip.end - 1; f >= clip.start; --f) {
-      ControllerDatabase::FootLanding& out = landings[2 * static_cast<size_t>(f) +
-                                                      static_cast<size_t>(side)];
-      if (db.contacts()[2 * static_cast<size_t>(f) + static_cast<size_t>(side)] != 0) next = f;
+      ControllerDatabase::FootLanding& out =
+          landings[2 * static_cast<size_t>(f) + static_cast<size_t>(side)];
+      if (db.contacts()[2 * static_cast<size_t>(f) + static_cast<size_t>(side)] != 0) {
+        next = f;
+        next_toe = chain_global(db, chain, f).translation;
+      }
       if (next < 0 || next - f > horizon) continue;
       const Transform root = chain_global(db, std::span(chain).first(1), f);
-      out.toe = transform_point(inverse(root), chain_global(db, chain, next).translation);
+      out.toe = transform_point(inverse(root), next_toe);
       out.found = true;
     }
   }

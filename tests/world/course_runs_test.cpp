@@ -282,7 +282,8 @@ TEST(CourseRuns, AFootStoppingShortOfABoxIsNotRaisedTowardItsTop) {
       for (int side = 0; side < 2; ++side) {
         const float placed = frame.placed_toe_ground[side];
         if (!frame.locked[side]) {
-          if (placed - frame.toe_ground[side] > 0.2f) highest[side] = std::max(highest[side], placed);
+          if (placed - frame.toe_ground[side] > 0.2f)
+            highest[side] = std::max(highest[side], placed);
           over_it[side] |= highest[side] > 0.0f && frame.toe_ground[side] > highest[side] - 0.05f;
           continue;
         }
