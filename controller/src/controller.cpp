@@ -70,6 +70,12 @@ constexpr float kPlantedSpeed = 0.35f;
 // A lock begins only on a toe at most this high (m) above the ground under it now: the data's
 // labelled toes stand lower.
 constexpr float kLockAboveGround = 0.12f;
+// Nor on a toe whose ground still rises faster than this (m/s), on its way onto a step: at
+// stairs_down's riser, its ground rising toward the tread, a toe whose footprint had reached the
+// tread's edge was locked 3.6 cm above the tread, in front of its edge; its ground fell back the
+// next update and the toe, let go, swung on over the tread 0.33 cm above it (docs/world.md,
+// session 28).
+constexpr float kLockGroundRising = 0.5f;
 // A labelled contact whose animated toe moves horizontally faster than this (m/s) is not held:
 // planted toes in the data move under 0.3 m/s, and some clips label a toe sweeping in at a
 // run's landing or out at its push-off. Held there, the toe stops dead and the leg snaps after
@@ -1384,12 +1390,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   f.previous_contact = contact;
   // The release's first update holds the toe where it was: its offset starts decaying from
   // rest on the next.
-  if (!released) {
-    critical_spring_apply(
-        f.offset, f.offset_velocity, glm::vec3(0.0f),
-        foot_springs_[side].offset.step(
-            std::max(f.release_halflife, settings_.foot_lock_release_halflife), dt));
-  }
+  if (!released) decay_offset(side, f.offset, f.offset_velocity, dt);
   glm::vec3 target = on_ground;
   // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting
   // off is no longer planted, and held down it would have that height to catch up on release.
@@ -1428,7 +1429,8 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   return target;
 }
 
-// Whether a toe (placed `on_ground`) is near enough the ground under it now for a lock to begin:
+// Whether a toe (placed `on_ground`) is near enough the ground under it now, and that ground still
+// enough (kLockGroundRising), for a lock to begin:
 // a foot whose ground the look-ahead raised toward a step it then lands short of (or a box its
 // heel swung over) has its contact label on in the air, and locked there it stood on nothing
 // until its ground came back down (docs/world.md, session 27). Under the heel counts too: a foot
@@ -1438,7 +1440,17 @@ bool Controller::on_its_ground(int side, const glm::vec3& on_ground) const {
   if (!world_) return true;
   const float under =
       std::max(foot_placement_.ground_under_toe(side), foot_placement_.ground_under_heel(side));
-  return on_ground.y - under < kLockAboveGround;
+  const float rising = foot_placement_.ground_velocity(side).toe;
+  return on_ground.y - under < kLockAboveGround && rising < kLockGroundRising;
+}
+
+// A released toe's offset and its rate moved on by one update's decay back to the animation.
+void Controller::decay_offset(int side, glm::vec3& offset, glm::vec3& velocity, float dt) {
+  const FootLock& f = feet_[side];
+  critical_spring_apply(
+      offset, velocity, glm::vec3(0.0f),
+      foot_springs_[side].offset.step(
+          std::max(f.release_halflife, settings_.foot_lock_release_halflife), dt));
 }
 
 // Whether the playing frame's contact label holds the toe: not where the animated toe moves

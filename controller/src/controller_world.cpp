@@ -547,7 +547,8 @@ glm::vec3 Controller::without_slide_back(const glm::vec3& step, float dt) const 
 // walls), along each toe in the air's way (risers), and to each hand, elbow and the head at
 // their own height when higher than a step. One batched call. The capsule keeps only the root a
 // radius from a wall; these reach past it.
-void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
+void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
+                            const std::array<glm::vec3, 2>& shown_toes) {
   const JointRoleIndices& roles = db_->roles();
   const int reaching[kReachingJoints] = {roles.left_hand, roles.right_hand, roles.left_lower_arm,
                                          roles.right_lower_arm, roles.head};
@@ -569,7 +570,11 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
   // A toe in the air, from where it was to where it goes, at its height over its ground: the
   // side of a step it is not yet above (a riser) is a wall to it until it is. Without it the
   // toe went on into the riser and was lifted onto the tread in the update it got there (20 cm
-  // in an update).
+  // in an update). Where it goes is where the foot lock will show it (`shown_toes`: a released
+  // toe's offset decays on after the probes), and the sweep starts a radius behind where it was
+  // (a sphere starting in contact finds nothing). Swept to where the offset had it, a toe creeping
+  // toward stairs_20_25's landing was swept away from the riser and never held; its footprint
+  // reached the landing's edge and lifted it 11 cm in an update (docs/world.md, session 28).
   for (int side = 0; side < 2; ++side) {
     riser_walls_[side] = WallHit{};
     const FootLock& f = feet_[side];
@@ -577,11 +582,14 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
     const float height =
         std::max(f.target.y, toe.y + foot_placement_.ground(side).toe - ground_height_);
-    const glm::vec3 from(f.target.x, height, f.target.z), to(toe.x, height, toe.z);
-    if (glm::length(to - from) < 1e-4f) continue;
+    const glm::vec3& shown = shown_toes[static_cast<size_t>(side)];
+    const glm::vec3 from(f.target.x, height, f.target.z), to(shown.x, height, shown.z);
+    const float length = glm::length(to - from);
+    if (length < 1e-4f) continue;
     out[count] = &riser_walls_[side];
     least_share[count] = kRiserNormal;  // a riser is a side, not a ramp's slope run into
-    sweeps[count++] = ShapeSweep{from, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
+    const glm::vec3 back = (to - from) * (kWallProbeRadius / length);
+    sweeps[count++] = ShapeSweep{from - back, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
   for (int k = 0; k < kReachingJoints; ++k) {
     body_walls_[k] = WallHit{};
@@ -693,6 +701,7 @@ void Controller::place_feet(float dt) {
   ground_offset_[0] = ground_offset_[1] = 0.0f;
   if (!settings_.ik_enabled || !settings_.foot_lock_enabled) return;
   std::array<PlacementLeg, 2> legs;
+  std::array<glm::vec3, 2> shown_toes;
   for (int side = 0; side < 2; ++side) {
     const std::vector<int>& leg = leg_joints_[side];
     PlacementLeg& p = legs[static_cast<size_t>(side)];
@@ -704,6 +713,9 @@ void Controller::place_feet(float dt) {
     // as continuously as the foot does), not where the animation has it.
     const FootLock& f = feet_[side];
     const glm::vec3 at = f.locked ? f.position : p.toe + f.offset;
+    glm::vec3 offset = f.offset, offset_velocity = f.offset_velocity;
+    decay_offset(side, offset, offset_velocity, dt);
+    shown_toes[static_cast<size_t>(side)] = f.locked ? f.position : p.toe + offset;
     const glm::vec3 moved(at.x - p.toe.x, 0.0f, at.z - p.toe.z);
     p.shift = moved;
     p.toe += moved;
@@ -724,7 +736,7 @@ void Controller::place_feet(float dt) {
   // animation would put it past the wall: held on a ledge's top while the animation swings it
   // out over the drop, the ground found out there (the body's, a step lower) lowered it into the
   // ledge's edge.
-  find_walls(legs);
+  find_walls(legs, shown_toes);
   for (int side = 0; side < 2; ++side) {
     PlacementLeg& p = legs[static_cast<size_t>(side)];
     ease_wall_push(side, p.toe, dt);

@@ -296,6 +296,39 @@ TEST(CourseRuns, AFootStoppingShortOfABoxIsNotRaisedTowardItsTop) {
   EXPECT_LE(raised_short, 1);
 }
 
+// Turning on the spot on the second course's stairs_20_25 at 1/144 s: a toe creeping toward the
+// landing's riser (its offset decaying toward the animation, half a metre a second) was swept for
+// the riser from where it was shown to where the placement had it, a step of the decay behind and
+// pointing away from the riser: never held there, its footprint reached the landing's edge and
+// the ground under it jumped to the landing's top, 9.6 cm in one update. Swept to where the foot
+// lock will show it, from a radius behind (a sphere starting in contact finds nothing), it waits
+// at the riser while its ground rises.
+TEST(CourseRuns, AToeCreepingToARiserWaitsThereInsteadOfJumpingOntoTheStep) {
+  const CourseRun r{"data/levels/course2.glb", "stand-turns.txt", {11.5, 2.0}, 0.00694444f};
+  float previous[2] = {0.0f, 0.0f}, largest = 0.0f;
+  bool first = true;
+  run(r, [&](const EvaluationFrame& frame) {
+    for (int side = 0; side < 2; ++side) {
+      if (!first) largest = std::max(largest, frame.placed_toe_ground[side] - previous[side]);
+      previous[side] = frame.placed_toe_ground[side];
+    }
+    first = false;
+  });
+  EXPECT_LT(largest, 0.05f);
+}
+
+// Walking back and forth by stairs_down on the tests' database at 1/30 s: a toe at the tread's
+// riser, its ground rising, was locked with its footprint on the tread's edge, 3.6 cm above the
+// tread in front of it; its ground fell back the next update and the toe, let go, swung
+// over the tread 0.33 cm above it. A lock begins only on a toe whose ground is not rising.
+TEST(CourseRuns, AToeIsNotLockedWhileItsGroundRisesOntoAStep) {
+  // The time step offlane.sh gives mm eval: at 1/30 s exactly the run takes another way there.
+  const CourseRun r{"data/levels/course2.glb", "reversals.txt", {17.45, 2.0}, 0.0333333f};
+  const EvaluationMetrics m = run(r);
+  EXPECT_GE(m.ground.toe_clearance_cm_min, 1.0);
+  EXPECT_EQ(m.ground.foot_penetration_cm_max, 0.0);
+}
+
 // The largest horizontal acceleration (m/s^2) of the simulation object over a run.
 float largest_simulation_acceleration(const CourseRun& r) {
   double largest = 0.0;

@@ -582,7 +582,8 @@ class Controller {
   void keep_arms_off_walls();
   bool in_arm(int joint) const;
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
-  void find_walls(const std::array<PlacementLeg, 2>& legs);
+  void find_walls(const std::array<PlacementLeg, 2>& legs,
+                  const std::array<glm::vec3, 2>& shown_toes);
   void keep_toe_off_wall(int side, glm::vec3& target) const;
   void ease_wall_push(int side, const glm::vec3& toe, float dt);
   void ease_ledge_push(int side, const glm::vec3& toe, float dt);
@@ -653,6 +654,7 @@ class Controller {
   float toe_ground(int side) const;
   bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
   bool contact_label_holds(int side) const;
+  void decay_offset(int side, glm::vec3& offset, glm::vec3& velocity, float dt);
   void hold_heading(int side, float dt);
   glm::vec3 playing_leg_end(int side);
   int leg_end(int side) const;

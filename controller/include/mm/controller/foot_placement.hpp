@@ -122,6 +122,8 @@ class FootPlacement {
               float body_ground, const glm::vec3& body_velocity, float dt);
 
   const FootGround& ground(int side) const { return feet_[side != 0 ? 1 : 0].ground; }
+  // How fast each foot's ground moves (m/s): rising onto a step, falling off one; 0 at rest.
+  const FootGround& ground_velocity(int side) const { return feet_[side != 0 ? 1 : 0].velocity; }
   float pelvis_drop() const { return pelvis_drop_; }
   // The ground probed under the toe now (its footprint's edge included), without the look-ahead
   // that raises a foot's ground before a step.
