@@ -1429,13 +1429,12 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   return target;
 }
 
-// Whether a toe (placed `on_ground`) is near enough the ground under it now, and that ground still
-// enough (kLockGroundRising), for a lock to begin:
-// a foot whose ground the look-ahead raised toward a step it then lands short of (or a box its
-// heel swung over) has its contact label on in the air, and locked there it stood on nothing
-// until its ground came back down (docs/world.md, session 27). Under the heel counts too: a foot
-// on a tread's edge, its toe out over the tread below, stands on the edge. Without a world the
-// toe is on its ground.
+// Whether a lock may begin on a toe placed `on_ground`: near enough the ground under it now, on
+// a ground not rising onto a step (kLockGroundRising). A foot whose ground the look-ahead raised
+// toward a step it then lands short of (or a box its heel swung over) has its contact label on in
+// the air, and locked there it stood on nothing until its ground came back down (docs/world.md,
+// session 27). Under the heel counts too: a foot on a tread's edge, its toe out over the tread
+// below, stands on the edge. Without a world the toe is on its ground.
 bool Controller::on_its_ground(int side, const glm::vec3& on_ground) const {
   if (!world_) return true;
   const float under =

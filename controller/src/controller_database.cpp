@@ -224,11 +224,12 @@ Result<std::shared_ptr<const ControllerDatabase>> ControllerDatabase::create(
   // The same end joint per leg as the controller's foot IK (Controller::resolve_joints).
   const int feet[2] = {db.roles().left_foot, db.roles().right_foot};
   const int toes[2] = {db.roles().left_toe, db.roles().right_toe};
+  out->landings_.resize(2 * static_cast<size_t>(db.frame_count()));
   for (int side = 0; side < 2; ++side) {
     const bool toe = toes[side] >= 0 && db.skeleton().parent(toes[side]) == feet[side];
-    out->lowest_foot_end_[side] = lowest_height(db, toe ? toes[side] : feet[side]);
-    if (side == 0) out->landings_.resize(2 * static_cast<size_t>(db.frame_count()));
-    find_landings(db, side, toe ? toes[side] : feet[side], out->landings_);
+    const int end = toe ? toes[side] : feet[side];
+    out->lowest_foot_end_[side] = lowest_height(db, end);
+    find_landings(db, side, end, out->landings_);
     const int knee = db.skeleton().parent(feet[side]);
     if (knee > 0) out->knee_hinge_[side] = measure_knee_hinge(db, knee);
   }
