@@ -1439,7 +1439,7 @@ bool Controller::on_its_ground(int side, const glm::vec3& on_ground) const {
   if (!world_) return true;
   const float under =
       std::max(foot_placement_.ground_under_toe(side), foot_placement_.ground_under_heel(side));
-  const float rising = foot_placement_.ground_velocity(side).toe;
+  const float rising = foot_placement_.toe_ground_rise(side);
   return on_ground.y - under < kLockAboveGround && rising < kLockGroundRising;
 }
 

@@ -102,6 +102,7 @@ void FootPlacement::reset(float ground) {
   for (Foot& foot : feet_) {
     foot.ground = FootGround{ground, ground};
     foot.velocity = FootGround{};
+    foot.toe_rise = 0.0f;
     foot.has_toe = false;
     foot.toe_velocity = glm::vec3(0.0f);
     foot.reach_shortfall = 0.0f;
@@ -124,6 +125,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
     const FootGround g = goal(side, settings, foot_length, legs[side].planted);
     Foot& foot = feet_[side];
+    const float toe_before = foot.ground.toe;
     // A planted foot's heel crossing a tread's edge (its ankle passing the edge by millimetres
     // as the foot turns on its held toe) rises more gently: the foot pivots about the held toe,
     // and the leg carried the whole rise into the knee (docs/world.md, session 23).
@@ -142,6 +144,7 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
     const PlacementLeg& leg = legs[side];
     const float lifted = leg.planted ? 0.0f : std::max(0.0f, leg.toe.y - body_ground - leg.lowest);
     stay_above(foot.ground.toe, foot.velocity.toe, probe_grounds_[slot(side, kToe)].y - lifted);
+    if (dt > 0.0f) foot.toe_rise = (foot.ground.toe - toe_before) / dt;
   }
   // Two springs in a row, each of half the halflife: the goal jumps as feet land and lift, and
   // one spring would answer each jump with a jump of the hips' vertical acceleration.

@@ -618,6 +618,35 @@ TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
   }
 }
 
+// A toe swung low across a tread's corner is lifted onto the tread the update it is over it
+// (stay_above), and its ground's follower goes on from rest there: the rise a lock must not begin
+// during (Controller::on_its_ground) is the ground's whole change over the update, the lift
+// included, not the follower's velocity.
+TEST(FootPlacement, AToesGroundLiftedOntoATreadReportsTheWholeRise) {
+  AnalyticWorld world;
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 1.3f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
+  CharacterMover mover;
+  FootPlacement p;
+  std::array<PlacementLeg, 2> legs{standing_leg(0.85f, 0.05f, 0.0f),
+                                   standing_leg(0.5f, -0.5f, 0.0f)};
+  legs[0].planted = legs[0].near_ground = false;
+  legs[0].lowest = 0.02f;
+  const FootPlacementSettings settings;
+  const glm::vec3 velocity(1.6f, 0.0f, 1.6f);
+  p.reset(0.0f);
+  float largest = 0.0f;
+  for (int f = 0; f < 10; ++f) {
+    legs[0].toe += velocity * kDt;
+    legs[0].ankle += velocity * kDt;
+    const float before = p.ground(0).toe;
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, velocity, kDt);
+    const float rise = (p.ground(0).toe - before) / kDt;
+    EXPECT_NEAR(p.toe_ground_rise(0), rise, 1e-3f) << f;
+    largest = std::max(largest, rise);
+  }
+  EXPECT_GT(largest, 0.5f);  // lifted onto the tread faster than a lock may begin on
+}
+
 // A foot planted on the floor before a box (0.35 m, higher than the foot's tilt reaches), its
 // heel swung back over the box's edge: lifted level with the heel it stood a box's height in the
 // air; it stays on the floor. A foot that already stood up there (its heel on the edge, its toe

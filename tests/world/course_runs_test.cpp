@@ -329,6 +329,30 @@ TEST(CourseRuns, AToeIsNotLockedWhileItsGroundRisesOntoAStep) {
   EXPECT_EQ(m.ground.foot_penetration_cm_max, 0.0);
 }
 
+// Turning on the spot on stairs_20_25's landing at 1/60 s, tests' database: a toe waiting at the
+// landing's riser, its ground rising toward the top, had its footprint reach the landing's edge
+// for one update: its ground was lifted 4.3 cm onto what was under it, a lift its follower
+// answers from rest, so the follower's velocity said the ground was not rising and a lock began 3
+// cm below the landing's top (Toes_L 144 m/s^2). The rise that keeps a lock from beginning is
+// the ground's whole change over the update. Counted: locks beginning on an update whose toe's
+// ground rose more than a centimetre.
+TEST(CourseRuns, NoLockBeginsOnTheUpdateAToesGroundIsLiftedOntoAStep) {
+  const CourseRun r{"data/levels/course2.glb", "stand-turns.txt", {11.5, 2.0}, 0.0166667f};
+  int lifted_locks = 0;
+  bool was_locked[2] = {false, false}, first = true;
+  float previous[2] = {0.0f, 0.0f};
+  run(r, [&](const EvaluationFrame& frame) {
+    for (int side = 0; side < 2; ++side) {
+      const float rise = frame.placed_toe_ground[side] - previous[side];
+      lifted_locks += !first && frame.locked[side] && !was_locked[side] && rise > 0.01f;
+      was_locked[side] = frame.locked[side];
+      previous[side] = frame.placed_toe_ground[side];
+    }
+    first = false;
+  });
+  EXPECT_EQ(lifted_locks, 0);
+}
+
 // The largest horizontal acceleration (m/s^2) of the simulation object over a run.
 float largest_simulation_acceleration(const CourseRun& r) {
   double largest = 0.0;

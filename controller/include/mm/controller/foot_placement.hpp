@@ -122,8 +122,9 @@ class FootPlacement {
               float body_ground, const glm::vec3& body_velocity, float dt);
 
   const FootGround& ground(int side) const { return feet_[side != 0 ? 1 : 0].ground; }
-  // How fast each foot's ground moves (m/s): rising onto a step, falling off one; 0 at rest.
-  const FootGround& ground_velocity(int side) const { return feet_[side != 0 ? 1 : 0].velocity; }
+  // How fast each toe's ground rose over the last update (m/s; negative falling): its follower's
+  // climb and any lift onto the ground under the toe, which its follower answers from rest.
+  float toe_ground_rise(int side) const { return feet_[side != 0 ? 1 : 0].toe_rise; }
   float pelvis_drop() const { return pelvis_drop_; }
   // The ground probed under the toe now (its footprint's edge included), without the look-ahead
   // that raises a foot's ground before a step.
@@ -151,6 +152,7 @@ class FootPlacement {
   struct Foot {
     FootGround ground;
     FootGround velocity;
+    float toe_rise = 0.0f;
     glm::vec3 toe{0.0f};  // the toe's position last update, and its horizontal velocity
     glm::vec3 toe_velocity{0.0f};
     bool has_toe = false;
