@@ -41,6 +41,13 @@ constexpr float kSideNormalY = 0.5f;
 constexpr float kProbeMargin = 0.02f;
 // Ground ahead this much higher than the plane of the ground under the foot (m) is a step.
 constexpr float kStepRise = 0.02f;
+// A step only a toe's own look-ahead sees, and not where it lands, is one it swings beside when
+// it is higher than this (m), a stair's riser: a lower one (a tread, a kerb, a bump of rough
+// ground) a foot crosses over on its way and has to clear (cut, a toe strafing across
+// stairs_down's treads toward a landing on the floor passed 2 mm over a tread's corner; on rough
+// ground the cut came and went as the landing moved over the bumps, dropping a swinging toe by
+// centimetres in an update).
+constexpr float kBesideStepRise = 0.2f;
 // Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
 constexpr float kEdgeRise = 0.01f;
 // A foot whose heel-to-toe line's horizontal extent is at least this share of its length is
@@ -63,6 +70,10 @@ constexpr int slot(int side, int which) {
 // The heel's or the toe's slot that a look-ahead slot looks ahead of.
 constexpr int now_of(int which) {
   return which % 2;
+}
+// The query slot probing where a side's toe lands.
+constexpr int landing_slot(int side) {
+  return FootPlacement::kProbes + 2 * FootPlacement::kFootprint + side;
 }
 
 // `pace` (FootPlacementSettings::pace) stretches the follower's time.
@@ -187,6 +198,7 @@ void FootPlacement::probe(const WorldQueries& world, const glm::dvec3& origin,
   rest_heels_on_edges(legs);
   stand_on_edges(body_ground, settings);
   keep_steps_ahead();
+  keep_own_lookahead_to_landings(legs, body_ground, settings);
   sweep_toes(world, origin, mover, legs, body_ground);
 }
 
@@ -268,6 +280,8 @@ void FootPlacement::place_probes(const FootPlacementSettings& settings,
                          leg.toe.z + kFootprintRadius * kAround[k][1]);
       probes_[kProbes + side * kFootprint + k] = GroundProbe{at, reach[side], 0.0f};
     }
+    probes_[landing_slot(side)] =
+        GroundProbe{glm::vec3(leg.landing.x, top[side], leg.landing.z), reach[side], 0.0f};
   }
 }
 
@@ -318,7 +332,9 @@ float FootPlacement::below_foot(int side, float body_ground) const {
 // steps down, was held level with the body 43 cm over the floor.)
 float FootPlacement::found(int i, float body_ground, const FootPlacementSettings& settings) const {
   const GroundHit& hit = hits_[static_cast<size_t>(i)];
-  const int side = i < kProbes ? i / kPerSide : (i - kProbes) / kFootprint;
+  const int side = i < kProbes           ? i / kPerSide
+                   : i < landing_slot(0) ? (i - kProbes) / kFootprint
+                                         : i - landing_slot(0);
   const float deepest =
       below_foot(side, body_ground) - settings.step_height - CharacterMover::kStepClearance;
   return hit.hit && hit.point.y >= deepest ? hit.point.y : body_ground;
@@ -378,6 +394,35 @@ void FootPlacement::keep_steps_ahead() {
       if (ahead_ground.y < plane_height(side, now, ahead_ground) + kStepRise) {
         ahead_ground.y = probe_grounds_[slot(side, now)].y;
       }
+    }
+  }
+}
+
+// A foot in the air comes down where its clip puts it (PlacementLeg::landing): a step that only
+// its own look-ahead sees, more than kBesideStepRise above the ground where it lands, under it now
+// and on the body's path (the body's look-ahead), is one it swings beside, not onto. Raised
+// toward it, a foot swinging along box_35's front face to land beside it rose to the box's top,
+// 47 cm over the floor it came down on (docs/world.md, session 29). The body's look-ahead is not
+// cut so: on stairs the clip's landing, predicted for flat ground, falls short of the tread the
+// foot goes onto. Nor a toe a riser holds back farther than kPastLanding from where the
+// animation puts it: the animation takes it over the step (a toe held at the side of
+// stairs_20_25's last tread, the animation 40 cm onto it, was dragged into the tread's corner by a
+// leg that could not reach it on the floor).
+void FootPlacement::keep_own_lookahead_to_landings(std::span<const PlacementLeg, 2> legs,
+                                                   float body_ground,
+                                                   const FootPlacementSettings& settings) {
+  for (int side = 0; side < 2; ++side) {
+    const PlacementLeg& leg = legs[side];
+    const bool headed_over =
+        leg.held_at_step && std::hypot(leg.shift.x, leg.shift.z) > kPastLanding;
+    if (leg.planted || !leg.lands || headed_over) continue;
+    const float landing = found(landing_slot(side), body_ground, settings);
+    const float cap = std::max(
+        {landing, probe_grounds_[slot(side, kHeel)].y, probe_grounds_[slot(side, kToe)].y,
+         probe_grounds_[slot(side, kHeelAhead)].y, probe_grounds_[slot(side, kToeAhead)].y});
+    for (const int own : {kHeelOwn, kToeOwn}) {
+      float& ahead = probe_grounds_[slot(side, own)].y;
+      if (ahead > cap + kBesideStepRise) ahead = cap;
     }
   }
 }

@@ -647,6 +647,49 @@ TEST(FootPlacement, AToesGroundLiftedOntoATreadReportsTheWholeRise) {
   EXPECT_GT(largest, 0.5f);  // lifted onto the tread faster than a lock may begin on
 }
 
+// A toe swinging along a box's front face (the body walking beside it), its own velocity veering
+// toward the face: its own look-ahead reaches over the box. Where the clip lands it on the floor
+// in front of the face, its ground stays on the floor; where the clip lands it on the box, or
+// where it is held at the face (a riser) with the animation 13 cm over the box, it rises.
+TEST(FootPlacement, AToeSwingingBesideABoxRisesOnlyWhereItGoesOntoIt) {
+  AnalyticWorld world;
+  // A box 0.3 m high (above a stair's riser) for z > 0.3.
+  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 1.3f), glm::vec2(1.0f, 1.0f), 0.0f, 0.3f});
+  CharacterMover mover;
+  const FootPlacementSettings settings;
+  const glm::vec3 body_velocity(-1.0f, 0.0f, 0.0f);  // along the face
+  const glm::vec3 toe_velocity(-1.0f, 0.0f, 0.6f);   // veering toward it
+  enum Case { kLandsBeside, kLandsOnIt, kHeldAtIt };
+  for (const Case c : {kLandsBeside, kLandsOnIt, kHeldAtIt}) {
+    FootPlacement p;
+    p.reset(0.0f);
+    std::array<PlacementLeg, 2> legs{standing_leg(0.5f, 0.08f, 0.0f),
+                                     standing_leg(0.0f, -0.3f, 0.0f)};
+    legs[0].planted = legs[0].near_ground = false;
+    legs[0].lowest = 0.02f;
+    legs[0].lands = true;
+    if (c == kHeldAtIt) {
+      legs[0].held_at_step = true;
+      legs[0].shift = glm::vec3(0.0f, 0.0f, -0.13f);
+    }
+    float highest = 0.0f;
+    for (int f = 0; f < 5; ++f) {
+      legs[0].toe += toe_velocity * kDt;
+      legs[0].ankle += toe_velocity * kDt;
+      legs[0].landing =
+          glm::vec3(legs[0].toe.x - 0.1f, 0.0f, c == kLandsOnIt ? 0.4f : legs[0].toe.z);
+      p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, body_velocity, kDt);
+      ASSERT_LT(legs[0].toe.z, 0.3f);  // never over the box itself
+      highest = std::max(highest, p.ground(0).toe);
+    }
+    if (c == kLandsBeside) {
+      EXPECT_EQ(highest, 0.0f);
+    } else {
+      EXPECT_GT(highest, 0.02f) << c;
+    }
+  }
+}
+
 // A foot planted on the floor before a box (0.35 m, higher than the foot's tilt reaches), its
 // heel swung back over the box's edge: lifted level with the heel it stood a box's height in the
 // air; it stays on the floor. A foot that already stood up there (its heel on the edge, its toe

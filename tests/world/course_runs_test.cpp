@@ -296,6 +296,25 @@ TEST(CourseRuns, AFootStoppingShortOfABoxIsNotRaisedTowardItsTop) {
   EXPECT_LE(raised_short, 1);
 }
 
+// Stop-and-go from x = 39.05 on the tests' database at 1/30 s: the character turns to walk along
+// box_35's front face, and a foot swinging along it to land beside the box had its look-ahead
+// (the toe's own velocity) reach over the face: its ground rose to the box's top, the foot 47 cm
+// over the floor it came down on, its toe swung over the face's edge on the way. A foot in the
+// air looks by its own motion no higher than where it lands or the body goes
+// (FootPlacement::keep_own_lookahead_to_landings). Counted:
+// updates with a toe in the air whose ground is raised more than 25 cm over the ground under it.
+TEST(CourseRuns, AFootSwingingAlongABoxToLandBesideItIsNotRaisedOntoItsTop) {
+  const CourseRun r{"data/levels/course2.glb", "stop-and-go.txt", {39.05, 2.0}, 0.0333333f};
+  int raised = 0;
+  run(r, [&](const EvaluationFrame& frame) {
+    for (int side = 0; side < 2; ++side) {
+      raised +=
+          !frame.locked[side] && frame.placed_toe_ground[side] - frame.toe_ground[side] > 0.25f;
+    }
+  });
+  EXPECT_EQ(raised, 0);
+}
+
 // Turning on the spot on the second course's stairs_20_25 at 1/144 s: a toe creeping toward the
 // landing's riser (its offset decaying toward the animation, half a metre a second) was swept for
 // the riser from where it was shown to where the placement had it, a step of the decay behind and

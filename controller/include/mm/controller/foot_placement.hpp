@@ -95,8 +95,9 @@ class FootPlacement {
   // side let a toe sink below the edge it was on. The toe stands on the highest of them.
   static constexpr int kFootprint = 4;
   static constexpr float kFootprintRadius = 0.015f;
-  // Ground probes per update, all in one call.
-  static constexpr int kQueries = kProbes + 2 * kFootprint;
+  // Ground probes per update, all in one call: the probes, the footprints, and where each toe
+  // lands.
+  static constexpr int kQueries = kProbes + 2 * kFootprint + 2;
   // How far ahead the probes look: the body's velocity times this (s), and the toe's own
   // (a step to the side or a turn's step goes where the body does not) times kToeLookahead.
   static constexpr float kLookahead = 0.2f;
@@ -174,6 +175,8 @@ class FootPlacement {
   void stand_on_edges(float body_ground, const FootPlacementSettings& settings);
   void rest_heels_on_edges(std::span<const PlacementLeg, 2> legs);
   void keep_steps_ahead();
+  void keep_own_lookahead_to_landings(std::span<const PlacementLeg, 2> legs, float body_ground,
+                                      const FootPlacementSettings& settings);
   float plane_height(int side, int which, const glm::vec3& at) const;
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length,
