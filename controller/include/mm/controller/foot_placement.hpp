@@ -153,6 +153,7 @@ class FootPlacement {
   struct Foot {
     FootGround ground;
     FootGround velocity;
+    FootGround last_goal;  // the goals the grounds followed on the last update
     float toe_rise = 0.0f;
     glm::vec3 toe{0.0f};  // the toe's position last update, and its horizontal velocity
     glm::vec3 toe_velocity{0.0f};
