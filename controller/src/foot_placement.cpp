@@ -45,9 +45,9 @@ constexpr float kStepRise = 0.02f;
 // A step only a toe's own look-ahead sees, and not where it lands, is one it swings beside when
 // it is higher than this (m), a stair's riser: a lower one (a tread, a kerb, a bump of rough
 // ground) a foot crosses over on its way and has to clear (cut, a toe strafing across
-// stairs_down's treads toward a landing on the floor passed 2 mm over a tread's corner; on rough
-// ground the cut came and went as the landing moved over the bumps, dropping a swinging toe by
-// centimetres in an update).
+// stairs_down's treads toward a landing on the floor barely cleared a tread's corner; on rough
+// ground the cut came and went as the landing moved over the bumps, dropping a swinging toe in
+// an update).
 constexpr float kBesideStepRise = 0.2f;
 // Ground around the toe this much higher than the plane under it (m) is an edge the toe is at.
 constexpr float kEdgeRise = 0.01f;
@@ -88,8 +88,8 @@ void follow_ground(float& height, float& velocity, float& last_goal, float goal,
   // on its spring, or a rise whose goal went back down (a bump a probe ahead found, passed), cut
   // short, jumped the rest and stopped dead in an update (a toe over the rough patch, 2.7 cm in
   // 1/60 s). At rest means slow and on the goal it followed: at the top of a rise whose goal went
-  // back down the ground is slow too, and was dropped the rest at once (1.2 cm in 1/144 s, a
-  // probe that saw the side of stairs_12_35 for two updates).
+  // back down the ground is slow too, and was dropped the rest at once (a probe that saw the side
+  // of stairs_12_35 for two updates).
   const bool rising = goal > height && velocity > 0.0f;
   const bool at_rest =
       std::abs(velocity) <= kAtRestSpeed && std::abs(height - last_goal) <= kOnGoalDistance;
@@ -253,7 +253,7 @@ void FootPlacement::sweep_toes(const WorldQueries& world, const glm::dvec3& orig
 // shortly and where their own does: a swinging toe sees the riser before it reaches it, also
 // when the body moves another way (a step to the side, a turn's step, a swing across the body's
 // path on a circle). A planted foot looks only where it is: ahead, up a slope, it would rise off
-// the surface it stands on. Then the toe's footprint around it.
+// the surface it stands on. Then the toe's footprint around it, and where the toe lands.
 void FootPlacement::place_probes(const FootPlacementSettings& settings,
                                  std::span<const PlacementLeg, 2> legs, float body_ground,
                                  const glm::vec3& body_velocity) {
@@ -410,12 +410,12 @@ void FootPlacement::keep_steps_ahead() {
 // A foot in the air comes down where its clip puts it (PlacementLeg::landing): a step that only
 // its own look-ahead sees, more than kBesideStepRise above the ground where it lands, under it now
 // and on the body's path (the body's look-ahead), is one it swings beside, not onto. Raised
-// toward it, a foot swinging along box_35's front face to land beside it rose to the box's top,
-// 47 cm over the floor it came down on (docs/world.md, session 29). The body's look-ahead is not
+// toward it, a foot swinging along box_35's front face to land beside it rose to the box's top
+// over the floor it came down on (docs/world.md, session 29). The body's look-ahead is not
 // cut so: on stairs the clip's landing, predicted for flat ground, falls short of the tread the
 // foot goes onto. Nor a toe a riser holds back farther than kPastLanding from where the
 // animation puts it: the animation takes it over the step (a toe held at the side of
-// stairs_20_25's last tread, the animation 40 cm onto it, was dragged into the tread's corner by a
+// stairs_20_25's last tread, the animation well onto it, was dragged into the tread's corner by a
 // leg that could not reach it on the floor).
 void FootPlacement::keep_own_lookahead_to_landings(std::span<const PlacementLeg, 2> legs,
                                                    float body_ground,
