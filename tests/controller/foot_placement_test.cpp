@@ -610,17 +610,27 @@ TEST(FootPlacement, AToeSwingingAcrossTheBodysPathRisesBeforeTheRiserItHeadsFor)
 // is never lower above the ground under it than the data's toes go (its ground lifted as far as
 // that needs, no farther: lifted onto the tread, a toe already above it popped up by the
 // difference).
-TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
-  AnalyticWorld world;
-  // A tread 0.17 m high for x < 1 and z > 0.3: its front face at z = 0.3, its side at x = 1.
+// A tread 0.17 m high for x < 1 and z > 0.3 (its front face at z = 0.3, its side at x = 1), and a
+// left toe in the air before its corner, the right foot standing back.
+void add_tread_with_a_corner(AnalyticWorld& world) {
   world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 1.3f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
-  CharacterMover mover;
-  FootPlacement p;
+}
+std::array<PlacementLeg, 2> left_before_the_corner() {
   std::array<PlacementLeg, 2> legs{standing_leg(0.85f, 0.05f, 0.0f),
                                    standing_leg(0.5f, -0.5f, 0.0f)};
   legs[0].planted = legs[0].near_ground = false;
+  return legs;
+}
+constexpr glm::vec3 kAcrossTheCorner(1.6f, 0.0f, 1.6f);  // diagonally across the tread's corner
+
+TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
+  AnalyticWorld world;
+  add_tread_with_a_corner(world);
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs = left_before_the_corner();
   const FootPlacementSettings settings;
-  const glm::vec3 velocity(1.6f, 0.0f, 1.6f);  // diagonally across the tread's corner
+  const glm::vec3 velocity = kAcrossTheCorner;
   // The toe swinging 1 cm above its lowest (3 cm up), then 11 cm.
   for (const float lowest : {0.02f, -0.08f}) {
     std::array<PlacementLeg, 2> swinging = legs;
@@ -655,15 +665,13 @@ TEST(FootPlacement, AToeCrossingATreadsCornerIsNeverBelowTheTreadItIsOver) {
 // included, not the follower's velocity.
 TEST(FootPlacement, AToesGroundLiftedOntoATreadReportsTheWholeRise) {
   AnalyticWorld world;
-  world.boxes.push_back(AnalyticBox{glm::vec2(0.0f, 1.3f), glm::vec2(1.0f, 1.0f), 0.0f, 0.17f});
+  add_tread_with_a_corner(world);
   CharacterMover mover;
   FootPlacement p;
-  std::array<PlacementLeg, 2> legs{standing_leg(0.85f, 0.05f, 0.0f),
-                                   standing_leg(0.5f, -0.5f, 0.0f)};
-  legs[0].planted = legs[0].near_ground = false;
+  std::array<PlacementLeg, 2> legs = left_before_the_corner();
   legs[0].lowest = 0.02f;
   const FootPlacementSettings settings;
-  const glm::vec3 velocity(1.6f, 0.0f, 1.6f);
+  const glm::vec3 velocity = kAcrossTheCorner;
   p.reset(0.0f);
   float largest = 0.0f;
   for (int f = 0; f < 10; ++f) {
