@@ -270,9 +270,8 @@ TEST(CourseRuns, AFootLandingShortOfAStepIsNotLockedInTheAir) {
 // looks no farther than a little past where the playing clip puts it down
 // (FootPlacement::kPastLanding). Counted: a foot whose ground rose more than 20 cm over the
 // ground under its toe and which then locked lower, its toe never over the raised ground: 2 with
-// the look-aheads not cut at the landing; 1 with the cut alone, a toe cutting the box's corner at
-// 1/30 s, until a foot's own look-ahead no longer raised it toward a box beside where it lands
-// (AFootSwingingAlongABoxToLandBesideItIsNotRaisedOntoItsTop).
+// the look-aheads not cut at the landing; 1 with the cut alone (a toe cutting the box's corner at
+// 1/30 s), none since session 29's rules (docs/world.md).
 TEST(CourseRuns, AFootStoppingShortOfABoxIsNotRaisedTowardItsTop) {
   int raised_short = 0;
   for (const float dt : {1.0f / 60.0f, 1.0f / 30.0f}) {
