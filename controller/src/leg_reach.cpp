@@ -11,10 +11,14 @@ glm::vec3 soft_reach(const glm::vec3& hip_to_ankle, float animated_distance, flo
                      float length) {
   const float d = glm::length(hip_to_ankle);
   const float soft = kSoftReach * length;
+  // Kept no nearer full length than the softening's least span: kept nearer, the reach went on
+  // past the leg's length (the leg clamped straight, where its knee moves fastest).
+  const float straightest = (1.0f - kMinSoftSpan) * length;
   const float kept =
-      soft + keep_animated * std::max(0.0f, std::min(animated_distance, length) - soft);
+      std::min(soft + keep_animated * std::max(0.0f, std::min(animated_distance, length) - soft),
+               straightest);
   if (d <= kept || d < 1e-6f) return hip_to_ankle;
-  const float span = std::max(length - kept, kMinSoftSpan * length);
+  const float span = length - kept;
   const float reached = kept + span * (1.0f - std::exp(-(d - kept) / span));
   return hip_to_ankle * (reached / d);
 }

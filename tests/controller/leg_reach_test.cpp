@@ -40,6 +40,22 @@ TEST(LegReach, BeyondTheSoftReachTheLegFallsShortAlongTheLine) {
   EXPECT_NEAR(glm::length(soft_reach(near, 0.89f, 1.0f, kLength)), glm::length(near), 1e-5f);
 }
 
+// Standing with the animation's leg within kMinSoftSpan of straight (the idle's legs stand at
+// about 99.7 % of their length), a target held beyond it is still reached short of the full
+// length: the kept distance stops kMinSoftSpan short of it. Kept at the animation's, the reach
+// went on past the length, and the leg was clamped straight, its knee moving fastest there as the
+// foot then stepped.
+TEST(LegReach, StandingNearlyStraightTheReachStaysShortOfTheLength) {
+  const glm::vec3 way = glm::normalize(glm::vec3(0.0f, -1.0f, 0.1f));
+  const float animated = 0.997f * kLength;
+  // A held toe just out of reach: short of the length by more than a millimetre a metre, so the
+  // knee keeps a bend.
+  const float reached = glm::length(soft_reach(way * (1.003f * kLength), animated, 1.0f, kLength));
+  EXPECT_LT(reached, 0.999f * kLength);
+  // A target at the animation's own distance is reached within a few millimetres of it.
+  EXPECT_NEAR(glm::length(soft_reach(way * animated, animated, 1.0f, kLength)), animated, 0.004f);
+}
+
 TEST(LegReach, ShortBelowKeepsTheHorizontalOffset) {
   const glm::vec3 target(0.1f, -1.2f, -0.2f);
   const glm::vec3 r = short_below(target, 0.85f);

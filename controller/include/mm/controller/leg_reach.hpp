@@ -5,11 +5,11 @@
 // Near full extension a knee's angle changes ever faster with the hip-to-ankle distance, so a
 // target at the edge of reach makes the knee snap. Reach is softened instead (soft_reach):
 // distances up to kSoftReach of the leg's length, or up to the animation's own hip-to-ankle
-// distance when its leg is straighter than that, are kept; longer ones approach the full length
-// exponentially, over at least kMinSoftSpan of it. The animation's own extension is kept only
-// standing, where poses lock their knees and softening them would bend both knees forward by
-// centimetres; in motion the shorter span it leaves makes knees snap straight at the
-// transitions.
+// distance when its leg is straighter than that (but no nearer the full length than kMinSoftSpan
+// of it), are kept; longer ones approach the full length exponentially, never reaching it. The
+// animation's own extension is kept only standing, where poses lock their knees and softening them
+// would bend both knees forward by centimetres; in motion the shorter span it leaves makes knees
+// snap straight at the transitions.
 //
 // A leg that falls short falls short along the hip-to-target line, except a foot reaching down
 // to ground lower than the body's (reach_down): it stays over the point it reaches for.
