@@ -713,9 +713,13 @@ void Controller::place_feet(float dt) {
     // as continuously as the foot does), not where the animation has it.
     const FootLock& f = feet_[side];
     const glm::vec3 at = f.locked ? f.position : p.toe + f.offset;
-    glm::vec3 offset = f.offset, offset_velocity = f.offset_velocity;
-    decay_offset(side, offset, offset_velocity, dt);
-    shown_toes[static_cast<size_t>(side)] = f.locked ? f.position : p.toe + offset;
+    glm::vec3& shown = shown_toes[static_cast<size_t>(side)];
+    shown = at;
+    if (!f.locked) {
+      glm::vec3 offset = f.offset, offset_velocity = f.offset_velocity;
+      decay_offset(side, offset, offset_velocity, dt);
+      shown = p.toe + offset;
+    }
     const glm::vec3 moved(at.x - p.toe.x, 0.0f, at.z - p.toe.z);
     p.shift = moved;
     p.toe += moved;
