@@ -60,6 +60,23 @@ void joint_accelerations(std::span<const glm::vec3> a, std::span<const glm::vec3
   for (size_t j = 1; j < b.size(); ++j) out.add(joint_acceleration(a, b, c, j, dt));
 }
 
+// The leg joints leg_accel_max reads (knees, ankles, toes; -1 where a role is missing).
+std::array<int, 6> leg_joints(const JointRoleIndices& roles) {
+  return {roles.left_lower_leg, roles.right_lower_leg, roles.left_foot,
+          roles.right_foot,     roles.left_toe,        roles.right_toe};
+}
+
+// The largest acceleration among `joints` (ignoring -1) from three consecutive frames.
+double largest_acceleration(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
+                            std::span<const glm::vec3> c, std::span<const int> joints,
+                            float dt) {
+  double largest = 0.0;
+  for (const int j : joints) {
+    if (j >= 0) largest = std::max(largest, joint_acceleration(a, b, c, static_cast<size_t>(j), dt));
+  }
+  return largest;
+}
+
 // How long a value has stayed within a tolerance of the value it was last held at.
 struct HeldValue {
   glm::vec3 anchor{0.0f};
@@ -129,6 +146,7 @@ struct EvaluationAccumulator::State {
   size_t joint_count = 0;
   float dt = 0.0f;
   int toes[2] = {-1, -1};  // toe role, or the foot when the side has none
+  std::array<int, 6> legs{};
   int lookback_frames = 1;
   int stand_settle_frames = 1, idle_settle_frames = 1, strafe_settle_frames = 1;
 
@@ -147,6 +165,7 @@ struct EvaluationAccumulator::State {
   void keep_largest(const EvaluationFrame& r, int windows);
   RunningMean skate_mean, distance, facing, updates, searches, stand_root, stand_foot;
   double distance_max = 0.0;
+  double leg_accel_max = 0.0, leg_accel_max_t = 0.0;
   int transitions = 0;
   ResponseEvent speed_event, heading_event;
   int speed_events = 0, heading_events = 0;
@@ -193,6 +212,7 @@ EvaluationAccumulator::EvaluationAccumulator(const JointRoleIndices& roles, size
   s.dt = dt;
   s.toes[0] = roles.left_toe >= 0 ? roles.left_toe : roles.left_foot;
   s.toes[1] = roles.right_toe >= 0 ? roles.right_toe : roles.right_foot;
+  s.legs = leg_joints(roles);
   s.lookback_frames = std::max(1, clamped_integer<int>(std::round(kStandTurnLookback / dt)));
   s.stand_settle_frames = frames_for(kStandSettleSeconds, dt);
   s.idle_settle_frames = frames_for(kIdleSettleSeconds, dt);
@@ -435,6 +455,13 @@ void EvaluationAccumulator::State::measure_transition_accel(const EvaluationFram
       joint_accelerations(positions[0], positions[1], r.joints, dt, accelerations);
     }
     if (count > 0 && transition_capacity > 0) keep_largest(r, count);
+    if (count == 0) {
+      const double leg = largest_acceleration(positions[0], positions[1], r.joints, legs, dt);
+      if (leg > leg_accel_max) {
+        leg_accel_max = leg;
+        leg_accel_max_t = previous.t;
+      }
+    }
   }
   transition_bits = (transition_bits << 1) | (r.transition ? 1u : 0u);
 }
@@ -511,6 +538,8 @@ EvaluationMetrics EvaluationAccumulator::metrics() const {
   m.search_us_mean = s.searches.value();
   m.update_us_mean = s.updates.value();
   m.transition_accel_p99 = s.accelerations.percentile(99.0);
+  m.leg_accel_max = s.leg_accel_max;
+  m.leg_accel_max_t = s.leg_accel_max_t;
 
   m.body_turn_rate_deg_s_max = s.hips_rates.max();
   m.body_turn_rate_deg_s_p99 = s.hips_rates.percentile(99.0);
@@ -751,14 +780,15 @@ class ClipPoses {
 // more the script runs than the data does.
 class PlayedAcceleration {
  public:
-  PlayedAcceleration(const Database& db, float dt, bool cubic) : dt_(dt), poses_(db, cubic) {
+  PlayedAcceleration(const Database& db, float dt, bool cubic)
+      : dt_(dt), poses_(db, cubic), legs_(leg_joints(db.roles())) {
     for (std::vector<glm::vec3>& step : steps_) step.assign(poses_.joints(), glm::vec3(0.0f));
   }
 
   void add(const ControllerDebug& d) {
     transition_bits_ = (transition_bits_ << 1) | (d.transitioned ? 1u : 0u);
     const int count = std::popcount(transition_bits_ & 0x3ffu);
-    if (count == 0 || d.clip < 0) return;
+    if (d.clip < 0) return;
     for (int k = 0; k < 3; ++k) {
       poses_.pose_at(d.clip, d.clip_time + static_cast<float>(k - 1) * dt_,
                      steps_[static_cast<size_t>(k)]);
@@ -766,15 +796,23 @@ class PlayedAcceleration {
     for (int i = 0; i < count; ++i) {
       joint_accelerations(steps_[0], steps_[1], steps_[2], dt_, accelerations_);
     }
+    if (count == 0) {
+      leg_max_ = std::max(leg_max_,
+                          largest_acceleration(steps_[0], steps_[1], steps_[2], legs_, dt_));
+    }
   }
   double p99() const { return accelerations_.percentile(99.0); }
+  // The leg joints' largest acceleration outside the windows (leg_accel_played_max).
+  double leg_max() const { return leg_max_; }
 
  private:
   float dt_;
   ClipPoses poses_;
   std::vector<glm::vec3> steps_[3];
+  std::array<int, 6> legs_;
   uint32_t transition_bits_ = 0;
   PercentileHistogram accelerations_;
+  double leg_max_ = 0.0;
 };
 
 // The playing clip's own toe heights above its flat ground at the playing time
@@ -922,6 +960,9 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   m.played_accel_p99 = played.p99();
   m.transition_accel_ratio_played =
       m.played_accel_p99 > 0.0 ? m.transition_accel_p99 / m.played_accel_p99 : 0.0;
+  m.leg_accel_played_max = played.leg_max();
+  m.leg_accel_ratio =
+      m.leg_accel_played_max > 0.0 ? m.leg_accel_max / m.leg_accel_played_max : 0.0;
   return result;
 }
 

@@ -507,6 +507,29 @@ TEST(Evaluation, NoTransitionReportUnlessAsked) {
   EXPECT_TRUE(accumulator.transition_samples().empty());
 }
 
+// leg_accel_max reads the legs' joints between transitions: a toe's jolt outside every window is
+// the maximum, at its frame; a larger one inside a transition's window and the head's own are
+// not counted.
+TEST(Evaluation, LegAccelerationIsTheLargestLegJointsJoltOutsideTheTransitionsWindows) {
+  EvaluationAccumulator accumulator(synthetic_roles(), kJointCount, kDt);
+  for (int i = 0; i < 60; ++i) {
+    Pose pose;
+    if (i == 12) pose.toe[0].y += 0.05f;  // inside the window of the transition at frame 10
+    if (i == 40) pose.toe[1].x += 0.01f;
+    if (i == 50) pose.head.y += 0.05f;
+    const std::vector<glm::vec3> joints = joints_of(pose);
+    EvaluationFrame f;
+    f.t = static_cast<float>(i + 1) * kDt;
+    f.transition = i == 10;
+    f.joints = joints;
+    accumulator.add(f);
+  }
+  const EvaluationMetrics m = accumulator.metrics();
+  // The toe and its foot (placed from the toe) move together: 2 cm of second difference.
+  EXPECT_NEAR(m.leg_accel_max, 0.02 / (kDt * kDt), 0.5);
+  EXPECT_NEAR(m.leg_accel_max_t, 41.0f * kDt, 1e-6f);
+}
+
 TEST(Evaluation, NothingMeasuredGivesZeroesAndZeroCounts) {
   EvaluationAccumulator empty(synthetic_roles(), kJointCount, kDt);
   const EvaluationMetrics m = empty.metrics();
@@ -519,6 +542,7 @@ TEST(Evaluation, NothingMeasuredGivesZeroesAndZeroCounts) {
   EXPECT_EQ(m.idle_head_frames, 0);
   EXPECT_EQ(m.toe_height_min_cm, 0.0);
   EXPECT_EQ(m.transitions_per_s, 0.0);
+  EXPECT_EQ(m.leg_accel_max, 0.0);
 }
 
 }  // namespace

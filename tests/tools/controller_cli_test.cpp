@@ -101,6 +101,7 @@ TEST(ControllerCli, EvalWritesEveryMetricUnderItsKey) {
                           "stand_foot_speed_cm_s_mean",
                           "transitions_per_s",
                           "transition_accel_ratio",
+                          "leg_accel_ratio",
                           "search_us_mean",
                           "update_us_mean",
                           "body_turn_rate_deg_s_p99",

@@ -247,6 +247,10 @@ void print_metrics(const EvaluationMetrics& m) {
       "transition_accel_ratio_played %8.3f   (against the playing clips on their own at the "
       "same moments, %.1f m/s^2)\n",
       m.transition_accel_ratio_played, m.played_accel_p99);
+  std::printf(
+      "leg_accel_ratio             %10.3f   (%.1f m/s^2 at %.3f s, outside transitions; the "
+      "playing clips' legs at the same moments %.1f m/s^2)\n",
+      m.leg_accel_ratio, m.leg_accel_max, m.leg_accel_max_t, m.leg_accel_played_max);
   std::printf("search_us_mean              %10.3f\n", m.search_us_mean);
   std::printf("update_us_mean              %10.3f\n", m.update_us_mean);
   print_body_metrics(m);

@@ -43,6 +43,13 @@
 //   transitions, while the data mostly walks), so transition_accel_ratio_played divides the
 //   same percentile by the one of the playing clips themselves at the same moments, played
 //   straight through with the controller's sampling (played_accel_p99): what the blends add;
+// - leg_accel_max: the largest acceleration (second difference of global positions) of a leg
+//   joint (knee, ankle or toe, either side) on a frame outside every transition's 10-frame window
+//   (transition_accel_ratio judges those), at leg_accel_max_t (s); leg_accel_played_max: the
+//   same joints' largest acceleration in the playing clips at the same moments, played straight
+//   through with the controller's sampling; leg_accel_ratio = leg_accel_max / leg_accel_played_max:
+//   what foot locking, placement and IK add to the legs between transitions (a knee that snaps as a
+//   held foot lets go, which no percentile sees);
 // - search_us_mean: wall time per search; update_us_mean: wall time per update() (the only
 //   figures that vary from run to run).
 //
@@ -183,6 +190,10 @@ struct EvaluationMetrics {
   double transition_accel_ratio_same_sampling = 0.0;
   double transition_accel_ratio_played = 0.0;
   double played_accel_p99 = 0.0;  // m/s^2, the playing clips on their own
+  double leg_accel_ratio = 0.0;
+  double leg_accel_max = 0.0;         // m/s^2
+  double leg_accel_max_t = 0.0;       // s
+  double leg_accel_played_max = 0.0;  // m/s^2
   double search_us_mean = 0.0;
   double update_us_mean = 0.0;
   // The body metrics (definitions at the top of this file).
