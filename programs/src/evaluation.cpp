@@ -68,11 +68,11 @@ std::array<int, 6> leg_joints(const JointRoleIndices& roles) {
 
 // The largest acceleration among `joints` (ignoring -1) from three consecutive frames.
 double largest_acceleration(std::span<const glm::vec3> a, std::span<const glm::vec3> b,
-                            std::span<const glm::vec3> c, std::span<const int> joints,
-                            float dt) {
+                            std::span<const glm::vec3> c, std::span<const int> joints, float dt) {
   double largest = 0.0;
   for (const int j : joints) {
-    if (j >= 0) largest = std::max(largest, joint_acceleration(a, b, c, static_cast<size_t>(j), dt));
+    if (j >= 0)
+      largest = std::max(largest, joint_acceleration(a, b, c, static_cast<size_t>(j), dt));
   }
   return largest;
 }
@@ -797,8 +797,8 @@ class PlayedAcceleration {
       joint_accelerations(steps_[0], steps_[1], steps_[2], dt_, accelerations_);
     }
     if (count == 0) {
-      leg_max_ = std::max(leg_max_,
-                          largest_acceleration(steps_[0], steps_[1], steps_[2], legs_, dt_));
+      leg_max_ =
+          std::max(leg_max_, largest_acceleration(steps_[0], steps_[1], steps_[2], legs_, dt_));
     }
   }
   double p99() const { return accelerations_.percentile(99.0); }
@@ -961,8 +961,7 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   m.transition_accel_ratio_played =
       m.played_accel_p99 > 0.0 ? m.transition_accel_p99 / m.played_accel_p99 : 0.0;
   m.leg_accel_played_max = played.leg_max();
-  m.leg_accel_ratio =
-      m.leg_accel_played_max > 0.0 ? m.leg_accel_max / m.leg_accel_played_max : 0.0;
+  m.leg_accel_ratio = m.leg_accel_played_max > 0.0 ? m.leg_accel_max / m.leg_accel_played_max : 0.0;
   return result;
 }
 
