@@ -455,7 +455,8 @@ void EvaluationAccumulator::State::measure_transition_accel(const EvaluationFram
       joint_accelerations(positions[0], positions[1], r.joints, dt, accelerations);
     }
     if (count > 0 && transition_capacity > 0) keep_largest(r, count);
-    if (count == 0) {
+    // Not where the sample's third frame is itself a transition: that jump is the transition's.
+    if (count == 0 && !r.transition) {
       const double leg = largest_acceleration(positions[0], positions[1], r.joints, legs, dt);
       if (leg > leg_accel_max) {
         leg_accel_max = leg;
@@ -961,7 +962,8 @@ Result<EvaluationResult> evaluate_script(std::shared_ptr<const ControllerDatabas
   m.transition_accel_ratio_played =
       m.played_accel_p99 > 0.0 ? m.transition_accel_p99 / m.played_accel_p99 : 0.0;
   m.leg_accel_played_max = played.leg_max();
-  m.leg_accel_ratio = m.leg_accel_played_max > 0.0 ? m.leg_accel_max / m.leg_accel_played_max : 0.0;
+  const double leg_reference = std::max(m.leg_accel_played_max, m.database_accel_p99_same_sampling);
+  m.leg_accel_ratio = leg_reference > 0.0 ? m.leg_accel_max / leg_reference : 0.0;
   return result;
 }
 

@@ -508,19 +508,21 @@ TEST(Evaluation, NoTransitionReportUnlessAsked) {
 }
 
 // leg_accel_max reads the legs' joints between transitions: a toe's jolt outside every window is
-// the maximum, at its frame; a larger one inside a transition's window and the head's own are
-// not counted.
+// the maximum, at its frame; a larger one inside a transition's window, a toe jumping at a
+// transition (its second difference centred on the frame before is the transition's too) and
+// the head's own are not counted.
 TEST(Evaluation, LegAccelerationIsTheLargestLegJointsJoltOutsideTheTransitionsWindows) {
   EvaluationAccumulator accumulator(synthetic_roles(), kJointCount, kDt);
   for (int i = 0; i < 60; ++i) {
     Pose pose;
     if (i == 12) pose.toe[0].y += 0.05f;  // inside the window of the transition at frame 10
+    if (i >= 25) pose.toe[0].z += 0.05f;  // a jump at the transition at frame 25
     if (i == 40) pose.toe[1].x += 0.01f;
     if (i == 50) pose.head.y += 0.05f;
     const std::vector<glm::vec3> joints = joints_of(pose);
     EvaluationFrame f;
     f.t = static_cast<float>(i + 1) * kDt;
-    f.transition = i == 10;
+    f.transition = i == 10 || i == 25;
     f.joints = joints;
     accumulator.add(f);
   }

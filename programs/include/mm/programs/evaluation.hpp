@@ -47,9 +47,11 @@
 //   joint (knee, ankle or toe, either side) on a frame outside every transition's 10-frame window
 //   (transition_accel_ratio judges those), at leg_accel_max_t (s); leg_accel_played_max: the
 //   same joints' largest acceleration in the playing clips at the same moments, played straight
-//   through with the controller's sampling; leg_accel_ratio = leg_accel_max / leg_accel_played_max:
-//   what foot locking, placement and IK add to the legs between transitions (a knee that snaps as a
-//   held foot lets go, which no percentile sees);
+//   through with the controller's sampling; leg_accel_ratio = leg_accel_max over the larger of
+//   leg_accel_played_max and database_accel_p99_same_sampling (a standing run's idle moves its
+//   legs so little that ordinary walking would read as a snap against it alone): what foot
+//   locking, placement and IK add to the legs between transitions (a knee that snaps as a held
+//   foot lets go, which no percentile sees);
 // - search_us_mean: wall time per search; update_us_mean: wall time per update() (the only
 //   figures that vary from run to run).
 //
