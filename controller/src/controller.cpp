@@ -56,8 +56,10 @@ constexpr float kRelockHeading = 0.05f;
 // (m): it rises as it leaves and lands as it arrives.
 constexpr float kStepLift = 1.0f;
 constexpr float kStepHeight = 0.08f;
-// Halflife (s) of the lift's spring: short beside a step, long beside a frame.
-constexpr float kLiftHalflife = 0.06f;
+// The bound on the lift's acceleration (m/s^2): it starts from rest without a jolt. On a spring
+// the lift began at its hardest acceleration, and a standing leg, near straight, turned that into
+// a knee snapping forward (docs/controller.md, Legs between transitions).
+constexpr float kLiftAcceleration = 10.0f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
 // foot) steps rather than being dragged: past full length, since soft reach still bends it.
 constexpr float kStepReach = 1.03f;
@@ -98,7 +100,12 @@ constexpr float kReleaseMaxAcceleration = 20.0f;
 constexpr float kHeelLagAcceleration = 200.0f;
 // How much of that lift (radians) is taken at once all the same: eased, the toe slid for the
 // few updates the heel took to rise, and a lock begins a little out of reach at most steps.
-constexpr float kHeelRiseAtOnce = 0.1f;
+constexpr float kHeelRiseAtOnce = 0.05f;
+// A held toe's heel is lifted this much (radians) beyond what the toe needs, the margin fading in
+// from no lift (lifted_heel): lifted exactly as far as needed, the ankle sat at the edge of the
+// softened reach, and the leg went from clamped to free as the heel came down after a release, a
+// kink the knee, near straight, turned into a snap.
+constexpr float kHeelMargin = 0.02f;
 // A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
 // follows the animation's own lift rather than stepping with a lift of its own.
 constexpr float kLiftOffSpeed = 0.2f;
@@ -207,6 +214,14 @@ float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::v
   // perpendicular to a, so a turns to a cos + (axis x a) sin.
   if (a.y * turn_cos + glm::cross(axis, a).y * turn_sin <= a.y) return 0.0f;
   return std::clamp(atan2_polynomial(turn_sin, turn_cos), 0.0f, FootPlacement::kMaxHeelRise);
+}
+
+// The heel's lift for a held toe that needs `needed` (heel_rise_angle): kHeelMargin more, the
+// margin fading in smoothly from no lift (it never jumps), no more than the heel's limit.
+float lifted_heel(float needed) {
+  if (!(needed > 0.0f)) return 0.0f;
+  return std::min(needed + kHeelMargin * (1.0f - std::exp(-needed / kHeelMargin)),
+                  FootPlacement::kMaxHeelRise);
 }
 
 // The root (joint 0) and the body (joints 1..) of a pose and its velocities: transitions treat
@@ -1317,7 +1332,7 @@ void Controller::foot_lock(float dt) {
     // animation stretches near straight, and the knee bends forward where the data's stands past
     // straight. Skipped whenever the target came within 10 micrometres of the animated toe, a
     // running leg's knee jumped 2 cm for an update and back.
-    reach(side, animated, target);
+    reach(side, animated, target, dt);
   }
 }
 
@@ -1336,6 +1351,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     f.has_target = true;
   }
   if (contact && grounded && !f.locked && !f.stepping &&
+      glm::length(f.target_velocity) < kLockSpeed &&
       (!f.previous_contact || glm::length(f.offset) < kRelockOffset)) {
     f.locked = true;
     f.lock_began = true;
@@ -1382,9 +1398,11 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
       f.stepping = contact && (settle || dragged) && f.velocity.y < kLiftOffSpeed;
       f.offset = f.target - on_ground;
       f.offset_velocity = -kReleaseHold * f.velocity;
-      f.release_halflife = std::max(settings_.foot_lock_release_halflife,
-                                    2.0f * std::numbers::ln2_v<float> *
-                                        std::sqrt(glm::length(f.offset) / kReleaseMaxAcceleration));
+      // A held toe rising with the animation's (a heel-off's toe) goes on rising at its rate:
+      // held for the release's update, it stopped for one update, a jolt up the leg.
+      f.offset.y += f.target_velocity.y * dt;
+      f.offset_velocity.y = f.target_velocity.y - f.velocity.y;
+      f.release_halflife = release_halflife(glm::length(f.offset));
     }
   }
   f.previous_contact = contact;
@@ -1394,7 +1412,19 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   glm::vec3 target = on_ground;
   // A held toe keeps its point on the ground, but rises with the animation's: a toe lifting
   // off is no longer planted, and held down it would have that height to catch up on release.
-  if (f.locked) target = glm::vec3(f.position.x, std::max(f.position.y, on_ground.y), f.position.z);
+  // Nor is it held up in the air: a toe still coming down as the contact begins (a heel strike)
+  // comes down as the animation's own toe does, rather than stopping dead where it was caught and
+  // standing there, the foot floating for the whole step. Its own descent, not its ground's (a
+  // ground lowered by the look-ahead of a step down does not take a held toe off its tread), and
+  // no lower than the data's lowest toe over the ground under it (unbounded, the downhill foot on
+  // a ramp went on down out of the leg's reach).
+  if (f.locked) {
+    const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
+    const float lowest = under + shared_->lowest_foot_end(side);
+    f.position.y = std::max(f.position.y + std::min(0.0f, f.animated_rise) * dt,
+                            std::min(f.position.y, lowest));
+    target = glm::vec3(f.position.x, std::max(f.position.y, on_ground.y), f.position.z);
+  }
   target += f.offset;
   if (world_) {
     // Out of the walls as place_feet put it (its ground probed there), eased where one let go;
@@ -1408,10 +1438,11 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   const float floor = shared_->lowest_foot_end(side) + toe_ground(side);
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
+  f.target_velocity = (target - f.target) / dt;
   f.target = target;
   // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
   // turning round its toe still has its heel's arc to go); the lift itself follows that height
-  // on a spring, so the foot leaves the ground smoothly.
+  // with a bounded acceleration, so the foot leaves the ground smoothly.
   float to_go = std::hypot(f.offset.x, f.offset.z) + std::abs(f.heading_offset) * foot_length(side);
   // A settling step goes to where the idle clip itself puts the toe, and the blend into the idle
   // carries the released toe there: lifted only by the offset left, it slid along the ground.
@@ -1420,7 +1451,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
     to_go = std::max(to_go, std::hypot(way.x, way.z));
   }
   const float lift_goal = f.stepping ? std::min(kStepHeight, kStepLift * to_go) : 0.0f;
-  foot_springs_[side].lift.update(f.lift, f.lift_velocity, lift_goal, kLiftHalflife, dt);
+  approach(f.lift, f.lift_velocity, lift_goal, kLiftAcceleration, dt);
   target.y += f.lift;
   if (f.stepping && glm::length(f.offset) < kRelockOffset && f.lift < kRelockOffset &&
       std::abs(f.heading_offset) < kRelockHeading) {
@@ -1481,11 +1512,14 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
     // knee 391 m/s^2 at 1/60 s, stand-turns.txt from x = 11.5 on the second course).
     const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
     f.low_and_slow = on_ground.y - under < kPlantedHeight && speed < kPlantedSpeed;
+    // The animation's own rise, without its ground's: a toe lowered onto a tread may lock.
+    f.animated_rise = (on_ground.y - ground_offset_[side] - f.animated_height) / dt;
     // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
     // jitter over a few milliseconds is no sweep.
     f.speed += (speed - f.speed) * sweep_pull_.of(kSweepHalflife, dt);
   }
   f.animated = on_ground;
+  f.animated_height = on_ground.y - ground_offset_[side];
   f.has_animated = true;
   return f.low_and_slow;
 }
@@ -1537,9 +1571,16 @@ void Controller::hold_heading(int side, float dt) {
     f.heading_offset_velocity = 0.0f;
     return;
   }
+  // Released, the offset decays on a halflife long enough that the ankle, swung about the toe
+  // through the offset's arc, starts with a bounded acceleration (release_halflife), as a
+  // released toe's offset does: on the shortest halflife a foot held 80 degrees round started
+  // swivelling back at hundreds of m/s^2 at the ankle.
+  if (f.heading_held) {
+    f.heading_release_halflife = release_halflife(std::abs(f.heading_offset) * foot_length(side));
+  }
   f.heading_held = false;
   foot_springs_[side].heading.update(f.heading_offset, f.heading_offset_velocity, 0.0f,
-                                     settings_.foot_lock_release_halflife, dt);
+                                     f.heading_release_halflife, dt);
 }
 
 // The animated foot's heading: the yaw of its foot-to-toe line (radians).
@@ -1552,7 +1593,7 @@ float Controller::foot_heading(int side) const {
 
 // Two-bone IK of one leg toward a toe target, the foot turned to its held heading, then the
 // bone lengths restored.
-void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& target) {
+void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& target, float dt) {
   const std::span<const int> parents = db_->skeleton().parents();
   const std::vector<int>& leg = leg_joints_[side];
   const int hip = leg[0], knee = leg[1], foot = leg[2];
@@ -1592,14 +1633,18 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   glm::quat heel_rise(1.0f, 0.0f, 0.0f, 0.0f);
   if (leg[3] >= 0 && (f.locked || f.heel_rise > 0.0f)) {
     const float length = glm::length(reached);
-    const float needed = heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis);
+    const float needed =
+        lifted_heel(heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis));
     if (f.lock_began) {
       f.heel_lag = std::max(0.0f, needed - f.heel_rise - kHeelRiseAtOnce);
       f.heel_lag_velocity = 0.0f;
     }
     if (f.locked && needed - f.heel_lag > f.heel_rise) {
-      f.heel_rise = needed - f.heel_lag;
-      f.heel_rise_velocity = 0.0f;
+      // Raised with the need, the heel keeps the rate it rose at: once the need falls away it
+      // comes down on its spring from that rate, not from rest, which was a jolt at the ankle.
+      const float rise = needed - f.heel_lag;
+      f.heel_rise_velocity = f.lock_began ? 0.0f : std::max(0.0f, (rise - f.heel_rise) / dt);
+      f.heel_rise = rise;
     }
     if (f.heel_rise > 0.0f) {
       heel_rise = glm::angleAxis(f.heel_rise, f.heel_axis);
@@ -1693,6 +1738,15 @@ void Controller::ease_heel_down(int side, float dt) {
   foot_springs_[side].heel.update(f.heel_rise, f.heel_rise_velocity, 0.0f,
                                   settings_.foot_lock_release_halflife, dt);
   if (f.heel_rise < 1e-4f) f.heel_rise = f.heel_rise_velocity = 0.0f;
+}
+
+// The halflife on which a released offset of `distance` (m; for a heading, the arc it swings the
+// ankle through) decays: foot_lock_release_halflife, or longer, so that a long offset starts
+// with a bounded acceleration (kReleaseMaxAcceleration).
+float Controller::release_halflife(float distance) const {
+  return std::max(
+      settings_.foot_lock_release_halflife,
+      2.0f * std::numbers::ln2_v<float> * std::sqrt(distance / kReleaseMaxAcceleration));
 }
 
 // The foot's length, ankle to toe, in the pose being played (0 without a toe).

@@ -58,6 +58,7 @@ void Controller::shift_origin(const glm::vec3& shift) {
     foot.position -= shift;
     foot.target -= shift;
     foot.animated -= shift;
+    foot.animated_height -= shift.y;
   }
   debug_.simulation_position -= shift;
   for (int i = 0; i < ControllerDebug::kMaxTrajectoryPoints; ++i) {

@@ -661,12 +661,13 @@ class Controller {
   bool in_early_blend() const;
   float foot_heading(int side) const;
   void align_hips(float dt);
-  void reach(int side, const glm::vec3& animated, const glm::vec3& target);
+  void reach(int side, const glm::vec3& animated, const glm::vec3& target, float dt);
   void ease_heel_down(int side, float dt);
   void restore_leg_lengths(int side);
   void refresh_subtree(int joint);    // globals of a joint and its descendants from the locals
   float leg_length(int side) const;   // upper plus lower leg in the played pose (m)
   float foot_length(int side) const;  // ankle to toe in the played pose (m; 0 without a toe)
+  float release_halflife(float distance) const;
   void finish_pose();
   void refresh_outputs(float dt);
 
@@ -688,10 +689,10 @@ class Controller {
   CriticalSpringStepCache offset_step_;
   CriticalSpringStepCache sim_rotation_step_;
   // The same for the springs the feet and the chest run every update, per foot: the release
-  // offset, the step's lift, the heading offset, the heel's rise; and the chest's twist.
+  // offset, the heading offset, the heel's rise; and the chest's twist.
   struct FootSprings {
     CriticalSpringStepCache offset, wall_push;
-    CriticalSpringScalarCache lift, heading, heel;
+    CriticalSpringScalarCache heading, heel;
   };
   FootSprings foot_springs_[2];
   CriticalSpringScalarCache chest_twist_spring_;
@@ -825,8 +826,9 @@ class Controller {
     float lock_ground = 0.0f;  // the toe's ground (toe_ground) when the lock last followed it
     glm::vec3 offset{0.0f};    // target - (lock point or animation), decaying
     glm::vec3 offset_velocity{0.0f};
-    float release_halflife = 0.0f;  // the offset's, since the release (s)
-    glm::vec3 target{0.0f};         // the toe's target last update (without a step's lift)
+    float release_halflife = 0.0f;    // the offset's, since the release (s)
+    glm::vec3 target{0.0f};           // the toe's target last update (without a step's lift)
+    glm::vec3 target_velocity{0.0f};  // its rate then (m/s)
     bool has_target = false;
     bool previous_contact = false;
     bool stepping = false;  // released during a contact: stepping, in the air until it lands
@@ -837,7 +839,8 @@ class Controller {
     float heading = 0.0f;
     float heading_offset = 0.0f;
     float heading_offset_velocity = 0.0f;
-    bool heading_held = false;  // on the last update
+    float heading_release_halflife = 0.0f;  // the heading offset's, since the release (s)
+    bool heading_held = false;              // on the last update
     // How far (radians) the heel is lifted about the held toe (reach), about which axis, and
     // the rate at which it comes down after a release.
     float heel_rise = 0.0f;
@@ -855,6 +858,9 @@ class Controller {
     float speed = 0.0f;
     bool has_animated = false;
     bool low_and_slow = false;
+    // The animated toe's height without its ground's offset last update, and its rate (m/s).
+    float animated_height = 0.0f;
+    float animated_rise = 0.0f;
     // How far (horizontally) walls keep the toe out this update (place_feet), and its rate: it
     // comes back onto the animation on a spring when a wall lets go, at once when one pushes.
     glm::vec3 wall_push{0.0f};
