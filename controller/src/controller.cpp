@@ -101,10 +101,12 @@ constexpr float kHeelLagAcceleration = 200.0f;
 // How much of that lift (radians) is taken at once all the same: eased, the toe slid for the
 // few updates the heel took to rise, and a lock begins a little out of reach at most steps.
 constexpr float kHeelRiseAtOnce = 0.05f;
-// A held toe's heel is lifted this much (radians) beyond what the toe needs, the margin fading in
-// from no lift (lifted_heel): lifted exactly as far as needed, the ankle sat at the edge of the
-// softened reach, and the leg went from clamped to free as the heel came down after a release, a
-// kink the knee, near straight, turned into a snap.
+// Standing, a held toe's heel is lifted this much (radians) beyond what the toe needs, the margin
+// fading in from no lift (lifted_heel): lifted exactly as far as needed, the ankle sat at the edge
+// of the softened reach, and the leg went from clamped to free as the heel came down after a
+// release, a kink the knee, standing near straight, turned into a snap. Not in motion, where the
+// legs are bent: there the margin only lifted the heels higher (on the second course's stairs,
+// the walk's transitions read rougher).
 constexpr float kHeelMargin = 0.02f;
 // A held toe whose animated toe rises faster than this (m/s) is lifting off: released, it
 // follows the animation's own lift rather than stepping with a lift of its own.
@@ -216,11 +218,12 @@ float heel_rise_angle(const glm::vec3& toe, const glm::vec3& ankle, const glm::v
   return std::clamp(atan2_polynomial(turn_sin, turn_cos), 0.0f, FootPlacement::kMaxHeelRise);
 }
 
-// The heel's lift for a held toe that needs `needed` (heel_rise_angle): kHeelMargin more, the
-// margin fading in smoothly from no lift (it never jumps), no more than the heel's limit.
-float lifted_heel(float needed) {
+// The heel's lift for a held toe that needs `needed` (heel_rise_angle): `margin` more, fading
+// in smoothly from no lift (it never jumps), no more than the heel's limit.
+float lifted_heel(float needed, float margin) {
   if (!(needed > 0.0f)) return 0.0f;
-  return std::min(needed + kHeelMargin * (1.0f - std::exp(-needed / kHeelMargin)),
+  if (!(margin > 0.0f)) return std::min(needed, FootPlacement::kMaxHeelRise);
+  return std::min(needed + margin * (1.0f - std::exp(-needed / margin)),
                   FootPlacement::kMaxHeelRise);
 }
 
@@ -1634,7 +1637,8 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   if (leg[3] >= 0 && (f.locked || f.heel_rise > 0.0f)) {
     const float length = glm::length(reached);
     const float needed =
-        lifted_heel(heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis));
+        lifted_heel(heel_rise_angle(target, ankle_target, hip_position, length, f.heel_axis),
+                    standing_reach_ * kHeelMargin);
     if (f.lock_began) {
       f.heel_lag = std::max(0.0f, needed - f.heel_rise - kHeelRiseAtOnce);
       f.heel_lag_velocity = 0.0f;

@@ -906,7 +906,7 @@ TEST(FootPlacement, AToeLandingOutOfReachLowersThePelvisOnItsSprings) {
 
 // Walking up and down a slope, a planted foot stands on it as on flat ground: its toe and its
 // heel (ankle) about as high above the surface under them as the flat run has them (no more
-// than 1.5 and 2 cm higher, 3 for the heel on 30 degrees: not floating), and every toe at
+// than 1.5 and 2 cm higher, 3.5 for the heel on 30 degrees: not floating), and every toe at
 // least 1 cm above it.
 TEST(FootPlacementController, OnSlopesThePlantedFeetStandOnTheSurface) {
   const auto clearances = [](const AnalyticWorld& world, float yaw_degrees) {
@@ -945,9 +945,11 @@ TEST(FootPlacementController, OnSlopesThePlantedFeetStandOnTheSurface) {
       // slope either.
       EXPECT_LT(on_slope[0], on_flat[0] + 0.015) << degrees << " yaw " << yaw;
       EXPECT_GT(on_slope[0], on_flat[0] - 0.02) << degrees << " yaw " << yaw;
-      // The heel 2 cm, 3 on 30 degrees: walked up at the climbing pace (climb_pace.hpp, 0.41 of
-      // the clip's rate there) the ankle of a planted foot stands 2.5 cm higher over the slope.
-      const double heel_margin = degrees >= 30.0f ? 0.03 : 0.02;
+      // The heel 2 cm, 3.5 on 30 degrees: walked up at the climbing pace (climb_pace.hpp, 0.41 of
+      // the clip's rate there) the ankle of a planted foot stands 2.5 cm higher over the slope
+      // (3.0 since session 30, where a held toe comes down with the animation's: the flat run's
+      // planted heels 1.8 cm lower, the slope's 1.3).
+      const double heel_margin = degrees >= 30.0f ? 0.035 : 0.02;
       EXPECT_LT(on_slope[1], on_flat[1] + heel_margin) << degrees << " yaw " << yaw;
       EXPECT_GT(on_slope[1], on_flat[1] - 0.03) << degrees << " yaw " << yaw;
       EXPECT_GT(on_slope[2], 0.01) << degrees << " yaw " << yaw;
