@@ -110,7 +110,8 @@ TEST(Knees, FootIkTurnsEachKneeAboutItsHingeAndKeepsTheLegsTwist) {
 // idle's legs stand near straight, where the knee moves many times as far as the reach changes:
 // a heel coming down on a spring from rest, a lift starting at its hardest acceleration, a clamp
 // letting go or a toe stopped for one update moved the knee centimetres in one update (main
-// b8c74d9: stand-turns 9.7 at 1/144 s and 3.7 at 1/60 s, chaos-turns 8.1 and 3.6).
+// b8c74d9 on the default database: stand-turns 9.7 at 1/144 s and 3.7 at 1/60 s, chaos-turns 8.1
+// and 3.6).
 TEST(Knees, NoKneeSnapsAsAStandingFootStepsOrAHeldFootLetsGo) {
   for (const char* name : {"stand-turns.txt", "chaos-turns.txt"}) {
     Result<InputScript> script =
