@@ -1515,7 +1515,8 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
     // knee 391 m/s^2 at 1/60 s, stand-turns.txt from x = 11.5 on the second course).
     const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
     f.low_and_slow = on_ground.y - under < kPlantedHeight && speed < kPlantedSpeed;
-    // The animation's own rise, without its ground's: a toe lowered onto a tread may lock.
+    // The animation's own rise, without its ground's (a held toe comes down as the animation's
+    // own does, foot_target).
     f.animated_rise = (on_ground.y - ground_offset_[side] - f.animated_height) / dt;
     // Whether a labelled toe sweeps is judged on its speed over about a 1/30 s frame: a blend's
     // jitter over a few milliseconds is no sweep.
