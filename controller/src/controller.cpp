@@ -59,7 +59,7 @@ constexpr float kStepHeight = 0.08f;
 // The bound on the lift's acceleration (m/s^2): it starts from rest without a jolt. On a spring
 // the lift began at its hardest acceleration, and a standing leg, near straight, turned that into
 // a knee snapping forward (docs/controller.md, Legs between transitions).
-constexpr float kLiftAcceleration = 15.0f;
+constexpr float kLiftAcceleration = 10.0f;
 // A held toe farther than this share of the leg's length from the hip (through the animated
 // foot) steps rather than being dragged: past full length, since soft reach still bends it.
 constexpr float kStepReach = 1.03f;
