@@ -1422,7 +1422,7 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   // no lower than the data's lowest toe over the ground under it (unbounded, the downhill foot on
   // a ramp went on down out of the leg's reach).
   if (f.locked) {
-    const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
+    const float under = ground_under_toe(side);
     const float lowest = under + shared_->lowest_foot_end(side);
     f.position.y = std::max(f.position.y + std::min(0.0f, f.animated_rise) * dt,
                             std::min(f.position.y, lowest));
@@ -1499,6 +1499,12 @@ float Controller::toe_ground(int side) const {
   return game_capsule_ ? ground_height_ : 0.0f;
 }
 
+// The ground under a toe now: in a world the probed ground under it, without the look-ahead
+// that toe_ground has in it; else toe_ground.
+float Controller::ground_under_toe(int side) const {
+  return world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
+}
+
 // Whether the animated toe (on its ground) is planted by geometry, as the skating metric sees
 // a toe (ground_metrics.hpp): low and horizontally slow. A blend's pose drags such a toe along
 // the ground while neither pose's contact label is on (a dead blend's first half has a foot
@@ -1513,7 +1519,7 @@ bool Controller::low_and_slow(int side, const glm::vec3& on_ground, float dt) {
     // before a step: a toe released at a riser, its ground already rising, was held again a few
     // centimetres up and came down with the ground as the held foot stopped looking ahead (the
     // knee 391 m/s^2 at 1/60 s, stand-turns.txt from x = 11.5 on the second course).
-    const float under = world_ ? foot_placement_.ground_under_toe(side) : toe_ground(side);
+    const float under = ground_under_toe(side);
     f.low_and_slow = on_ground.y - under < kPlantedHeight && speed < kPlantedSpeed;
     // The animation's own rise, without its ground's (a held toe comes down as the animation's
     // own does, foot_target).

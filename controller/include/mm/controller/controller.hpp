@@ -652,6 +652,7 @@ class Controller {
                         bool contact, bool grounded, bool settling, float dt);
   bool on_its_ground(int side, const glm::vec3& on_ground) const;
   float toe_ground(int side) const;
+  float ground_under_toe(int side) const;
   bool low_and_slow(int side, const glm::vec3& on_ground, float dt);
   bool contact_label_holds(int side) const;
   void decay_offset(int side, glm::vec3& offset, glm::vec3& velocity, float dt);
