@@ -378,8 +378,10 @@ void Controller::settle_on_ground() {
   obstacle_edge_ = false;
   held_time_ = 0.0f;
   std::fill(std::begin(toe_walls_), std::end(toe_walls_), WallHit{});
+  std::fill(std::begin(beside_toe_walls_), std::end(beside_toe_walls_), WallHit{});
   std::fill(std::begin(riser_walls_), std::end(riser_walls_), WallHit{});
   std::fill(std::begin(body_walls_), std::end(body_walls_), WallHit{});
+  trunk_wall_ = WallHit{};
   wall_push_ = wall_push_velocity_ = glm::vec3(0.0f);
   arm_push_lag_ = arm_push_lag_velocity_ = glm::vec3(0.0f);
 }
@@ -430,25 +432,23 @@ void Controller::keep_body_off_walls(float dt) {
   keep_arms_off_walls();
 }
 
-// The walls the body is in, into `out`, and how many: the wall the simulation object stands
-// against (the joints higher than a step: the trunk and head's deepest, and the arms'), and the
-// walls found toward each hand, lower arm and the head (find_walls), with the upper arm's depth
-// in a hand's or lower arm's wall (the arm's swing turns about it, so only the push takes it out).
+// The walls the body is in, into `out`, and how many: the wall found toward the trunk's joint
+// deepest in the plane of the one the simulation object stands against (deepest_trunk_joint),
+// with the trunk and head's deepest in it, and the walls found toward each hand, lower arm and
+// the head (find_walls), with the upper arm's depth in a hand's or lower arm's wall (the arm's
+// swing turns about it, so only the push takes it out).
 size_t Controller::wall_depths(std::span<WallDepth, kMaxWallDepths> out) const {
   size_t count = 0;
-  glm::vec3 point, n;
-  if (wall_beside(point, n)) {
+  if (trunk_wall_.found) {
     const float above = ground_height_ + settings_.step_height;
-    float depth[2] = {0.0f, 0.0f};  // the trunk and head's, the arms'
+    float depth = 0.0f;
     for (size_t j = 1; j < globals_.size(); ++j) {
       const glm::vec3& p = globals_[j].translation;
-      if (p.y > above) {
-        float& deepest = depth[in_arm(static_cast<int>(j)) ? 1 : 0];
-        deepest = std::max(deepest, glm::dot(point - p, n));
+      if (p.y > above && !in_arm(static_cast<int>(j))) {
+        depth = std::max(depth, glm::dot(trunk_wall_.point - p, trunk_wall_.normal));
       }
     }
-    out[count++] = {n, depth[0], false};
-    out[count++] = {n, depth[1], true};
+    out[count++] = {trunk_wall_.normal, depth, false};
   }
   const JointRoleIndices& roles = db_->roles();
   const int upper_arms[2] = {roles.left_upper_arm, roles.right_upper_arm};
@@ -506,11 +506,8 @@ void Controller::keep_arms_off_walls() {
   const JointRoleIndices& roles = db_->roles();
   const int upper_arms[2] = {roles.left_upper_arm, roles.right_upper_arm};
   const std::span<const int> parents(db_->skeleton().parents());
-  glm::vec3 point, n;
-  const bool beside = wall_beside(point, n);
   for (int side = 0; side < 2; ++side) {
     if (upper_arms[side] < 0) continue;
-    if (beside) swing_arm_out_of_wall(globals_, parents, upper_arms[side], {point, n}, kArmMargin);
     // find_walls' list: the hands first, then the lower arms, left before right.
     for (const int k : {side, 2 + side}) {
       const WallHit& hit = body_walls_[k];
@@ -554,17 +551,37 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
                                          roles.right_lower_arm, roles.head};
   const glm::vec3 root = locals_[0].translation;
   const float step = ground_height_ + settings_.step_height;
-  std::array<ShapeSweep, 4 + kReachingJoints> sweeps;
-  std::array<SweepHit, 4 + kReachingJoints> hits;
-  std::array<WallHit*, 4 + kReachingJoints> out;
+  constexpr size_t kSweeps = 7 + kReachingJoints;
+  std::array<ShapeSweep, kSweeps> sweeps;
+  std::array<SweepHit, kSweeps> hits;
+  std::array<WallHit*, kSweeps> out;
   // The least horizontal share of a face's normal that makes it a wall to each sweep.
-  std::array<float, 4 + kReachingJoints> least_share;
+  std::array<float, kSweeps> least_share;
   least_share.fill(0.5f);
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
     out[count] = &toe_walls_[side];
     sweeps[count++] = ShapeSweep{glm::vec3(root.x, step, root.z), glm::vec3(toe.x, step, toe.z),
+                                 kWallProbeRadius, 2.0f * kWallProbeRadius};
+  }
+  // The wall the simulation object stands against, where a toe is in its plane: swept from out
+  // of the plane back to the toe, along its normal, a step above the body's ground. The plane
+  // goes on past the wall's end, and a toe stepping into the second course's corridor beside the
+  // end of its wall, in the plane but not in the wall, was pushed out of it: 1.5 m back in a few
+  // updates. Only a face the sweep meets keeps the toe out. A ledge's edge is no face the toe
+  // could go into: ease_ledge_push brings it back over.
+  glm::vec3 beside_point, beside_normal;
+  const bool beside = !obstacle_edge_ && wall_beside(beside_point, beside_normal);
+  for (int side = 0; side < 2; ++side) {
+    beside_toe_walls_[side] = WallHit{};
+    const glm::vec3 toe(legs[static_cast<size_t>(side)].toe.x, step,
+                        legs[static_cast<size_t>(side)].toe.z);
+    const float depth =
+        beside ? glm::dot(beside_point - toe, beside_normal) + kWallProbeRadius : 0.0f;
+    if (!(depth > 0.0f)) continue;
+    out[count] = &beside_toe_walls_[side];
+    sweeps[count++] = ShapeSweep{toe + beside_normal * (depth + kWallProbeRadius), toe,
                                  kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
   // A toe in the air, from where it was to where it goes, at its height over its ground: the
@@ -602,6 +619,14 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
                                  glm::vec3(p.x, p.y - kWallProbeRadius, p.z), kWallProbeRadius,
                                  2.0f * kWallProbeRadius};
   }
+  trunk_wall_ = WallHit{};
+  glm::vec3 trunk;
+  if (deepest_trunk_joint(trunk_wall_.joint, trunk)) {
+    out[count] = &trunk_wall_;
+    sweeps[count++] = ShapeSweep{glm::vec3(root.x, trunk.y - kWallProbeRadius, root.z),
+                                 glm::vec3(trunk.x, trunk.y - kWallProbeRadius, trunk.z),
+                                 kWallProbeRadius, 2.0f * kWallProbeRadius};
+  }
   mover_.sweep(*world_, origin_, std::span(sweeps).first(count), std::span(hits).first(count));
   for (size_t i = 0; i < count; ++i) {
     WallHit& wall = *out[i];
@@ -615,19 +640,42 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   }
 }
 
+// The joint of the trunk or head (higher than a step, not in an arm) deepest in the plane of the
+// wall the simulation object stands against, if one is within a probe's radius of it: find_walls
+// sweeps out to it from the root, and only a wall found there pushes the trunk (wall_depths).
+// The plane goes on past the wall's end: the trunk beside the end of the second course's corridor
+// wall, in the plane but not in the wall, was pushed 5 cm in an update.
+bool Controller::deepest_trunk_joint(int& joint, glm::vec3& position) const {
+  glm::vec3 point, n;
+  if (!wall_beside(point, n)) return false;
+  const float above = ground_height_ + settings_.step_height;
+  float deepest = -kWallProbeRadius;
+  joint = -1;
+  for (size_t j = 1; j < globals_.size(); ++j) {
+    const glm::vec3& p = globals_[j].translation;
+    if (p.y <= above || in_arm(static_cast<int>(j))) continue;
+    const float depth = glm::dot(point - p, n);
+    if (depth > deepest) {
+      deepest = depth;
+      joint = static_cast<int>(j);
+      position = p;
+    }
+  }
+  return joint >= 0;
+}
+
 // A toe target is kept a margin out of the walls found between the body and the toes, and out of
-// the one the simulation object stands against: a step to the side or ahead would put the foot
-// into it (the capsule keeps only the root a radius away). A toe in the air is kept out of the
-// riser it met, which it waits at while its ground rises (FootPlacement, PlacementLeg's
-// held_at_step).
+// the one the simulation object stands against where the toe is in it (find_walls): a step to
+// the side or ahead would put the foot into it (the capsule keeps only the root a radius away).
+// A toe in the air is kept out of the riser it met, which it waits at while its ground rises
+// (FootPlacement, PlacementLeg's held_at_step).
 void Controller::keep_toe_off_wall(int side, glm::vec3& target) const {
   const auto push_out = [&target](const glm::vec3& wall, const glm::vec3& n) {
     const float depth = glm::dot(wall - target, n) + kWallProbeRadius;
     if (depth > 0.0f) target += n * depth;
   };
-  glm::vec3 wall, n;
-  // A ledge's edge is no face the toe could go into: ease_ledge_push brings it back over.
-  if (!obstacle_edge_ && wall_beside(wall, n)) push_out(wall, n);
+  const WallHit& beside = beside_toe_walls_[side];
+  if (beside.found) push_out(beside.point, beside.normal);
   const WallHit& toe_wall = toe_walls_[side];
   if (toe_wall.found) push_out(toe_wall.point, toe_wall.normal);
   const WallHit& riser = riser_walls_[side];

@@ -243,6 +243,23 @@ TEST(CourseRuns, AHandPastAWallsEndDoesNotThrowTheBody) {
   EXPECT_LE(m.ground.wall_depth_cm_max, 2.0);
 }
 
+// Strafing into the second course's corridor (strafe from x = 33.75 at 1/144 s on the tests'
+// database): the simulation object met the end of the corridor's wall, and the plane of that
+// end face, which goes on past the wall, pushed what was in it out: a toe stepping into the
+// corridor beside the wall was pulled back 1.5 m in a few updates (9,660 m/s^2 at 9.19 s), the
+// hips 5 cm in an update (1,169 m/s^2 at 8.85 s). A toe or the trunk in that plane is swept out
+// to and kept out only of a face found there; here every leg end and the hips stay under 170.
+TEST(CourseRuns, BesideAWallsEndNeitherAFootNorTheBodyIsPushedOutOfItsPlane) {
+  const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
+  const CourseRun r{"data/levels/course2.glb", "strafe.txt", {33.75, 2.0}, 0.00694444f};
+  EvaluationMetrics m;
+  EXPECT_LT(largest_acceleration(r, roles.hips, 8.0f, 9.6f, &m), 300.0f);
+  EXPECT_LE(m.ground.wall_depth_cm_max, 2.0);
+  for (const int toe : {roles.left_toe, roles.right_toe}) {
+    EXPECT_LT(largest_acceleration(r, toe, 8.0f, 9.6f), 300.0f) << toe;
+  }
+}
+
 // Up the second course's stairs_20_25 (stop-and-go from x = 11.5 at 1/30 s on the tests'
 // database): a foot landing on the first tread 6 cm before the next riser had its ground raised
 // toward the next tread by the probes' look-ahead, and its contact label came on with the toe

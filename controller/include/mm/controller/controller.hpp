@@ -584,6 +584,7 @@ class Controller {
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs,
                   const std::array<glm::vec3, 2>& shown_toes);
+  bool deepest_trunk_joint(int& joint, glm::vec3& position) const;
   void keep_toe_off_wall(int side, glm::vec3& target) const;
   void ease_wall_push(int side, const glm::vec3& toe, float dt);
   void ease_ledge_push(int side, const glm::vec3& toe, float dt);
@@ -950,12 +951,15 @@ class Controller {
     float depth = 0.0f;
     bool arm = false;
   };
-  static constexpr int kMaxWallDepths = 2 + 2 * kReachingJoints;
+  static constexpr int kMaxWallDepths = 1 + 2 * kReachingJoints;
   size_t wall_depths(std::span<WallDepth, kMaxWallDepths> out) const;
   void follow_arm_push(std::span<const WallDepth> walls, float dt);
   WallHit toe_walls_[2];
+  WallHit beside_toe_walls_[2];  // the wall beside, where a toe is in its plane (find_walls)
   WallHit riser_walls_[2];
   WallHit body_walls_[kReachingJoints];
+  // Toward the trunk's joint deepest in the plane of the wall beside (find_walls).
+  WallHit trunk_wall_;
   glm::vec3 body_shift_{0.0f};  // what moved the body above the root this update
   float ground_offset_[2] = {0.0f, 0.0f};
 
