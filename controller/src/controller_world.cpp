@@ -558,6 +558,8 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   // The least horizontal share of a face's normal that makes it a wall to each sweep.
   std::array<float, kSweeps> least_share;
   least_share.fill(0.5f);
+  // How far each sweep travels before a face it meets counts (m).
+  std::array<float, kSweeps> least_travel{};
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
@@ -605,6 +607,11 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     if (length < 1e-4f) continue;
     out[count] = &riser_walls_[side];
     least_share[count] = kRiserNormal;  // a riser is a side, not a ramp's slope run into
+    // Started a radius back, a toe moving away from a face it was kept a radius off starts
+    // inside it, and the sweep's contact there, at its start, faced the other way: the toe was
+    // pushed into the face it moved away from (random-long from x = 9 at 1/60 s, a toe taken 3.5
+    // cm into the side of stairs_20_25). A face counts only once the sweep is past half of that.
+    least_travel[count] = 0.5f * kWallProbeRadius;
     const glm::vec3 back = (to - from) * (kWallProbeRadius / length);
     sweeps[count++] = ShapeSweep{from - back, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
@@ -631,7 +638,8 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   for (size_t i = 0; i < count; ++i) {
     WallHit& wall = *out[i];
     const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
-    wall.found = hits[i].hit && glm::length(n) > least_share[i];
+    wall.found = hits[i].hit && glm::length(n) > least_share[i] &&
+                 hits[i].fraction * glm::length(sweeps[i].to - sweeps[i].from) >= least_travel[i];
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.

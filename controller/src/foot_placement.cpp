@@ -31,6 +31,16 @@ constexpr float kOnGoalDistance = 0.001f;          // m: nearer, it is on its go
 constexpr float kStepAcceleration = 40.0f;         // m/s^2
 constexpr float kPlantedHeelAcceleration = 20.0f;  // m/s^2: a planted foot's heel
 constexpr float kFallHalflife = 0.06f;             // s
+// A foot rising to a landing a step up (rise_to_landing): the least acceleration it rises at,
+// and the least toe speed its time to the landing is reckoned with.
+constexpr float kLandingRiseAcceleration = 20.0f;  // m/s^2
+constexpr float kLandingRiseMinSpeed = 0.3f;       // m/s
+// The lowest and highest step up a foot rises to as its swing starts (m): a stair's riser, a
+// kerb. Not a bump of rough ground, nor a box's top, which the clip's landing, predicted for
+// flat ground, finds beyond a foot that stops short of the box (the look-ahead's cut at
+// kPastLanding keeps the rest from rising toward it).
+constexpr float kLandingRiseMin = 0.1f;
+constexpr float kLandingRiseMax = 0.25f;
 // The sphere swept from a planted toe toward its hip (m, sweep_toes), how far toward its hip (m)
 // it looks for a step's side its leg would drag it into, and the largest vertical share of a
 // normal that is such a side (a slope's is larger).
@@ -141,17 +151,17 @@ void FootPlacement::update(const WorldQueries& world, const glm::dvec3& origin,
   probe(world, origin, mover, settings, legs, body_ground, body_velocity / pace);
   for (int side = 0; side < 2; ++side) {
     const float foot_length = glm::length(legs[side].toe - legs[side].ankle);
-    const FootGround g = goal(side, settings, foot_length, legs[side].planted);
+    FootGround g = goal(side, settings, foot_length, legs[side].planted);
     Foot& foot = feet_[side];
     const float toe_before = foot.ground.toe;
+    const float rise = rise_to_landing(side, legs[side], body_ground, settings, g);
     // A planted foot's heel crossing a tread's edge (its ankle passing the edge by millimetres
     // as the foot turns on its held toe) rises more gently: the foot pivots about the held toe,
     // and the leg carried the whole rise into the knee (docs/world.md, session 23).
-    const float heel_rise = legs[side].planted ? kPlantedHeelAcceleration : kStepAcceleration;
+    const float heel_rise = legs[side].planted ? kPlantedHeelAcceleration : rise;
     follow_ground(foot.ground.heel, foot.velocity.heel, foot.last_goal.heel, g.heel, heel_rise,
                   pace, dt);
-    follow_ground(foot.ground.toe, foot.velocity.toe, foot.last_goal.toe, g.toe, kStepAcceleration,
-                  pace, dt);
+    follow_ground(foot.ground.toe, foot.velocity.toe, foot.last_goal.toe, g.toe, rise, pace, dt);
     // The ground under the toe now is a floor the toe never lags under. Across a step the
     // look-ahead sees the tread first, but a toe swinging over a tread's front corner toward its
     // side (circling onto stairs, the look-ahead already beside them) reaches the tread the
@@ -434,6 +444,44 @@ void FootPlacement::keep_own_lookahead_to_landings(std::span<const PlacementLeg,
       if (ahead > cap + kBesideStepRise) ahead = cap;
     }
   }
+}
+
+// A foot in the air landing a step up (a tread, a kerb: higher than the plane of the ground under
+// its toe by kLandingRiseMin to kLandingRiseMax) rises toward the landing's ground from the start
+// of its swing, with the acceleration that gets it there as the toe arrives at its toe's speed
+// (at least kLandingRiseAcceleration, at most kStepAcceleration), rather than when its
+// look-ahead meets the riser, a tenth of a second before the toe does, at kStepAcceleration
+// (a settling step onto stairs_20_25's landing, the toe 12 cm short of the tread's height, rose
+// onto it at 40 m/s^2 while its toe waited at the riser). `g` is raised to the landing's ground;
+// returns the rise's acceleration.
+float FootPlacement::rise_to_landing(int side, const PlacementLeg& leg, float body_ground,
+                                     const FootPlacementSettings& settings, FootGround& g) const {
+  if (leg.planted || !leg.lands) return kStepAcceleration;
+  const float landing = found(landing_slot(side), body_ground, settings);
+  const Foot& foot = feet_[side];
+  // A step both ways: above the plane of the ground under the toe (up a ramp the landing is only
+  // the slope), and the plane of the landing's ground above the toe's (where a ramp starts, the
+  // landing up its slope is above the floor's plane, but the ramp's plane meets the floor).
+  const GroundHit& hit = hits_[static_cast<size_t>(landing_slot(side))];
+  const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+  const float landing_plane_at_toe =
+      landing -
+      (n.x * (leg.toe.x - leg.landing.x) + n.z * (leg.toe.z - leg.landing.z)) / std::max(n.y, 0.1f);
+  const float up = landing - std::max(g.toe, plane_height(side, kToe, leg.landing));
+  if (!(up > kLandingRiseMin) || up > kLandingRiseMax ||
+      !(landing_plane_at_toe - g.toe > kLandingRiseMin)) {
+    return kStepAcceleration;
+  }
+  const float left = std::max(0.0f, landing - foot.ground.toe);
+  const float distance =
+      glm::length(glm::vec2(leg.landing.x - leg.toe.x, leg.landing.z - leg.toe.z));
+  const float speed = std::max(glm::length(glm::vec2(foot.toe_velocity.x, foot.toe_velocity.z)),
+                               kLandingRiseMinSpeed);
+  const float time = distance / speed;
+  g.toe = landing;
+  g.heel = std::max(g.heel, landing);
+  const float needed = time > 1e-3f ? 4.0f * left / (time * time) : kStepAcceleration;
+  return std::clamp(needed, kLandingRiseAcceleration, kStepAcceleration);
 }
 
 // The heights a foot's heel and toe go to: the highest of now and ahead, then each raised to

@@ -433,6 +433,51 @@ TEST(FootPlacement, ARiserSeenAheadIsClimbedWithBoundedAcceleration) {
   }
 }
 
+// A foot stepping onto a tread (a settling step as the body stops before stairs, the body not
+// moving: no body look-ahead) rises toward its landing from the start of its swing, at the
+// acceleration that gets it there as the toe arrives, at least kLandingRiseAcceleration (20
+// m/s^2), on the tread's height before the toe reaches the riser; its own look-ahead alone saw
+// the riser 0.1 s before the toe got there and rose at 40 m/s^2. Not onto a box's top, higher
+// than a stair's riser, which a foot stopping short of it was raised toward (the clip's landing
+// is predicted for flat ground).
+TEST(FootPlacement, AFootLandingAStepUpRisesFromTheStartOfItsSwing) {
+  for (const float dt : {1.0f / 30.0f, 1.0f / 60.0f, 1.0f / 144.0f}) {
+    for (const float height : {0.17f, 0.3f}) {
+      AnalyticWorld world;
+      add_riser(world, 0.6f, height);
+      CharacterMover mover;
+      FootPlacement p;
+      std::array<PlacementLeg, 2> legs = left_swinging(-0.45f);
+      legs[0].lowest = 0.02f;
+      legs[0].lands = true;
+      legs[0].landing = glm::vec3(-0.1f, 0.0f, 0.8f);
+      p.reset(0.0f);
+      const glm::vec3 velocity(0.0f, 0.0f, 0.6f);
+      std::array<float, 3> heights{0.0f, 0.0f, 0.0f};
+      float largest = 0.0f, halfway = 0.0f;
+      int updates = 0;
+      while (legs[0].toe.z + velocity.z * dt < 0.6f - 0.03f) {
+        legs[0].toe += velocity * dt;
+        legs[0].ankle += velocity * dt;
+        p.update(world, glm::dvec3(0.0), mover, FootPlacementSettings{}, legs, 0.0f,
+                 glm::vec3(0.0f), dt);
+        heights = {heights[1], heights[2], p.ground(0).toe};
+        if (legs[0].toe.z < 0.3f) halfway = p.ground(0).toe;
+        if (++updates >= 3) {
+          largest =
+              std::max(largest, std::abs(heights[2] - 2.0f * heights[1] + heights[0]) / (dt * dt));
+        }
+      }
+      if (height < 0.2f) {
+        EXPECT_NEAR(halfway, height, 1e-3f) << dt;  // up already, the toe 30 cm from the riser
+        EXPECT_LE(largest, 25.0f) << dt;  // kLandingRiseAcceleration, landing on the height
+      } else {
+        EXPECT_EQ(halfway, 0.0f) << dt;
+      }
+    }
+  }
+}
+
 // A step seen ahead for two updates only (a probe grazing the side of stairs_12_35): the toe's
 // ground starts up toward it and, the step gone, comes back down on its spring. At the top of
 // that short rise the ground is slow, but not on the goal it followed: dropped the rest at once,

@@ -260,6 +260,20 @@ TEST(CourseRuns, BesideAWallsEndNeitherAFootNorTheBodyIsPushedOutOfItsPlane) {
   }
 }
 
+// Stopping at the top of the second course's stairs_20_25 (stand-turns from x = 11.5 at 1/30 s on
+// the tests' database): a settling step onto the landing, the toe 12 cm short of the tread's
+// height, rose only when its look-ahead met the riser, an update before the toe did, at 40
+// m/s^2 while the toe waited there (the right leg's joints 46-53 m/s^2 at 43.3-43.43 s, the run's
+// transition ratio 0.924). A foot landing a step up rises toward its landing from the start of
+// its swing, here at about half that.
+TEST(CourseRuns, AFootLandingAStepUpRisesFromTheStartOfItsSwing) {
+  const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
+  const CourseRun r{"data/levels/course2.glb", "stand-turns.txt", {11.5, 2.0}, 0.0333333f};
+  for (const int joint : {roles.right_lower_leg, roles.right_foot, roles.right_toe}) {
+    EXPECT_LT(largest_acceleration(r, joint, 42.9f, 43.6f), 35.0f) << joint;
+  }
+}
+
 // Up the second course's stairs_20_25 (stop-and-go from x = 11.5 at 1/30 s on the tests'
 // database): a foot landing on the first tread 6 cm before the next riser had its ground raised
 // toward the next tread by the probes' look-ahead, and its contact label came on with the toe

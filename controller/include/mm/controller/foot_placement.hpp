@@ -182,6 +182,8 @@ class FootPlacement {
   void follow_toes(std::span<const PlacementLeg, 2> legs, float dt);
   FootGround goal(int side, const FootPlacementSettings& settings, float foot_length,
                   bool planted) const;
+  float rise_to_landing(int side, const PlacementLeg& leg, float body_ground,
+                        const FootPlacementSettings& settings, FootGround& g) const;
   void sweep_toes(const WorldQueries& world, const glm::dvec3& origin, CharacterMover& mover,
                   std::span<const PlacementLeg, 2> legs, float body_ground);
   float drop_goal(const FootPlacementSettings& settings, std::span<const PlacementLeg, 2> legs,
