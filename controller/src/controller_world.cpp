@@ -39,6 +39,9 @@ constexpr float kArmPushAcceleration = 20.0f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
+// A face met at a sweep's start whose normal's share against the way is less than this (cosine)
+// lies across the way (backed_into_face).
+constexpr float kAcrossTheWay = 0.5f;
 // The least horizontal share of a face's normal that makes it a riser a toe waits at (a face
 // steeper than about 64 degrees).
 constexpr float kRiserNormal = 0.9f;
@@ -62,6 +65,17 @@ constexpr float kSameEdge = 0.99f;
 // How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
 // the skin's thickness through it).
 constexpr float kArmMargin = 0.01f;
+
+// Whether a sweep started a radius back from where it goes from (find_walls' risers) met a face
+// within half a radius of its start, facing back along its way: the start was inside the face,
+// and such a contact's normal is the reverse of the face's.
+bool backed_into_face(const ShapeSweep& sweep, const SweepHit& hit) {
+  const glm::vec3 way(sweep.to.x - sweep.from.x, 0.0f, sweep.to.z - sweep.from.z);
+  const float length = glm::length(way);
+  if (!(length > 1e-6f) || hit.fraction * length >= 0.5f * kWallProbeRadius) return false;
+  const glm::vec3 n(hit.normal.x, 0.0f, hit.normal.z);
+  return glm::dot(n, way / length) < -kAcrossTheWay;
+}
 
 }  // namespace
 
@@ -558,8 +572,8 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   // The least horizontal share of a face's normal that makes it a wall to each sweep.
   std::array<float, kSweeps> least_share;
   least_share.fill(0.5f);
-  // How far each sweep travels before a face it meets counts (m).
-  std::array<float, kSweeps> least_travel{};
+  // The sweeps started a radius back from where they go from (the risers').
+  std::array<bool, kSweeps> backed{};
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
@@ -610,8 +624,10 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     // Started a radius back, a toe moving away from a face it was kept a radius off starts
     // inside it, and the sweep's contact there, at its start, faced the other way: the toe was
     // pushed into the face it moved away from (random-long from x = 9 at 1/60 s, a toe taken 3.5
-    // cm into the side of stairs_20_25). A face counts only once the sweep is past half of that.
-    least_travel[count] = 0.5f * kWallProbeRadius;
+    // cm into the side of stairs_20_25). A face met within half a radius of the start counts
+    // only across the way (a toe sliding along the riser it is kept off), not facing back along
+    // it.
+    backed[count] = true;
     const glm::vec3 back = (to - from) * (kWallProbeRadius / length);
     sweeps[count++] = ShapeSweep{from - back, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
   }
@@ -639,7 +655,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     WallHit& wall = *out[i];
     const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
     wall.found = hits[i].hit && glm::length(n) > least_share[i] &&
-                 hits[i].fraction * glm::length(sweeps[i].to - sweeps[i].from) >= least_travel[i];
+                 !(backed[i] && backed_into_face(sweeps[i], hits[i]));
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.
