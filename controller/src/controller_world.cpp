@@ -584,9 +584,9 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   // The wall the simulation object stands against, where a toe is in its plane: swept from out
   // of the plane back to the toe, along its normal, a step above the body's ground. The plane
   // goes on past the wall's end, and a toe stepping into the second course's corridor beside the
-  // end of its wall, in the plane but not in the wall, was pushed out of it: 1.5 m back in a few
-  // updates. Only a face the sweep meets keeps the toe out. A ledge's edge is no face the toe
-  // could go into: ease_ledge_push brings it back over.
+  // end of its wall, in the plane but not in the wall, was pushed out of it, back toward the
+  // body, in a few updates. Only a face the sweep meets keeps the toe out. A ledge's edge is no
+  // face the toe could go into: ease_ledge_push brings it back over.
   glm::vec3 beside_point, beside_normal;
   const bool beside = !obstacle_edge_ && wall_beside(beside_point, beside_normal);
   for (int side = 0; side < 2; ++side) {
@@ -623,8 +623,8 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     least_share[count] = kRiserNormal;  // a riser is a side, not a ramp's slope run into
     // Started a radius back, a toe moving away from a face it was kept a radius off starts
     // inside it, and the sweep's contact there, at its start, faced the other way: the toe was
-    // pushed into the face it moved away from (random-long from x = 9 at 1/60 s, a toe taken 3.5
-    // cm into the side of stairs_20_25). A face met within half a radius of the start counts
+    // pushed into the face it moved away from (random-long from x = 9 at 1/60 s, a toe taken into
+    // the side of stairs_20_25; docs/world.md). A face met within half a radius of the start counts
     // only across the way (a toe sliding along the riser it is kept off), not facing back along
     // it.
     backed[count] = true;
@@ -668,7 +668,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
 // wall the simulation object stands against, if one is within a probe's radius of it: find_walls
 // sweeps out to it from the root, and only a wall found there pushes the trunk (wall_depths).
 // The plane goes on past the wall's end: the trunk beside the end of the second course's corridor
-// wall, in the plane but not in the wall, was pushed 5 cm in an update.
+// wall, in the plane but not in the wall, was pushed out of it in an update (docs/world.md).
 bool Controller::deepest_trunk_joint(int& joint, glm::vec3& position) const {
   glm::vec3 point, n;
   if (!wall_beside(point, n)) return false;

@@ -450,10 +450,10 @@ void FootPlacement::keep_own_lookahead_to_landings(std::span<const PlacementLeg,
 // its toe by kLandingRiseMin to kLandingRiseMax) rises toward the landing's ground from the start
 // of its swing, with the acceleration that gets it there as the toe arrives at its toe's speed
 // (at least kLandingRiseAcceleration, at most kStepAcceleration), rather than when its
-// look-ahead meets the riser, a tenth of a second before the toe does, at kStepAcceleration
-// (a settling step onto stairs_20_25's landing, the toe 12 cm short of the tread's height, rose
-// onto it at 40 m/s^2 while its toe waited at the riser). `g` is raised to the landing's ground;
-// returns the rise's acceleration.
+// look-ahead meets the riser, just before the toe does, at kStepAcceleration (a settling step
+// onto stairs_20_25's landing, well short of the tread's height, rose onto it while its toe
+// waited at the riser; docs/world.md). `g` is raised to the landing's ground; returns the rise's
+// acceleration.
 float FootPlacement::rise_to_landing(int side, const PlacementLeg& leg, float body_ground,
                                      const FootPlacementSettings& settings, FootGround& g) const {
   if (leg.planted || !leg.lands) return kStepAcceleration;
