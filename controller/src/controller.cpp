@@ -1441,7 +1441,9 @@ glm::vec3 Controller::foot_target(int side, const glm::vec3& animated, const glm
   const float floor = shared_->lowest_foot_end(side) + toe_ground(side);
   const float below = target.y - floor;
   target.y = floor + 0.5f * (below + std::sqrt(below * below + kFloorSoftness * kFloorSoftness));
-  f.target_velocity = (target - f.target) / dt;
+  // An update of no time (a placement, the root pulled within reach of a game's capsule) keeps
+  // the rate: divided by it, the rate was not a number, and a release carried it on.
+  if (dt > 0.0f) f.target_velocity = (target - f.target) / dt;
   f.target = target;
   // A stepping foot rises with the distance it still has to go and lands as it arrives (a foot
   // turning round its toe still has its heel's arc to go); the lift itself follows that height
@@ -1654,7 +1656,8 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
       // Raised with the need, the heel keeps the rate it rose at: once the need falls away it
       // comes down on its spring from that rate, not from rest, which was a jolt at the ankle.
       const float rise = needed - f.heel_lag;
-      f.heel_rise_velocity = f.lock_began ? 0.0f : std::max(0.0f, (rise - f.heel_rise) / dt);
+      f.heel_rise_velocity =
+          f.lock_began || !(dt > 0.0f) ? 0.0f : std::max(0.0f, (rise - f.heel_rise) / dt);
       f.heel_rise = rise;
     }
     if (f.heel_rise > 0.0f) {

@@ -57,6 +57,28 @@ TEST(GameCapsule, TheCharacterFollowsTheGamesCapsuleUpStairsAndStopsAtItsWall) {
   EXPECT_LT(largest_step, 0.05f);
 }
 
+// A game that moves its capsule in one frame, again and again (a teleport of its own, a push):
+// the displayed root is pulled within reach of the capsule at once, the held feet following, in
+// an update of no time. Nothing a foot works out per second may divide by that time: the held
+// toe's rate and its heel's rise did, and the joints went to NaN for good.
+TEST(GameCapsule, ACapsuleMovedFarInOneFrameLeavesEveryJointFinite) {
+  Controller c = make_controller();
+  for (int f = 0; f < 90; ++f) c.update(kDt, push_toward(0.0f));
+  for (int jump = 0; jump < 12; ++jump) {
+    const glm::dvec3 capsule =
+        c.simulation_position_world() + glm::dvec3(0.1 * (jump + 1), 0.0, -0.15 * jump);
+    c.set_simulation_position_world(capsule);
+    for (int f = 0; f < 30; ++f) {
+      c.update(kDt, push_toward(0.0f));
+      for (const Transform& t : c.global_transforms()) {
+        ASSERT_TRUE(std::isfinite(t.translation.x) && std::isfinite(t.translation.y) &&
+                    std::isfinite(t.translation.z))
+            << jump << " " << f;
+      }
+    }
+  }
+}
+
 TEST(GameCapsule, ANonFinitePositionIsIgnored) {
   Controller c = make_controller();
   for (int f = 0; f < 30; ++f) c.update(kDt, push_toward(90.0f));
