@@ -588,7 +588,8 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   // body, in a few updates. Only a face the sweep meets keeps the toe out. A ledge's edge is no
   // face the toe could go into: ease_ledge_push brings it back over.
   glm::vec3 beside_point, beside_normal;
-  const bool beside = !obstacle_edge_ && wall_beside(beside_point, beside_normal);
+  const bool against_wall = wall_beside(beside_point, beside_normal);
+  const bool beside = against_wall && !obstacle_edge_;
   for (int side = 0; side < 2; ++side) {
     beside_toe_walls_[side] = WallHit{};
     const glm::vec3 toe(legs[static_cast<size_t>(side)].toe.x, step,
@@ -644,7 +645,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   }
   trunk_wall_ = WallHit{};
   glm::vec3 trunk;
-  if (deepest_trunk_joint(trunk_wall_.joint, trunk)) {
+  if (against_wall && deepest_trunk_joint(beside_point, beside_normal, trunk_wall_.joint, trunk)) {
     out[count] = &trunk_wall_;
     sweeps[count++] = ShapeSweep{glm::vec3(root.x, trunk.y - kWallProbeRadius, root.z),
                                  glm::vec3(trunk.x, trunk.y - kWallProbeRadius, trunk.z),
@@ -665,13 +666,13 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
 }
 
 // The joint of the trunk or head (higher than a step, not in an arm) deepest in the plane of the
-// wall the simulation object stands against, if one is within a probe's radius of it: find_walls
-// sweeps out to it from the root, and only a wall found there pushes the trunk (wall_depths).
+// wall the simulation object stands against (through `point`, normal `n`: wall_beside), if one is
+// within a probe's radius of it: find_walls sweeps out to it from the root, and only a wall found
+// there pushes the trunk (wall_depths).
 // The plane goes on past the wall's end: the trunk beside the end of the second course's corridor
 // wall, in the plane but not in the wall, was pushed out of it in an update (docs/world.md).
-bool Controller::deepest_trunk_joint(int& joint, glm::vec3& position) const {
-  glm::vec3 point, n;
-  if (!wall_beside(point, n)) return false;
+bool Controller::deepest_trunk_joint(const glm::vec3& point, const glm::vec3& n, int& joint,
+                                     glm::vec3& position) const {
   const float above = ground_height_ + settings_.step_height;
   float deepest = -kWallProbeRadius;
   joint = -1;

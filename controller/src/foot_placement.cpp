@@ -116,6 +116,13 @@ void follow_ground(float& height, float& velocity, float& last_goal, float goal,
   }
 }
 
+// The height at `at` (horizontally) of the plane through `point` tilted as the surface `hit`
+// found (level where it hit nothing).
+float height_on_plane(const glm::vec3& point, const GroundHit& hit, const glm::vec3& at) {
+  const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
+  return point.y - (n.x * (at.x - point.x) + n.z * (at.z - point.z)) / std::max(n.y, 0.1f);
+}
+
 // A ground height held at or above `floor`: lifted onto it, it goes on from rest there
 // (with the speed it had, it would overshoot the floor and the goal).
 void stay_above(float& height, float& velocity, float floor) {
@@ -380,10 +387,7 @@ void FootPlacement::stand_on_edges(float body_ground, const FootPlacementSetting
 // The height at `at` (horizontally) of the plane through the ground probe `which` of a side found,
 // tilted as the surface it hit (level where it hit nothing).
 float FootPlacement::plane_height(int side, int which, const glm::vec3& at) const {
-  const glm::vec3& here = probe_grounds_[slot(side, which)];
-  const GroundHit& hit = hits_[slot(side, which)];
-  const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
-  return here.y - (n.x * (at.x - here.x) + n.z * (at.z - here.z)) / std::max(n.y, 0.1f);
+  return height_on_plane(probe_grounds_[slot(side, which)], hits_[slot(side, which)], at);
 }
 
 // A planted foot whose toe stands on a tread and whose heel is out over the edge behind it rests
@@ -462,11 +466,9 @@ float FootPlacement::rise_to_landing(int side, const PlacementLeg& leg, float bo
   // A step both ways: above the plane of the ground under the toe (up a ramp the landing is only
   // the slope), and the plane of the landing's ground above the toe's (where a ramp starts, the
   // landing up its slope is above the floor's plane, but the ramp's plane meets the floor).
-  const GroundHit& hit = hits_[static_cast<size_t>(landing_slot(side))];
-  const glm::vec3 n = hit.hit ? hit.normal : glm::vec3(0.0f, 1.0f, 0.0f);
   const float landing_plane_at_toe =
-      landing -
-      (n.x * (leg.toe.x - leg.landing.x) + n.z * (leg.toe.z - leg.landing.z)) / std::max(n.y, 0.1f);
+      height_on_plane(glm::vec3(leg.landing.x, landing, leg.landing.z),
+                      hits_[static_cast<size_t>(landing_slot(side))], leg.toe);
   const float up = landing - std::max(g.toe, plane_height(side, kToe, leg.landing));
   if (!(up > kLandingRiseMin) || up > kLandingRiseMax ||
       !(landing_plane_at_toe - g.toe > kLandingRiseMin)) {

@@ -584,7 +584,8 @@ class Controller {
   bool wall_beside(glm::vec3& point, glm::vec3& normal) const;
   void find_walls(const std::array<PlacementLeg, 2>& legs,
                   const std::array<glm::vec3, 2>& shown_toes);
-  bool deepest_trunk_joint(int& joint, glm::vec3& position) const;
+  bool deepest_trunk_joint(const glm::vec3& point, const glm::vec3& n, int& joint,
+                           glm::vec3& position) const;
   void keep_toe_off_wall(int side, glm::vec3& target) const;
   void ease_wall_push(int side, const glm::vec3& toe, float dt);
   void ease_ledge_push(int side, const glm::vec3& toe, float dt);
