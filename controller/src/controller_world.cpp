@@ -576,6 +576,12 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
   std::array<bool, kSweeps> backed{};
   size_t count = 0;
   for (int side = 0; side < 2; ++side) {
+    toe_walls_[side] = WallHit{};
+    // A toe standing on ground higher than the sweep (held on a tread the body went down beside,
+    // more than a step below it) is over what the sweep meets there, the riser under its own
+    // tread: pushed out of it, the toe let go went 19 cm back in an update (circling off the side
+    // of the second course's stairs_12_35; docs/world.md, session 32).
+    if (foot_placement_.ground(side).toe > step) continue;
     const glm::vec3& toe = legs[static_cast<size_t>(side)].toe;
     out[count] = &toe_walls_[side];
     sweeps[count++] = ShapeSweep{glm::vec3(root.x, step, root.z), glm::vec3(toe.x, step, toe.z),

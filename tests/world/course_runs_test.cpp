@@ -260,6 +260,20 @@ TEST(CourseRuns, BesideAWallsEndNeitherAFootNorTheBodyIsPushedOutOfItsPlane) {
   }
 }
 
+// Circling off the side of the second course's stairs_12_35 (circle from x = 8.7 at 1/144 s on
+// the tests' database): a toe held on the fourth tread (48 cm up) while the body went down beside
+// the stairs stood, when let go, 38 cm above the body's ground, and the sweep from the root out
+// to it a step above the body's ground met the riser under that tread: the toe was pushed 19 cm
+// back in an update (the left leg's joints 2,500-3,900 m/s^2 at 4.58 s; under 40 now). A toe on
+// ground higher than that sweep goes on with the animation.
+TEST(CourseRuns, AToeLeftOnATreadTheBodyWentDownBesideIsNotPushedOffIt) {
+  const JointRoleIndices& roles = test::normal_controller_database()->database().roles();
+  const CourseRun r{"data/levels/course2.glb", "circle.txt", {8.7, 2.0}, 0.00694444f};
+  for (const int joint : {roles.left_lower_leg, roles.left_toe}) {
+    EXPECT_LT(largest_acceleration(r, joint, 4.5f, 4.7f), 100.0f) << joint;
+  }
+}
+
 // Stopping at the top of the second course's stairs_20_25 (stand-turns from x = 11.5 at 1/30 s on
 // the tests' database): a settling step onto the landing, the toe 12 cm short of the tread's
 // height, rose only when its look-ahead met the riser, an update before the toe did, at 40
