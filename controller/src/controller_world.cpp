@@ -9,6 +9,7 @@
 
 #include "mm/controller/arm_off_wall.hpp"
 #include "mm/controller/controller.hpp"
+#include "mm/controller/sweep_start.hpp"
 #include "mm/controller/wall_slide.hpp"
 #include "mm/runtime/approach.hpp"
 #include "mm/runtime/finite.hpp"
@@ -39,9 +40,6 @@ constexpr float kArmPushAcceleration = 20.0f;
 // The radius (m) of the spheres swept to find walls near the toes and arms, and how far a toe
 // joint stays from a wall's face (the toes reach past their joint).
 constexpr float kWallProbeRadius = 0.03f;
-// A face met at a sweep's start whose normal's share against the way is less than this (cosine)
-// lies across the way (backed_into_face).
-constexpr float kAcrossTheWay = 0.5f;
 // The least horizontal share of a face's normal that makes it a riser a toe waits at (a face
 // steeper than about 64 degrees).
 constexpr float kRiserNormal = 0.9f;
@@ -65,17 +63,6 @@ constexpr float kSameEdge = 0.99f;
 // How far in front of a wall's face an arm's joints are swung (a hand exactly on the plane shows
 // the skin's thickness through it).
 constexpr float kArmMargin = 0.01f;
-
-// Whether a sweep started a radius back from where it goes from (find_walls' risers) met a face
-// within half a radius of its start, facing back along its way: the start was inside the face,
-// and such a contact's normal is the reverse of the face's.
-bool backed_into_face(const ShapeSweep& sweep, const SweepHit& hit) {
-  const glm::vec3 way(sweep.to.x - sweep.from.x, 0.0f, sweep.to.z - sweep.from.z);
-  const float length = glm::length(way);
-  if (!(length > 1e-6f) || hit.fraction * length >= 0.5f * kWallProbeRadius) return false;
-  const glm::vec3 n(hit.normal.x, 0.0f, hit.normal.z);
-  return glm::dot(n, way / length) < -kAcrossTheWay;
-}
 
 }  // namespace
 
@@ -662,7 +649,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     WallHit& wall = *out[i];
     const glm::vec3 n(hits[i].normal.x, 0.0f, hits[i].normal.z);
     wall.found = hits[i].hit && glm::length(n) > least_share[i] &&
-                 !(backed[i] && backed_into_face(sweeps[i], hits[i]));
+                 !(backed[i] && backed_into_face(sweeps[i], hits[i], kWallProbeRadius));
     if (!wall.found) continue;
     wall.normal = glm::normalize(n);
     // The sphere's centre stopped a radius off the face.
