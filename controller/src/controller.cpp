@@ -425,7 +425,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
   sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
   if (world_) settle_on_ground();
-  sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
+  sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = sim_yield_ = glm::vec3(0.0f);
   sim_rotation_ = desired_rotation_ = simulation_goal_rotation_ = warp_facing_ = rotation;
   warp_facing_reached_ = true;
   desired_velocity_ = glm::vec3(0.0f);
@@ -952,6 +952,8 @@ void Controller::simulate(float dt) {
     limit_turn_rate(before_rotation, dt);
   }
   if (world_) {
+    sim_position_ += sim_yield_;
+    sim_yield_ = glm::vec3(0.0f);
     collide_simulation(before);
   } else if (!game_capsule_) {
     sim_position_.y = 0.0f;
@@ -1064,7 +1066,14 @@ void Controller::synchronize(float dt) {
     if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
     const float max_step = max_speed * dt;
     if (glm::length(step) > max_step) step *= max_step / glm::length(step);
-    sim_position_ += without_slide_back(step, dt);
+    // In a world the give is swept with the object's next step (simulate): moved straight toward
+    // a character going round a wall's end, the object went into the wall's corner, through to
+    // its back (docs/world.md, session 32).
+    if (world_) {
+      sim_yield_ += without_slide_back(step, dt);
+    } else {
+      sim_position_ += without_slide_back(step, dt);
+    }
   }
   // Pull the character toward the simulation, no faster than a share of its own motion.
   const glm::vec3 velocity = displayed_velocity_;
@@ -1631,10 +1640,9 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // hip-to-target line instead, a foot behind the body over a box's edge swung back toward the
   // hip, into the box's face (docs/world.md, session 27). Faded in over kShortBelowDepth of the
   // foot's ground below the body's.
-  if (world_) {
-    const float below = ground_height_ - foot_placement_.ground(side).toe;
-    reached = reach_down(ankle_target - hip_position, reached, below / kShortBelowDepth);
-  }
+  const float reach_down_weight =
+      world_ ? (ground_height_ - foot_placement_.ground(side).toe) / kShortBelowDepth : 0.0f;
+  reached = reach_down(ankle_target - hip_position, reached, reach_down_weight);
   // A held toe the softened leg falls short of is reached by lifting the heel, not by dragging
   // the toe: the leg keeps the softened length, so the knee bends as it would, and the toe
   // stays put (up to the heel's limit).
@@ -1662,8 +1670,11 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
     }
     if (f.heel_rise > 0.0f) {
       heel_rise = glm::angleAxis(f.heel_rise, f.heel_axis);
-      reached = target + rotated(heel_rise, ankle_target - target) - hip_position;
-      reached *= std::min(1.0f, length / glm::length(reached));
+      // Cut to the leg's length as the reach itself is: a foot reaching down stays over its
+      // point (cut along the hip's line, a foot held behind the body on the tread below, its
+      // heel lifting, was taken forward into the riser above it: docs/world.md, session 32).
+      reached = reach_at_most(target + rotated(heel_rise, ankle_target - target) - hip_position,
+                              length, reach_down_weight);
     }
   }
   f.lock_began = false;

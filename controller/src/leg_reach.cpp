@@ -42,4 +42,10 @@ glm::vec3 reach_down(const glm::vec3& hip_to_ankle, const glm::vec3& reached, fl
   return mixed_length > 1e-6f ? mixed * (length / mixed_length) : reached;
 }
 
+glm::vec3 reach_at_most(const glm::vec3& hip_to_ankle, float length, float weight) {
+  const float d = glm::length(hip_to_ankle);
+  if (!(d > length)) return hip_to_ankle;
+  return reach_down(hip_to_ankle, hip_to_ankle * (length / d), weight);
+}
+
 }  // namespace mm

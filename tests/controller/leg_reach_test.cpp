@@ -99,5 +99,25 @@ TEST(LegReach, ReachingDownChangesNothingWhereTheLegReachesOrTheWeightIsNone) {
   expect_near(reach_down(up, up_along, 1.0f), up_along, 0.0f);
 }
 
+// A heel lifted about a held toe puts the ankle somewhere the leg may still not reach: cut to the
+// leg's length, a foot reaching down stays over its point as the reach itself does (cut along the
+// hip's line, a foot held behind the body on the tread below was taken 3 cm forward into the
+// riser above it: camera-turns from x = 11.25, z = 1.5 on the second course at 1/60 s, the
+// default database), and one on the body's ground falls short along the line.
+TEST(LegReach, ALiftedAnkleOutOfReachIsCutAsTheReachIs) {
+  const glm::vec3 lifted(0.0f, -0.77f, -0.38f);
+  const float length = 0.8f;
+  ASSERT_GT(glm::length(lifted), length);
+  const glm::vec3 down = reach_at_most(lifted, length, 1.0f);
+  EXPECT_NEAR(glm::length(down), length, 1e-5f);
+  EXPECT_NEAR(down.z, -0.38f, 1e-5f);
+  const glm::vec3 along = reach_at_most(lifted, length, 0.0f);
+  expect_near(along, lifted * (length / glm::length(lifted)), 1e-6f);
+  EXPECT_GT(along.z, -0.38f + 0.02f);
+  // Within reach nothing is cut.
+  const glm::vec3 near(0.0f, -0.7f, -0.2f);
+  expect_near(reach_at_most(near, length, 1.0f), near, 0.0f);
+}
+
 }  // namespace
 }  // namespace mm

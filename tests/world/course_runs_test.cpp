@@ -274,6 +274,28 @@ TEST(CourseRuns, AToeLeftOnATreadTheBodyWentDownBesideIsNotPushedOffIt) {
   }
 }
 
+// Strafing along the second course's corner's far wall (its face z = 7, x 29.3 to 32.05, 25 cm
+// thick) past its end and back (strafe-run from x = 31.05, z = 1.5, on the tests' database): the
+// character went round the wall's end while the simulation object gave way toward it in a
+// straight line, into the wall's corner, up to 2.3 cm deep at 1/60 and 1/30 s (on the default
+// database at 1/144 s right through, to the wall's back; the legs thrown about, 4,278 m/s^2).
+// The give is swept with the object's next step.
+TEST(CourseRuns, TheSimulationObjectGivingWayToTheCharacterStaysOutOfAWallsCorner) {
+  constexpr float kWallX[2] = {29.3f, 32.05f}, kWallZ[2] = {7.0f, 7.25f};
+  const float radius = ControllerSettings{}.character_radius;
+  for (const float dt : {1.0f / 60.0f, 1.0f / 30.0f}) {
+    const CourseRun r{"data/levels/course2.glb", "strafe-run.txt", {31.05, 1.5}, dt};
+    float deepest = 0.0f;
+    run(r, [&](const EvaluationFrame& frame) {
+      const glm::dvec3 p = frame.origin + glm::dvec3(frame.sim_position);
+      const double dx = p.x - std::clamp(p.x, double(kWallX[0]), double(kWallX[1]));
+      const double dz = p.z - std::clamp(p.z, double(kWallZ[0]), double(kWallZ[1]));
+      deepest = std::max(deepest, radius - static_cast<float>(std::hypot(dx, dz)));
+    });
+    EXPECT_LT(deepest, 0.005f) << dt;
+  }
+}
+
 // Stopping at the top of the second course's stairs_20_25 (stand-turns from x = 11.5 at 1/30 s on
 // the tests' database): a settling step onto the landing, the toe 12 cm short of the tread's
 // height, rose only when its look-ahead met the riser, an update before the toe did, at 40

@@ -42,4 +42,8 @@ glm::vec3 short_below(const glm::vec3& hip_to_ankle, float length);
 // the target is not below the hip.
 glm::vec3 reach_down(const glm::vec3& hip_to_ankle, const glm::vec3& reached, float weight);
 
+// `hip_to_ankle` (where a heel lifted about a held toe puts the ankle) no longer than `length`:
+// cut along itself, or, by `weight` as reach_down's, kept over the point it reaches for.
+glm::vec3 reach_at_most(const glm::vec3& hip_to_ankle, float length, float weight);
+
 }  // namespace mm
