@@ -283,6 +283,20 @@ MoveResult CharacterMover::move(const WorldQueries& world, const glm::dvec3& ori
   return result;
 }
 
+glm::vec3 CharacterMover::free_step(const WorldQueries& world, const glm::dvec3& origin,
+                                    const CharacterShape& shape, const glm::vec3& position,
+                                    const glm::vec3& step) {
+  const glm::vec3 d(step.x, 0.0f, step.z);
+  if (!(glm::length(d) > 1e-6f)) return d;
+  const glm::vec3 from = position + lift(shape);
+  const ShapeSweep query{from, from + d, shape.radius, shape.height};
+  SweepHit hit;
+  world.sweep(origin, std::span(&query, 1), std::span(&hit, 1));
+  if (!accept(query, hit) || !hit.hit || on_step_top(hit.normal)) return d;
+  const glm::vec3 n = horizontal_normal(hit.normal, d);
+  return d - n * std::min(0.0f, glm::dot(d, n));
+}
+
 bool CharacterMover::ground(const WorldQueries& world, const glm::dvec3& origin,
                             const CharacterShape& shape, const glm::vec3& position, float above,
                             GroundHit& hit) {

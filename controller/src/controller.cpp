@@ -425,7 +425,7 @@ void Controller::place(const glm::vec3& position, float yaw) {
   const glm::quat rotation = yaw_rotation(std::isfinite(yaw) ? yaw : 0.0f);
   sim_position_ = finite(ground) ? ground : glm::vec3(0.0f);
   if (world_) settle_on_ground();
-  sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = sim_yield_ = glm::vec3(0.0f);
+  sim_velocity_ = sim_acceleration_ = sim_angular_velocity_ = glm::vec3(0.0f);
   sim_rotation_ = desired_rotation_ = simulation_goal_rotation_ = warp_facing_ = rotation;
   warp_facing_reached_ = true;
   desired_velocity_ = glm::vec3(0.0f);
@@ -952,8 +952,6 @@ void Controller::simulate(float dt) {
     limit_turn_rate(before_rotation, dt);
   }
   if (world_) {
-    sim_position_ += sim_yield_;
-    sim_yield_ = glm::vec3(0.0f);
     collide_simulation(before);
   } else if (!game_capsule_) {
     sim_position_.y = 0.0f;
@@ -1066,14 +1064,12 @@ void Controller::synchronize(float dt) {
     if (stopping_) max_speed = std::max(max_speed, settings_.simulation_yield_standing_speed);
     const float max_step = max_speed * dt;
     if (glm::length(step) > max_step) step *= max_step / glm::length(step);
-    // In a world the give is swept with the object's next step (simulate): moved straight toward
-    // a character going round a wall's end, the object went into the wall's corner, through to
-    // its back (docs/world.md, session 32).
-    if (world_) {
-      sim_yield_ += without_slide_back(step, dt);
-    } else {
-      sim_position_ += without_slide_back(step, dt);
-    }
+    // In a world the give goes no way into a wall: given straight toward a character going round
+    // a wall's end, the object went into the wall's corner, and on through to its back
+    // (docs/world.md, session 32).
+    step = without_slide_back(step, dt);
+    if (world_) step = mover_.free_step(*world_, origin_, character_shape(), sim_position_, step);
+    sim_position_ += step;
   }
   // Pull the character toward the simulation, no faster than a share of its own motion.
   const glm::vec3 velocity = displayed_velocity_;

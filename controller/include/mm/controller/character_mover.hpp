@@ -115,6 +115,13 @@ class CharacterMover {
   bool ground(const WorldQueries& world, const glm::dvec3& origin, const CharacterShape& shape,
               const glm::vec3& position, float above, GroundHit& hit);
 
+  // A horizontal `step` from `position` (the simulation object's give toward the character) less
+  // its part into whatever the capsule meets on the way: one sweep, no slide, no ground probe. A
+  // step's top under the capsule's bottom is no obstacle.
+  glm::vec3 free_step(const WorldQueries& world, const glm::dvec3& origin,
+                      const CharacterShape& shape, const glm::vec3& position,
+                      const glm::vec3& step);
+
   // Ground probes as given, in one call to the world; an answer that fails the checks
   // (world.hpp) becomes no hit and is counted in rejected(). `hits` is as long as `probes`.
   void probe(const WorldQueries& world, const glm::dvec3& origin,

@@ -747,9 +747,6 @@ class Controller {
 
   // Simulation object.
   glm::vec3 sim_position_{0.0f}, sim_velocity_{0.0f}, sim_acceleration_{0.0f};
-  // In a world, the simulation object's give toward the character (synchronize), moved through
-  // the world with the object's next step.
-  glm::vec3 sim_yield_{0.0f};
   glm::quat sim_rotation_{1.0f, 0.0f, 0.0f, 0.0f};
   glm::vec3 sim_angular_velocity_{0.0f};
   glm::vec3 desired_velocity_{0.0f};

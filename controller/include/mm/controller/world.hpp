@@ -6,8 +6,9 @@
 // Who calls, how often: the controller, inside update(), a fixed number of batched calls per
 // update (at most kMaxWorldCallsPerUpdate), each carrying every query of one kind that one of
 // its moves needs: a sweep, a slide and a ground probe (character_mover.hpp) for the simulation
-// object, the same for the animated root, and the same for every predicted trajectory sample at
-// once; and one call probing the ground under the feet (foot_placement.hpp). The spans are the
+// object (and one sweep of its give toward the character), the same for the animated root, and
+// the same for every predicted trajectory sample at once; one call probing the ground under the
+// feet (foot_placement.hpp) and one sweeping toward the toes and arms. The spans are the
 // controller's own pre-sized buffers: an implementation must not keep them past the call. A
 // call must not allocate if the game's frame must not, and must be safe to make from the thread
 // that runs this controller's update (several controllers may query one world from several
@@ -29,8 +30,10 @@
 namespace mm {
 
 // At most this many query calls per update: three moves (simulation, root, trajectory) of at
-// most three calls each, and the feet's ground probes (foot_placement.hpp).
-inline constexpr int kMaxWorldCallsPerUpdate = 11;
+// most three calls each, the feet's ground probes (foot_placement.hpp), the sweeps toward the
+// toes and arms (walls near the feet), and the simulation object's give toward the character
+// (one sweep).
+inline constexpr int kMaxWorldCallsPerUpdate = 12;
 
 // From `from`, straight down (-Y), at most `max_distance` metres.
 struct GroundProbe {
