@@ -408,14 +408,21 @@ void FootPlacement::rest_heels_on_edges(std::span<const PlacementLeg, 2> legs) {
 }
 
 // Ahead counts only where the ground steps up: up a slope it is only the slope, which the foot
-// will meet as it gets there (counted now, a landing foot would lock in the air).
+// will meet as it gets there (counted now, a landing foot would lock in the air), and so is the
+// start of a slope ahead.
 void FootPlacement::keep_steps_ahead() {
   for (int side = 0; side < 2; ++side) {
     for (const int later : {kHeelAhead, kToeAhead, kHeelOwn, kToeOwn}) {
       const int now = now_of(later);
       glm::vec3& ahead_ground = probe_grounds_[slot(side, later)];
-      if (ahead_ground.y < plane_height(side, now, ahead_ground) + kStepRise) {
-        ahead_ground.y = probe_grounds_[slot(side, now)].y;
+      const glm::vec3& now_ground = probe_grounds_[slot(side, now)];
+      // Nor where the ground ahead is a slope whose own plane, carried back, passes below the
+      // ground here: a ramp starting ahead, which the foot meets as it gets there (raised toward
+      // it, a foot landing at ramp_30's foot rose 5 cm in an update and sank again: docs/world.md,
+      // session 32).
+      const bool slope_starts = plane_height(side, later, now_ground) < now_ground.y + kStepRise;
+      if (ahead_ground.y < plane_height(side, now, ahead_ground) + kStepRise || slope_starts) {
+        ahead_ground.y = now_ground.y;
       }
     }
   }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -400,6 +401,29 @@ TEST(FootPlacement, ASwingingToeRisesBeforeItReachesTheRiser) {
   // planted foot, looking only where it is, does not.
   EXPECT_GT(p.ground(0).toe, 0.15f);
   EXPECT_EQ(p.ground(1).toe, 0.0f);
+}
+
+// A foot swinging toward the foot of a 30 degree ramp: its look-ahead finds the ramp's slope
+// higher than the floor's plane carried forward, as a tread would be, but the ramp's own plane
+// carried back to the toe passes below the floor: it is a slope that starts ahead, which the foot
+// meets as it gets there, not a step to rise to. Raised toward it, a foot about to land at the
+// ramp's foot rose 5 cm in an update and sank again (stand-turns before the first course's
+// ramp_30 at 1/30 s). A riser ahead is still a step (ASwingingToeRisesBeforeItReachesTheRiser).
+TEST(FootPlacement, ASwingingToeDoesNotRiseTowardARampThatStartsAhead) {
+  AnalyticWorld world;
+  const double slope = std::tan(30.0 * kPi / 180.0);
+  world.height = [slope](double, double z) { return z > 0.3 ? (z - 0.3) * slope : 0.0; };
+  CharacterMover mover;
+  FootPlacement p;
+  const std::array<PlacementLeg, 2> legs = left_swinging(0.1f);  // the toe at z = 0.25
+  p.reset(0.0f);
+  const FootPlacementSettings settings;
+  float highest = 0.0f;
+  for (int f = 0; f < 6; ++f) {
+    p.update(world, glm::dvec3(0.0), mover, settings, legs, 0.0f, glm::vec3(0.0f, 0.0f, 1.4f), kDt);
+    highest = std::max(highest, p.ground(0).toe);
+  }
+  EXPECT_LT(highest, 0.01f);
 }
 
 // A riser seen at the end of the look-ahead (the body's, 0.2 s) is climbed with the toe's ground
