@@ -1638,7 +1638,7 @@ void Controller::reach(int side, const glm::vec3& animated, const glm::vec3& tar
   // foot's ground below the body's.
   const float reach_down_weight =
       world_ ? (ground_height_ - foot_placement_.ground(side).toe) / kShortBelowDepth : 0.0f;
-  reached = reach_down(ankle_target - hip_position, reached, reach_down_weight);
+  if (world_) reached = reach_down(ankle_target - hip_position, reached, reach_down_weight);
   // A held toe the softened leg falls short of is reached by lifting the heel, not by dragging
   // the toe: the leg keeps the softened length, so the knee bends as it would, and the toe
   // stays put (up to the heel's limit).
