@@ -615,12 +615,7 @@ void Controller::find_walls(const std::array<PlacementLeg, 2>& legs,
     if (length < 1e-4f) continue;
     out[count] = &riser_walls_[side];
     least_share[count] = kRiserNormal;  // a riser is a side, not a ramp's slope run into
-    // Started a radius back, a toe moving away from a face it was kept a radius off starts
-    // inside it, and the sweep's contact there, at its start, faced the other way: the toe was
-    // pushed into the face it moved away from (random-long from x = 9 at 1/60 s, a toe taken into
-    // the side of stairs_20_25; docs/world.md). A face met within half a radius of the start counts
-    // only across the way (a toe sliding along the riser it is kept off), not facing back along
-    // it.
+    // Started a radius back, it may start inside a face the toe leaves (sweep_start.hpp).
     backed[count] = true;
     const glm::vec3 back = (to - from) * (kWallProbeRadius / length);
     sweeps[count++] = ShapeSweep{from - back, to, kWallProbeRadius, 2.0f * kWallProbeRadius};
